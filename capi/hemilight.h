@@ -1,0 +1,123 @@
+/* hemilight.h — the C ABI of hemilight (C99, no C++ inside).
+ *
+ * hemilight bakes diffuse global illumination on the CPU: a software hemicube rasterizer, exact
+ * hemicube integration with irradiance gradients, an irradiance cache, and seamless cube-map
+ * filtering. This header is the stable interface for engines; link with -lhemilight_c
+ * (CMake: hemilight::capi, pkg-config: hemilight).
+ *
+ * Conventions
+ *   - Every function returns hemilight_status. On failure nothing is written to the caller's
+ *     outputs and hemilight_last_error() describes the problem, naming the bad argument.
+ *   - No C++ exception ever leaves this library.
+ *   - Directions and positions are float[3] (x, y, z); frames are right-handed.
+ *   - Radiance is in W m^-2 sr^-1 (or any consistent unit); irradiance is the integral of
+ *     L cos(theta) d omega, so a uniform sky of radiance L gives pi L. No hidden 1/pi.
+ *   - Images are float, channels interleaved, rows one after another, row 0 first; cube maps are
+ *     six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), face-major, each size x size texels with
+ *     x along the GL s coordinate and y along t.
+ *   - Thread safety: every function may be called from any thread; objects are immutable after
+ *     creation unless a function says otherwise.
+ */
+#ifndef HEMILIGHT_H
+#define HEMILIGHT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#  if defined(HEMILIGHT_BUILDING_CAPI)
+#    define HEMILIGHT_API __declspec(dllexport)
+#  else
+#    define HEMILIGHT_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__) || defined(__clang__)
+#  define HEMILIGHT_API __attribute__((visibility("default")))
+#else
+#  define HEMILIGHT_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Compile-time version of this header; hemilight_version() gives the library's. */
+#define HEMILIGHT_VERSION_MAJOR 0
+#define HEMILIGHT_VERSION_MINOR 1
+#define HEMILIGHT_VERSION_PATCH 0
+
+typedef enum hemilight_status {
+  HEMILIGHT_OK = 0,
+  HEMILIGHT_ERROR_INVALID_ARGUMENT, /* NULL, NaN/Inf, out-of-range or inconsistent argument */
+  HEMILIGHT_ERROR_OUT_OF_MEMORY,    /* allocation failed, or a size over a documented limit */
+  HEMILIGHT_ERROR_IO,               /* file missing, unreadable, truncated, corrupt, or not written */
+  HEMILIGHT_ERROR_UNSUPPORTED,      /* valid but not handled: e.g. an EXR without R, G, B */
+  HEMILIGHT_ERROR_CANCELLED,        /* a progress callback asked to stop */
+  HEMILIGHT_ERROR_INTERNAL          /* a bug in hemilight: please report it */
+} hemilight_status;
+
+/* The message of the last failure on the calling thread ("" if none yet). Never NULL. The
+ * pointer stays valid until the next hemilight call on the same thread. */
+HEMILIGHT_API const char* hemilight_last_error(void);
+
+/* The library's version. Any pointer may be NULL. */
+HEMILIGHT_API void hemilight_version(int* major, int* minor, int* patch);
+
+/* ---- hemicube geometry ------------------------------------------------------------------------
+ * A hemicube of resolution N (even, 2..4096) has a top face of N x N texels and four side faces
+ * (+x, -x, +y, -y) of N x N/2 texels: 3 N^2 texels, numbered top face first, then the side faces in
+ * that order, row-major inside each face. In the local frame the surface normal is +z; the top
+ * face's texel (0, 0) is at the corner (-1, -1) and its rows go towards +y; a side face's rows
+ * start at the horizon and go up, and its columns run along z x (face axis). See
+ * include/hemilight/geometry.hpp for the full table. */
+
+/* Number of texels of a hemicube of resolution N: 3 N^2.
+ * Errors: INVALID_ARGUMENT if count is NULL or N is odd or outside [2, 4096]. */
+HEMILIGHT_API hemilight_status hemilight_hemicube_texel_count(int resolution, size_t* count);
+
+/* One texel's unit centre direction (local frame, z >= 0), exact solid angle (sr) and exact
+ * projected solid angle (integral of cos(theta) over the texel, sr). Solid angles sum to 2 pi,
+ * projected solid angles to pi. Any output pointer may be NULL (not written).
+ * Errors: INVALID_ARGUMENT for an invalid N or texel >= 3 N^2. Cost: O(1) (a cached table). */
+HEMILIGHT_API hemilight_status hemilight_hemicube_texel_info(int resolution, size_t texel, float direction[3],
+                                                             float* solid_angle, float* projected_solid_angle);
+
+/* ---- OpenEXR images ----------------------------------------------------------------------------
+ * Two calls to read: hemilight_exr_info for the size, then a load into a buffer the caller owns.
+ * Readers accept any scanline or tiled EXR with channels R, G, B (A and others are ignored), of
+ * half, float or uint type. Images of more than 2^28 pixels are refused (OUT_OF_MEMORY). */
+
+/* Width and height of an EXR image, and whether it is a cube map (envmap attribute = cube, or
+ * height == 6 x width). Any output may be NULL. Errors: INVALID_ARGUMENT (path NULL), IO (missing,
+ * unreadable or corrupt file), UNSUPPORTED (no R, G, B channels). */
+HEMILIGHT_API hemilight_status hemilight_exr_info(const char* path, int* width, int* height, int* is_cubemap);
+
+/* Reads an EXR image as float RGB into rgb (capacity in floats, at least width x height x 3).
+ * width and height (may be NULL) receive the size. Errors: as hemilight_exr_info, and
+ * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). */
+HEMILIGHT_API hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t capacity, int* width,
+                                                      int* height);
+
+/* Writes float RGB pixels (width x height x 3 floats) as an EXR file, 32-bit float channels or,
+ * when half_float is nonzero, 16-bit half. The file is replaced atomically: on failure any
+ * existing file is left as it was. Errors: INVALID_ARGUMENT (NULL, sizes <= 0 or over the limit,
+ * non-finite values are allowed), IO (cannot write). */
+HEMILIGHT_API hemilight_status hemilight_exr_save_rgb(const char* path, const float* rgb, int width, int height,
+                                                      int half_float);
+
+/* Reads an ENVMAP_CUBE EXR (size x 6 size) as six GL-ordered faces of float RGB into faces
+ * (capacity in floats, at least 6 x size x size x 3); size receives the face size (may be NULL).
+ * Errors: as hemilight_exr_load_rgb, and UNSUPPORTED when the image is not 6x as tall as wide or
+ * is a latlong map. */
+HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, float* faces, size_t capacity,
+                                                              int* size);
+
+/* Writes six GL-ordered float RGB faces of size x size as an OpenEXR ENVMAP_CUBE file.
+ * Errors: as hemilight_exr_save_rgb. */
+HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size,
+                                                              int half_float);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* HEMILIGHT_H */

@@ -1,0 +1,181 @@
+// The C ABI: validates every argument, calls the C++ library, and turns exceptions into
+// hemilight_status + a thread-local message. Nothing is written to an output before the whole
+// result is known, so a failing call leaves the caller's memory untouched.
+#include "hemilight.h"
+
+#include "hemilight/error.hpp"
+#include "hemilight/geometry.hpp"
+#include "hemilight/image_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <string>
+
+namespace {
+
+thread_local std::string last_error_message;
+
+hemilight_status to_c(hemilight::status s) { return static_cast<hemilight_status>(static_cast<int>(s)); }
+
+hemilight_status set_error(hemilight_status code, std::string message) {
+  last_error_message = std::move(message);
+  return code;
+}
+
+hemilight_status invalid(const char* function, const std::string& what) {
+  return set_error(HEMILIGHT_ERROR_INVALID_ARGUMENT, std::string(function) + ": " + what);
+}
+
+// Runs f() and converts every exception to a status; f returns HEMILIGHT_OK or an error it set.
+template <class F>
+hemilight_status guarded(const char* function, F&& f) noexcept {
+  try {
+    return f();
+  } catch (const hemilight::error& e) {
+    return set_error(to_c(e.code()), e.what());
+  } catch (const std::bad_alloc&) {
+    return set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY, std::string(function) + ": out of memory");
+  } catch (const std::exception& e) {
+    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error: " + e.what());
+  } catch (...) {
+    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error (unknown exception)");
+  }
+}
+
+bool check_resolution(const char* function, int resolution, hemilight_status& status) {
+  if (hemilight::is_valid_hemicube_resolution(resolution)) return true;
+  status = invalid(function, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
+  return false;
+}
+
+bool check_size(const char* function, const char* name, int value, hemilight_status& status) {
+  if (value > 0) return true;
+  status = invalid(function, std::string(name) + " is " + std::to_string(value) + "; it must be positive");
+  return false;
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* hemilight_last_error(void) { return last_error_message.c_str(); }
+
+void hemilight_version(int* major, int* minor, int* patch) {
+  if (major) *major = hemilight::version_major;
+  if (minor) *minor = hemilight::version_minor;
+  if (patch) *patch = hemilight::version_patch;
+}
+
+hemilight_status hemilight_hemicube_texel_count(int resolution, size_t* count) {
+  const char* fn = "hemilight_hemicube_texel_count";
+  return guarded(fn, [&] {
+    hemilight_status st = HEMILIGHT_OK;
+    if (!count) return invalid(fn, "count is NULL");
+    if (!check_resolution(fn, resolution, st)) return st;
+    *count = hemilight::hemicube_texel_count(resolution);
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_hemicube_texel_info(int resolution, size_t texel, float direction[3], float* solid_angle,
+                                               float* projected_solid_angle) {
+  const char* fn = "hemilight_hemicube_texel_info";
+  return guarded(fn, [&] {
+    hemilight_status st = HEMILIGHT_OK;
+    if (!check_resolution(fn, resolution, st)) return st;
+    const std::size_t count = hemilight::hemicube_texel_count(resolution);
+    if (texel >= count)
+      return invalid(fn, "texel " + std::to_string(texel) + " is out of range: resolution " +
+                             std::to_string(resolution) + " has " + std::to_string(count) + " texels");
+    const auto table = hemilight::hemicube_table::get(resolution);
+    const glm::vec3 d = hemilight::hemicube_texel_direction(resolution, texel);
+    if (direction) {
+      direction[0] = d.x;
+      direction[1] = d.y;
+      direction[2] = d.z;
+    }
+    if (solid_angle) *solid_angle = table->solid_angle()[texel];
+    if (projected_solid_angle) *projected_solid_angle = table->projected_solid_angle()[texel];
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_exr_info(const char* path, int* width, int* height, int* is_cubemap) {
+  const char* fn = "hemilight_exr_info";
+  return guarded(fn, [&] {
+    if (!path) return invalid(fn, "path is NULL");
+    // Reading the pixels too keeps one code path for every check (truncation, channels); the
+    // cost is one decode of the file.
+    const hemilight::image img = hemilight::read_exr(path, 3);
+    if (width) *width = img.width;
+    if (height) *height = img.height;
+    if (is_cubemap) *is_cubemap = static_cast<long long>(img.height) == 6LL * img.width ? 1 : 0;
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t capacity, int* width, int* height) {
+  const char* fn = "hemilight_exr_load_rgb";
+  return guarded(fn, [&] {
+    if (!path) return invalid(fn, "path is NULL");
+    if (!rgb) return invalid(fn, "rgb is NULL");
+    const hemilight::image img = hemilight::read_exr(path, 3);
+    if (img.pixels.size() > capacity)
+      return invalid(fn, "capacity " + std::to_string(capacity) + " floats is too small for '" + path + "' (" +
+                             std::to_string(img.width) + " x " + std::to_string(img.height) + " x 3 = " +
+                             std::to_string(img.pixels.size()) + " floats)");
+    std::copy(img.pixels.begin(), img.pixels.end(), rgb);
+    if (width) *width = img.width;
+    if (height) *height = img.height;
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_exr_save_rgb(const char* path, const float* rgb, int width, int height, int half_float) {
+  const char* fn = "hemilight_exr_save_rgb";
+  return guarded(fn, [&] {
+    hemilight_status st = HEMILIGHT_OK;
+    if (!path) return invalid(fn, "path is NULL");
+    if (!rgb) return invalid(fn, "rgb is NULL");
+    if (!check_size(fn, "width", width, st) || !check_size(fn, "height", height, st)) return st;
+    hemilight::image img = hemilight::image::make(width, height, 3);  // validates the size limit
+    std::copy(rgb, rgb + img.pixels.size(), img.pixels.begin());
+    hemilight::write_exr(path, img, half_float ? hemilight::exr_pixel_type::half16 : hemilight::exr_pixel_type::float32);
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, float* faces, size_t capacity, int* size) {
+  const char* fn = "hemilight_exr_load_cubemap_rgb";
+  return guarded(fn, [&] {
+    if (!path) return invalid(fn, "path is NULL");
+    if (!faces) return invalid(fn, "faces is NULL");
+    const hemilight::cube_image cube = hemilight::read_exr_cubemap(path, 3);
+    if (cube.pixels.size() > capacity)
+      return invalid(fn, "capacity " + std::to_string(capacity) + " floats is too small for '" + path +
+                             "' (6 x " + std::to_string(cube.size) + " x " + std::to_string(cube.size) + " x 3 = " +
+                             std::to_string(cube.pixels.size()) + " floats)");
+    std::copy(cube.pixels.begin(), cube.pixels.end(), faces);
+    if (size) *size = cube.size;
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size, int half_float) {
+  const char* fn = "hemilight_exr_save_cubemap_rgb";
+  return guarded(fn, [&] {
+    hemilight_status st = HEMILIGHT_OK;
+    if (!path) return invalid(fn, "path is NULL");
+    if (!faces) return invalid(fn, "faces is NULL");
+    if (!check_size(fn, "size", size, st)) return st;
+    hemilight::cube_image cube = hemilight::cube_image::make(size, 3);
+    std::copy(faces, faces + cube.pixels.size(), cube.pixels.begin());
+    hemilight::write_exr_cubemap(path, cube,
+                                 half_float ? hemilight::exr_pixel_type::half16 : hemilight::exr_pixel_type::float32);
+    return HEMILIGHT_OK;
+  });
+}
+
+}  // extern "C"
