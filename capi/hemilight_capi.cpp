@@ -1,7 +1,7 @@
 // The C ABI: validates every argument, calls the C++ library, and turns exceptions into
 // hemilight_status + a thread-local message. Nothing is written to an output before the whole
 // result is known, so a failing call leaves the caller's memory untouched.
-#include "hemilight.h"
+#include "capi_internal.hpp"
 
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
@@ -15,34 +15,10 @@
 
 namespace {
 
+using hemilight::capi::guarded;
+using hemilight::capi::invalid;
+
 thread_local std::string last_error_message;
-
-hemilight_status to_c(hemilight::status s) { return static_cast<hemilight_status>(static_cast<int>(s)); }
-
-hemilight_status set_error(hemilight_status code, std::string message) {
-  last_error_message = std::move(message);
-  return code;
-}
-
-hemilight_status invalid(const char* function, const std::string& what) {
-  return set_error(HEMILIGHT_ERROR_INVALID_ARGUMENT, std::string(function) + ": " + what);
-}
-
-// Runs f() and converts every exception to a status; f returns HEMILIGHT_OK or an error it set.
-template <class F>
-hemilight_status guarded(const char* function, F&& f) noexcept {
-  try {
-    return f();
-  } catch (const hemilight::error& e) {
-    return set_error(to_c(e.code()), e.what());
-  } catch (const std::bad_alloc&) {
-    return set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY, std::string(function) + ": out of memory");
-  } catch (const std::exception& e) {
-    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error: " + e.what());
-  } catch (...) {
-    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error (unknown exception)");
-  }
-}
 
 bool check_resolution(const char* function, int resolution, hemilight_status& status) {
   if (hemilight::is_valid_hemicube_resolution(resolution)) return true;
@@ -57,6 +33,19 @@ bool check_size(const char* function, const char* name, int value, hemilight_sta
 }
 
 }  // namespace
+
+namespace hemilight::capi {
+
+hemilight_status set_error(hemilight_status code, std::string message) {
+  last_error_message = std::move(message);
+  return code;
+}
+
+hemilight_status invalid(const char* function, const std::string& what) {
+  return set_error(HEMILIGHT_ERROR_INVALID_ARGUMENT, std::string(function) + ": " + what);
+}
+
+}  // namespace hemilight::capi
 
 extern "C" {
 

@@ -99,7 +99,7 @@ TEST_CASE("exr: row 0 is the first scanline (top of the image)", "[image_io]") {
   CHECK(r[0] == 0.0f);
 }
 
-TEST_CASE("exr: an RGB file read as RGBA gets alpha 1; RGBA read as RGB drops alpha", "[image_io]") {
+TEST_CASE("exr: an RGB file read as RGBA gets alpha 1, RGBA read as RGB drops alpha", "[image_io]") {
   const image rgb = random_image(4, 4, 3, 9);
   write_exr(tmp_path("rgb.exr"), rgb);
   const image rgba = read_exr(tmp_path("rgb.exr"), 4);

@@ -4,8 +4,12 @@
 //   error.hpp     status codes, hemilight::error, version
 //   geometry.hpp  hemicube layout and exact texel weights, GL cube-map faces, frames
 //   image_io.hpp  float images and cube maps as OpenEXR
+//   parallel.hpp  parallel_for: the one way hemilight uses several cores
+//   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
 #pragma once
 
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
+#include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
+#include "hemilight/parallel.hpp"

@@ -1,0 +1,49 @@
+// Shared by the C ABI's implementation files (not installed): status conversion, the
+// thread-local last error, and the exception guard every entry point runs in.
+#pragma once
+
+#include "hemilight.h"
+
+#include "hemilight/error.hpp"
+
+#include <cmath>
+#include <exception>
+#include <new>
+#include <string>
+
+namespace hemilight::capi {
+
+/// Stores `message` as the calling thread's last error and returns `code`.
+hemilight_status set_error(hemilight_status code, std::string message);
+
+/// set_error(HEMILIGHT_ERROR_INVALID_ARGUMENT, "function: what").
+hemilight_status invalid(const char* function, const std::string& what);
+
+inline hemilight_status to_c(status s) { return static_cast<hemilight_status>(static_cast<int>(s)); }
+
+/// Runs f() (which returns HEMILIGHT_OK or a status it set) and turns every exception into a
+/// status with a message: hemilight::error keeps its code, bad_alloc is OUT_OF_MEMORY, anything
+/// else is INTERNAL. No exception leaves.
+template <class F>
+hemilight_status guarded(const char* function, F&& f) noexcept {
+  try {
+    return f();
+  } catch (const error& e) {
+    return set_error(to_c(e.code()), e.what());
+  } catch (const std::bad_alloc&) {
+    return set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY, std::string(function) + ": out of memory");
+  } catch (const std::exception& e) {
+    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error: " + e.what());
+  } catch (...) {
+    return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error (unknown exception)");
+  }
+}
+
+/// True if all `count` floats are finite.
+inline bool all_finite(const float* v, std::size_t count) noexcept {
+  for (std::size_t i = 0; i < count; ++i)
+    if (!std::isfinite(v[i])) return false;
+  return true;
+}
+
+}  // namespace hemilight::capi
