@@ -6,8 +6,10 @@
 //   image_io.hpp  float images and cube maps as OpenEXR
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
+//   cubemap.hpp   environment cube maps: mappings, sampling, lookup fixup, filtering, SH
 #pragma once
 
+#include "hemilight/cubemap.hpp"
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"

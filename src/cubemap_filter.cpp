@@ -1,0 +1,533 @@
+// Cube-map filtering: the fast cosine-power / irradiance filter, its brute-force reference, the
+// gloss mapping and mip chains, and 9-coefficient SH irradiance.
+#include "hemilight/cubemap.hpp"
+#include "hemilight/parallel.hpp"
+
+#include "cubemap_internal.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+namespace hemilight {
+
+namespace cubemap_detail {
+
+face_table::face_table(int size) : n(size), texels(std::size_t(size) * std::size_t(size)) {
+  const std::size_t m = std::size_t(size) + 1;
+  const double s = 2.0 / size;
+  // A(u, v) at the texel corners once; a texel's solid angle is a 2 x 2 difference of them.
+  std::vector<double> a(m * m);
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < m; ++i) {
+      const double u = -1.0 + s * static_cast<double>(i), v = -1.0 + s * static_cast<double>(j);
+      a[j * m + i] = std::atan2(u * v, std::sqrt(u * u + v * v + 1.0));
+    }
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const std::size_t i = std::size_t(x), j = std::size_t(y);
+      const double omega = a[(j + 1) * m + i + 1] - a[j * m + i + 1] - a[(j + 1) * m + i] + a[j * m + i];
+      const double u = cubemap_texel_coordinate(size, x, edge_fixup::none);
+      const double v = cubemap_texel_coordinate(size, y, edge_fixup::none);
+      const double len = std::sqrt(u * u + v * v + 1.0);
+      texels[j * std::size_t(size) + i] =
+          glm::vec4(static_cast<float>(u / len), static_cast<float>(v / len), static_cast<float>(1.0 / len),
+                    static_cast<float>(omega));
+    }
+}
+
+std::shared_ptr<const face_table> face_table::get(int size) {
+  static std::mutex mutex;
+  static std::map<int, std::shared_ptr<const face_table>> cache;
+  if (size > 1024) return std::make_shared<const face_table>(size);
+  std::lock_guard<std::mutex> lock(mutex);
+  std::shared_ptr<const face_table>& slot = cache[size];
+  if (!slot) slot = std::make_shared<const face_table>(size);
+  return slot;
+}
+
+}  // namespace cubemap_detail
+
+using namespace cubemap_detail;
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+
+void check_power(const char* fn, float power) {
+  if (!std::isfinite(power) || !(power > 0.0f))
+    throw_invalid_argument(std::string(fn) + ": specular power " + std::to_string(power) +
+                           " is invalid; it must be finite and > 0");
+}
+
+void check_output_size(const char* fn, int size) {
+  if (size < 1 || size > cubemap_max_size)
+    throw_invalid_argument(std::string(fn) + ": output size " + std::to_string(size) + " is outside [1, " +
+                           std::to_string(cubemap_max_size) + "]");
+}
+
+void check_options(const char* fn, const filter_options& o) {
+  const int f = static_cast<int>(o.fixup);
+  if (f < 0 || f > 2) throw_invalid_argument(std::string(fn) + ": fixup " + std::to_string(f) + " is not 0, 1 or 2");
+  if (!std::isfinite(o.cutoff) || !(o.cutoff > 0.0f) || !(o.cutoff < 1.0f))
+    throw_invalid_argument(std::string(fn) + ": cutoff " + std::to_string(o.cutoff) + " is outside (0, 1)");
+  if (!std::isfinite(o.texels_per_sigma) || !(o.texels_per_sigma > 0.0f))
+    throw_invalid_argument(std::string(fn) + ": texels_per_sigma " + std::to_string(o.texels_per_sigma) +
+                           " must be finite and > 0");
+  if (o.min_input_size < 1)
+    throw_invalid_argument(std::string(fn) + ": min_input_size " + std::to_string(o.min_input_size) + " must be >= 1");
+}
+
+// Level 0 of the input and coarser levels below it (as long as the size stays even), each
+// texel with its face-local centre direction and exact solid angle (the shared face table). A
+// coarser texel holds the solid-angle-weighted mean of its four children (downsample_cube).
+// (Tried and dropped: evaluating coarse texels at their energy centroid; it cut the error at
+// texels_per_sigma = 1.5 by a third but cost 1.6x the time, worse than raising texels_per_sigma.)
+struct chain_level {
+  const cube_image* image = nullptr;
+  std::shared_ptr<const face_table> centres;
+};
+
+struct input_chain {
+  std::vector<cube_image> owned;  // levels 1..
+  std::vector<chain_level> levels;
+  explicit input_chain(const cube_image& top) {
+    owned.reserve(16);
+    levels.push_back({&top, face_table::get(top.size)});
+    while (levels.back().image->size > 1 && levels.back().image->size % 2 == 0) {
+      owned.push_back(downsample_cube(*levels.back().image));
+      levels.push_back({&owned.back(), face_table::get(owned.back().size)});
+    }
+  }
+};
+
+// The weight max(0, d.w)^p as a function of x = 1 - d.w over [0, 1 - cos(theta_max)]: a table
+// with linear interpolation for p >= 8 (the relative interpolation error is below 1e-5: the log
+// of the weight changes by ln(1/cutoff)/1024 per step), std::pow below (wide lobes, coarse
+// levels: few evaluations, and the table would be inaccurate near dot = 0 for p < 1). Past the
+// cutoff the table falls linearly to 0 over one step and stays 0, so the tabulated weight needs
+// no branch (everything outside the lobe, including dot <= 0, reads 0).
+struct lobe {
+  static constexpr int steps = 1024;
+  float power = 1;
+  float cos_max = 0;
+  bool cosine = false;  // p == 1: the weight is the dot itself
+  bool tabulated = false;
+  float inv_step = 0;
+  std::vector<float> table;
+
+  lobe(float p, float cutoff) : power(p) {
+    cos_max = static_cast<float>(std::pow(static_cast<double>(cutoff), 1.0 / p));
+    cosine = p == 1.0f;
+    if (p >= 8.0f) {
+      tabulated = true;
+      const double range = 1.0 - cos_max;
+      table.assign(steps + 3, 0.0f);
+      for (int i = 0; i <= steps; ++i)
+        table[std::size_t(i)] = static_cast<float>(std::pow(1.0 - range * i / steps, static_cast<double>(p)));
+      inv_step = static_cast<float>(steps / range);
+    }
+  }
+  float weight(float dot) const noexcept {
+    if (cosine) return dot;
+    if (!tabulated) return std::pow(dot, power);
+    return tabulated_weight(dot);
+  }
+  float tabulated_weight(float dot) const noexcept {
+    const float f = std::min(std::max(0.0f, 1.0f - dot) * inv_step, static_cast<float>(steps + 1));
+    const int i = static_cast<int>(f);
+    const float t = f - static_cast<float>(i);
+    const float* e = table.data() + i;
+    return e[0] + t * (e[1] - e[0]);
+  }
+};
+
+// Range of face coordinate (along `c`) covered by the cap {w : d.w >= cos(theta)} on the face with
+// local direction components (dc, dr, da) of d. Returns false if the cap misses the face.
+bool cap_range(double dc, double da, double s2, double rho, double& lo, double& hi) {
+  if (da > 0.0 && da * da > s2) {
+    // The cap's boundary is an ellipse on the face plane; its tangent lines u = u0 solve
+    // (da^2 - s2) u0^2 - 2 dc da u0 + (dc^2 - s2) = 0 (the dual conic of n n^T - s2 I).
+    const double q = da * da - s2;
+    const double disc = std::sqrt(std::max(0.0, s2 * (da * da + dc * dc - s2)));
+    lo = (dc * da - disc) / q;
+    hi = (dc * da + disc) / q;
+  } else {
+    // The cap reaches the face plane's horizon: bound it by the ball |w - d| <= rho instead.
+    // On a face the major component is >= 1/sqrt(3).
+    const double a_lo = std::max(da - rho, 0.5773502691896258), a_hi = std::min(da + rho, 1.0);
+    if (a_hi < a_lo) return false;
+    const double c_lo = std::max(dc - rho, -1.0), c_hi = std::min(dc + rho, 1.0);
+    lo = std::min(c_lo / a_lo, c_lo / a_hi);
+    hi = std::max(c_hi / a_lo, c_hi / a_hi);
+  }
+  return hi >= -1.0 && lo <= 1.0;
+}
+
+// Sums w L (per channel, into sums[0..3]) and w (sums[4]) over texels xa..xb of one row, w =
+// solid angle * tabulated lobe weight; the hot loop of the filter. SSE2 (every x86-64) does
+// four texels at a time; other targets use the scalar loop. Either way the order of the sums
+// depends only on (xa, xb), never on threads: results are deterministic.
+void accumulate_row(const lobe& lb, const glm::vec3& dl, const glm::vec4* row, const float* px, std::size_t ch, int xa,
+                    int xb, float sums[5]) {
+  float a0 = 0, a1 = 0, a2 = 0, a3 = 0, ws = 0;  // one row: at most a few hundred terms
+  int x = xa;
+#if defined(__SSE2__)
+  if (ch == 3 || ch == 4) {
+    const __m128 dx = _mm_set1_ps(dl.x), dy = _mm_set1_ps(dl.y), dz = _mm_set1_ps(dl.z);
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps(), inv = _mm_set1_ps(lb.inv_step);
+    const __m128 top = _mm_set1_ps(static_cast<float>(lobe::steps + 1));
+    __m128 acc_a = zero, acc_b = zero, acc_c = zero, acc_w = zero;
+    alignas(16) int idx[4];
+    for (; x + 3 <= xb; x += 4) {
+      __m128 tx = _mm_loadu_ps(&row[x].x), ty = _mm_loadu_ps(&row[x + 1].x);
+      __m128 tz = _mm_loadu_ps(&row[x + 2].x), tw = _mm_loadu_ps(&row[x + 3].x);
+      _MM_TRANSPOSE4_PS(tx, ty, tz, tw);  // now x, y, z, solid angle of the four texels
+      const __m128 dot = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, tx), _mm_mul_ps(dy, ty)), _mm_mul_ps(dz, tz));
+      const __m128 f = _mm_min_ps(_mm_mul_ps(_mm_max_ps(zero, _mm_sub_ps(one, dot)), inv), top);
+      const __m128i fi = _mm_cvttps_epi32(f);
+      const __m128 t = _mm_sub_ps(f, _mm_cvtepi32_ps(fi));
+      _mm_store_si128(reinterpret_cast<__m128i*>(idx), fi);
+      const float* tab = lb.table.data();
+      const __m128 e0 = _mm_setr_ps(tab[idx[0]], tab[idx[1]], tab[idx[2]], tab[idx[3]]);
+      const __m128 e1 = _mm_setr_ps(tab[idx[0] + 1], tab[idx[1] + 1], tab[idx[2] + 1], tab[idx[3] + 1]);
+      const __m128 w = _mm_mul_ps(tw, _mm_add_ps(e0, _mm_mul_ps(t, _mm_sub_ps(e1, e0))));
+      acc_w = _mm_add_ps(acc_w, w);
+      const float* p = px + std::size_t(x) * ch;
+      if (ch == 3) {
+        // 12 floats r0 g0 b0 r1 | g1 b1 r2 g2 | b2 r3 g3 b3 times w0 w0 w0 w1 | w1 w1 w2 w2 | w2 w3 w3 w3
+        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(w, w, _MM_SHUFFLE(1, 0, 0, 0))));
+        acc_b = _mm_add_ps(acc_b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(w, w, _MM_SHUFFLE(2, 2, 1, 1))));
+        acc_c = _mm_add_ps(acc_c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(w, w, _MM_SHUFFLE(3, 3, 3, 2))));
+      } else {
+        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(w, w, _MM_SHUFFLE(0, 0, 0, 0))));
+        acc_b = _mm_add_ps(acc_b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(w, w, _MM_SHUFFLE(1, 1, 1, 1))));
+        acc_c = _mm_add_ps(acc_c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(w, w, _MM_SHUFFLE(2, 2, 2, 2))));
+        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p + 12), _mm_shuffle_ps(w, w, _MM_SHUFFLE(3, 3, 3, 3))));
+      }
+    }
+    alignas(16) float va[4], vb[4], vc[4], vw[4];
+    _mm_store_ps(va, acc_a);
+    _mm_store_ps(vb, acc_b);
+    _mm_store_ps(vc, acc_c);
+    _mm_store_ps(vw, acc_w);
+    if (ch == 3) {
+      a0 = va[0] + va[3] + vb[2] + vc[1];
+      a1 = va[1] + vb[0] + vb[3] + vc[2];
+      a2 = va[2] + vb[1] + vc[0] + vc[3];
+    } else {
+      a0 = va[0] + vb[0] + vc[0];
+      a1 = va[1] + vb[1] + vc[1];
+      a2 = va[2] + vb[2] + vc[2];
+      a3 = va[3] + vb[3] + vc[3];
+    }
+    ws = (vw[0] + vw[1]) + (vw[2] + vw[3]);
+  }
+#endif
+  for (; x <= xb; ++x) {
+    const glm::vec4& t = row[x];
+    const float w = t.w * lb.tabulated_weight(dl.x * t.x + dl.y * t.y + dl.z * t.z);
+    const float* p = px + std::size_t(x) * ch;
+    a0 += w * p[0];
+    a1 += w * p[1];
+    a2 += w * p[2];
+    if (ch == 4) a3 += w * p[3];
+    ws += w;
+  }
+  sums[0] = a0;
+  sums[1] = a1;
+  sums[2] = a2;
+  sums[3] = a3;
+  sums[4] = ws;
+}
+
+// The filtered value along unit direction d over one input level.
+glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm::vec3& d) {
+  const cube_image& in = *level.image;
+  const int n = in.size;
+  const std::size_t ch = std::size_t(in.channels);
+  const double cos_max = lb.cos_max;
+  const double s2 = std::max(0.0, 1.0 - cos_max * cos_max);
+  const double rho = std::sqrt(std::max(0.0, 2.0 - 2.0 * cos_max));  // chord = 2 sin(theta / 2)
+  double acc[4] = {0, 0, 0, 0}, wsum = 0;
+  for (int f = 0; f < 6; ++f) {
+    const face_frame& fr = frame_of(f);
+    const glm::vec3 dl(glm::dot(d, fr.column), glm::dot(d, fr.row), glm::dot(d, fr.axis));
+    double u0, u1, v0, v1;
+    if (!cap_range(dl.x, dl.z, s2, rho, u0, u1) || !cap_range(dl.y, dl.z, s2, rho, v0, v1)) continue;
+    const double h = 0.5 * n;
+    // One texel of margin against rounding.
+    const int x0 = std::clamp(static_cast<int>(std::floor((u0 + 1.0) * h)) - 1, 0, n - 1);
+    const int x1 = std::clamp(static_cast<int>(std::floor((u1 + 1.0) * h)) + 1, 0, n - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor((v0 + 1.0) * h)) - 1, 0, n - 1);
+    const int y1 = std::clamp(static_cast<int>(std::floor((v1 + 1.0) * h)) + 1, 0, n - 1);
+    const glm::vec4* face_texels = level.centres->texels.data();
+    const bool ellipse = dl.z > 0.0f && static_cast<double>(dl.z) * dl.z > s2;
+    for (int y = y0; y <= y1; ++y) {
+      int xa = x0, xb = x1;
+      if (ellipse) {
+        // This row's span of the cap: A u^2 + B u + C >= 0 from (d.(u, v, 1))^2 >= k (1 + u^2 + v^2).
+        const double k = cos_max * cos_max;
+        const double v = (2.0 * y + 1.0) / n - 1.0;
+        const double e = dl.z + v * dl.y;
+        const double qa = static_cast<double>(dl.x) * dl.x - k, qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
+        const double disc = qb * qb - 4.0 * qa * qc;
+        if (disc < 0.0) continue;
+        const double r0 = (-qb + std::sqrt(disc)) / (2.0 * qa), r1 = (-qb - std::sqrt(disc)) / (2.0 * qa);
+        // texel centres u = (2x + 1)/n - 1 inside [r0, r1], one texel of margin for rounding
+        xa = std::max(x0, static_cast<int>(std::ceil((std::min(r0, r1) + 1.0) * h - 0.5)) - 1);
+        xb = std::min(x1, static_cast<int>(std::floor((std::max(r0, r1) + 1.0) * h - 0.5)) + 1);
+      }
+      const glm::vec4* row = face_texels + std::size_t(y) * std::size_t(n);
+      const float* px = in.at(f, 0, y);
+      if (lb.tabulated) {
+        // Pad the span to a multiple of four texels (inside the face) so the SIMD loop has no
+        // scalar tail: texels outside the cap read weight 0 from the table, so this only costs.
+        const int padded = (xb - xa + 4) / 4 * 4;
+        if (padded <= n) {
+          xb = std::min(n - 1, xa + padded - 1);
+          xa = xb - padded + 1;
+        }
+        float sums[5];
+        accumulate_row(lb, dl, row, px, ch, xa, xb, sums);
+        for (std::size_t c = 0; c < 4; ++c) acc[c] += sums[c];
+        wsum += sums[4];
+        continue;
+      }
+      const float cmax = lb.cos_max;
+      for (int x = xa; x <= xb; ++x) {
+        const glm::vec4& t = row[x];
+        const float dot = dl.x * t.x + dl.y * t.y + dl.z * t.z;
+        if (!(dot > cmax) || !(dot > 0.0f)) continue;
+        const double w = static_cast<double>(t.w * lb.weight(dot));
+        const float* p = px + std::size_t(x) * ch;
+        for (std::size_t c = 0; c < ch; ++c) acc[c] += w * static_cast<double>(p[c]);
+        wsum += w;
+      }
+    }
+  }
+  if (!(wsum > 0.0)) return glm::dvec4(0.0);  // cannot happen: d's own texel is in the lobe
+  return glm::dvec4(acc[0], acc[1], acc[2], ch == 4 ? acc[3] : wsum) / wsum;  // RGB alpha: 1
+}
+
+// Picks the input level for a lobe of power p.
+const chain_level& pick_level(const input_chain& chain, float power, const filter_options& o) {
+  const double need = std::max(2.0 * static_cast<double>(o.texels_per_sigma) * std::sqrt(static_cast<double>(power)),
+                               static_cast<double>(o.min_input_size));
+  const chain_level* best = &chain.levels[0];
+  for (const chain_level& l : chain.levels)
+    if (static_cast<double>(l.image->size) >= need) best = &l;
+  return *best;
+}
+
+cube_image filter_chain(const input_chain& chain, float power, bool irradiance, int out_size, const filter_options& o) {
+  const chain_level& level = pick_level(chain, power, o);
+  const cube_image& in = *level.image;
+  const lobe lb(power, irradiance ? 1e-30f : o.cutoff);  // the cosine lobe: the whole hemisphere
+  cube_image out = cube_image::make(out_size, in.channels);
+  const std::size_t ch = std::size_t(in.channels);
+  const double scale = irradiance ? pi : 1.0;
+  const std::size_t rows = 6u * std::size_t(out_size);
+  parallel_for(rows, o.thread_count, 1, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(out_size)), y = static_cast<int>(r % std::size_t(out_size));
+      for (int x = 0; x < out_size; ++x) {
+        const glm::vec3 d = cubemap_texel_direction(out_size, f, x, y, o.fixup);
+        const glm::dvec4 v = filter_direction(level, lb, d) * scale;
+        float* p = out.at(f, x, y);
+        for (std::size_t c = 0; c < ch; ++c) p[c] = static_cast<float>(v[static_cast<glm::length_t>(c)]);
+        if (irradiance && ch == 4) p[3] = static_cast<float>(v[3] / scale);  // alpha: the mean, not scaled
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
+cube_image filter_cosine_power(const cubemap& input, float power, int output_size, const filter_options& options) {
+  const char* fn = "filter_cosine_power";
+  if (input.levels.empty()) throw_invalid_argument(std::string(fn) + ": the input cube map has no levels");
+  validate_level(fn, input.levels[0]);
+  check_power(fn, power);
+  check_output_size(fn, output_size);
+  check_options(fn, options);
+  const input_chain chain(input.levels[0]);
+  return filter_chain(chain, power, false, output_size, options);
+}
+
+cube_image filter_irradiance(const cubemap& input, int output_size, const filter_options& options) {
+  const char* fn = "filter_irradiance";
+  if (input.levels.empty()) throw_invalid_argument(std::string(fn) + ": the input cube map has no levels");
+  validate_level(fn, input.levels[0]);
+  check_output_size(fn, output_size);
+  check_options(fn, options);
+  const input_chain chain(input.levels[0]);
+  return filter_chain(chain, 1.0f, true, output_size, options);
+}
+
+std::vector<float> filter_reference(const cube_image& input, float power, int output_size, edge_fixup fixup,
+                                    const std::vector<std::size_t>& texels, int thread_count) {
+  const char* fn = "filter_reference";
+  validate_level(fn, input);
+  if (!std::isfinite(power)) check_power(fn, power);
+  check_output_size(fn, output_size);
+  const bool irradiance = !(power > 0.0f);
+  const std::size_t on = std::size_t(output_size), count_all = 6u * on * on;
+  for (std::size_t t : texels)
+    if (t >= count_all) throw_invalid_argument(std::string(fn) + ": texel " + std::to_string(t) + " is out of range");
+  // Every input texel's direction and exact solid angle, in double.
+  const int n = input.size;
+  const std::size_t nn = std::size_t(n) * std::size_t(n);
+  std::vector<glm::dvec4> in(6 * nn);
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const glm::dvec3 p = glm::normalize(face_point_d(f, cubemap_texel_coordinate(n, x, edge_fixup::none),
+                                                         cubemap_texel_coordinate(n, y, edge_fixup::none)));
+        in[std::size_t(f) * nn + std::size_t(y) * std::size_t(n) + std::size_t(x)] =
+            glm::dvec4(p, cubemap_texel_solid_angle(n, x, y));
+      }
+  const std::size_t count = texels.empty() ? count_all : texels.size();
+  const std::size_t ch = std::size_t(input.channels);
+  std::vector<float> out(count * ch);
+  parallel_for(count, thread_count, 1, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t t = texels.empty() ? k : texels[k];
+      const int f = static_cast<int>(t / (on * on));
+      const int y = static_cast<int>((t % (on * on)) / on), x = static_cast<int>(t % on);
+      const glm::dvec3 d = face_point_d(f, cubemap_texel_coordinate(output_size, x, fixup),
+                                        cubemap_texel_coordinate(output_size, y, fixup));
+      const glm::dvec3 dn = glm::normalize(d);
+      double acc[4] = {0, 0, 0, 0}, wsum = 0;
+      for (std::size_t i = 0; i < in.size(); ++i) {
+        const double dot = glm::dot(dn, glm::dvec3(in[i]));
+        if (dot <= 0.0) continue;
+        const double w = in[i].w * (irradiance ? dot : std::pow(dot, static_cast<double>(power)));
+        const float* p = input.pixels.data() + i * ch;
+        for (std::size_t c = 0; c < ch; ++c) acc[c] += w * p[c];
+        wsum += w;
+      }
+      for (std::size_t c = 0; c < ch; ++c) {
+        const double scale = irradiance && c < 3 ? pi : 1.0;
+        out[k * ch + c] = static_cast<float>(scale * acc[c] / wsum);
+      }
+    }
+  });
+  return out;
+}
+
+float gloss_power(int top_size, int level, float texels) noexcept {
+  assert(top_size >= 1 && level >= 0 && texels > 0.0f);
+  const int size = level >= 31 ? 1 : std::max(1, top_size >> level);
+  const float half = static_cast<float>(size) / (2.0f * texels);
+  return half * half;
+}
+
+cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_options& options, float lobe_texels,
+                         int levels) {
+  const char* fn = "filter_mip_chain";
+  if (input.levels.empty()) throw_invalid_argument(std::string(fn) + ": the input cube map has no levels");
+  validate_level(fn, input.levels[0]);
+  check_output_size(fn, output_size);
+  check_options(fn, options);
+  if (!std::isfinite(lobe_texels) || !(lobe_texels > 0.0f))
+    throw_invalid_argument(std::string(fn) + ": lobe_texels must be finite and > 0");
+  if (levels < 0) throw_invalid_argument(std::string(fn) + ": levels " + std::to_string(levels) + " is negative");
+  int full = 1;
+  while ((output_size >> full) >= 1 && full < 31) ++full;
+  const int count = levels == 0 ? full : std::min(levels, full);
+  const input_chain chain(input.levels[0]);
+  cubemap out;
+  for (int l = 0; l < count; ++l) {
+    const int size = std::max(1, output_size >> l);
+    out.levels.push_back(filter_chain(chain, gloss_power(output_size, l, lobe_texels), false, size, options));
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// SH
+
+std::array<double, 9> sh9_basis(const glm::dvec3& w) noexcept {
+  const double x = w.x, y = w.y, z = w.z;
+  return {0.28209479177387814,
+          0.4886025119029199 * y,
+          0.4886025119029199 * z,
+          0.4886025119029199 * x,
+          1.0925484305920792 * x * y,
+          1.0925484305920792 * y * z,
+          0.31539156525252005 * (3.0 * z * z - 1.0),
+          1.0925484305920792 * x * z,
+          0.5462742152960396 * (x * x - y * y)};
+}
+
+sh9 project_sh9(const cube_image& level, int thread_count) {
+  validate_level("project_sh9", level);
+  const int n = level.size;
+  const std::shared_ptr<const face_table> table = face_table::get(n);
+  const std::size_t rows = 6u * std::size_t(n), ch = std::size_t(level.channels);
+  std::vector<sh9> partial(rows);  // one partial sum per row, added in row order: deterministic
+  parallel_for(rows, thread_count, 8, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(n)), y = static_cast<int>(r % std::size_t(n));
+      const face_frame& fr = frame_of(f);
+      sh9 acc;
+      for (int x = 0; x < n; ++x) {
+        const glm::vec4& t = table->texels[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+        const glm::dvec3 w = glm::dvec3(fr.column * t.x + fr.row * t.y + fr.axis * t.z);
+        const std::array<double, 9> b = sh9_basis(w);
+        const float* p = level.at(f, x, y);
+        const glm::dvec4 l(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f);
+        const glm::dvec4 lw = l * static_cast<double>(t.w);
+        for (std::size_t k = 0; k < 9; ++k) acc.coefficients[k] += lw * b[k];
+      }
+      partial[r] = acc;
+    }
+  });
+  sh9 total;
+  for (const sh9& s : partial)
+    for (std::size_t k = 0; k < 9; ++k) total.coefficients[k] += s.coefficients[k];
+  return total;
+}
+
+glm::dvec4 sh9_irradiance(const sh9& radiance, const glm::dvec3& n) noexcept {
+  static constexpr double band[9] = {pi,           2.0 * pi / 3, 2.0 * pi / 3, 2.0 * pi / 3, pi / 4,
+                                     pi / 4,       pi / 4,       pi / 4,       pi / 4};
+  const std::array<double, 9> b = sh9_basis(n);
+  glm::dvec4 e(0.0);
+  for (std::size_t k = 0; k < 9; ++k) e += radiance.coefficients[k] * (band[k] * b[k]);
+  return e;
+}
+
+cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping, int channels, int thread_count) {
+  check_output_size("irradiance_from_sh9", size);
+  if (channels != 3 && channels != 4)
+    throw_invalid_argument("irradiance_from_sh9: channels is " + std::to_string(channels) + "; it must be 3 or 4");
+  const int m = static_cast<int>(mapping);
+  if (m < 0 || m > 2) throw_invalid_argument("irradiance_from_sh9: mapping " + std::to_string(m) + " is not 0, 1 or 2");
+  cube_image out = cube_image::make(size, channels);
+  const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
+  parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
+      for (int x = 0; x < size; ++x) {
+        const glm::dvec4 e = sh9_irradiance(radiance, glm::dvec3(cubemap_texel_direction(size, f, x, y, mapping)));
+        float* p = out.at(f, x, y);
+        for (std::size_t c = 0; c < ch; ++c) p[c] = static_cast<float>(e[static_cast<glm::length_t>(c)]);
+        if (ch == 4) p[3] = static_cast<float>(e.w / pi);  // alpha: its cosine-weighted mean, not scaled by pi
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace hemilight
