@@ -116,6 +116,95 @@ HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, 
 HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size,
                                                               int half_float);
 
+/* ---- cube maps -----------------------------------------------------------------------------------
+ * Float RGB cube maps: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), face-major, each
+ * size x size texels, rows along the GL t coordinate, columns along s, RGB interleaved
+ * (6 x size x size x 3 floats). Face sizes are 1..16384. A mip chain is its levels one after
+ * another, level i of size max(1, size >> i), down to 1 x 1 (hemilight_cubemap_chain_floats).
+ * Details, formulas and measured accuracy: include/hemilight/cubemap.hpp, docs/cubemap.md. */
+
+/* How output texels get their directions. Face coordinate u in [-1, 1] of texel x of n:
+ * NONE    u = (x + 0.5) 2/n - 1 (texel centres, what GPUs sample);
+ * STRETCH u = 2x/(n - 1) - 1 (edge texels of adjacent faces are the same direction; undone
+ *         exactly at lookup time by hemilight_cubemap_fixup_lookup);
+ * WARP    u = c + a c^3 on the centre c, a = n^2/(n - 1)^3 (edge texels coincide too).
+ * At size 1 all three give the face centre. */
+typedef enum hemilight_edge_fixup {
+  HEMILIGHT_EDGE_FIXUP_NONE = 0,
+  HEMILIGHT_EDGE_FIXUP_STRETCH,
+  HEMILIGHT_EDGE_FIXUP_WARP
+} hemilight_edge_fixup;
+
+/* How hemilight_cubemap_sample filters, like GPUs do. */
+typedef enum hemilight_cube_sampling {
+  HEMILIGHT_CUBE_SAMPLING_CLAMP_PER_FACE = 0, /* bilinear in one face, clamp-to-edge */
+  HEMILIGHT_CUBE_SAMPLING_SEAMLESS            /* bilinear across faces (GL seamless / D3D) */
+} hemilight_cube_sampling;
+
+/* Unit direction of texel (x, y) of `face` (0..5) of a size x size face under a mapping.
+ * Errors: INVALID_ARGUMENT for size outside [1, 16384], face outside [0, 5], x or y outside
+ * [0, size), an unknown fixup, or direction NULL (nothing written). Cost: O(1). */
+HEMILIGHT_API hemilight_status hemilight_cubemap_texel_direction(int size, int face, int x, int y,
+                                                                 hemilight_edge_fixup fixup, float direction[3]);
+
+/* The runtime lookup fixup for a STRETCH-filtered cube map sampled per face: the two components
+ * other than the major one (ties go to x, then y, then z) are multiplied by (size - 1)/size when
+ * lod < 0 (a known, fixed size), or by max(0, 1 - 2^lod / size) for an explicit lod >= 0 (size =
+ * top-level size; at or past the last mip the scale is 0: the face centre). Exact for STRETCH;
+ * for WARP it is off by up to ~0.2 texel between face centre and edge (docs/cubemap.md). The
+ * result is not normalised; the zero vector gives the zero vector. Also available as GLSL and HLSL
+ * (include/hemilight/shaders/cubemap_fixup.glsl, .hlsl) with the same behaviour.
+ * out_direction may alias direction. Errors: INVALID_ARGUMENT for NULL pointers, NaN or Inf in
+ * direction or lod, size outside [1, 16384]. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_fixup_lookup(const float direction[3], int size, float lod,
+                                                              float out_direction[3]);
+
+/* Filters an RGB cube map with the normalised cosine-power lobe of specular power p > 0: each
+ * output texel (direction from `fixup`) is sum L W / sum W, W = exact texel solid angle x
+ * max(0, cos)^p, over the lobe's extent (cutoff 1e-4), reading a coarser mip of the input where
+ * the lobe spans many texels (max relative error ~1% against brute force, docs/cubemap.md).
+ * Uses all cores; deterministic. output holds 6 x output_size^2 x 3 floats and must not overlap
+ * input. Errors: INVALID_ARGUMENT for NULL pointers, sizes outside [1, 16384], p not finite and
+ * > 0, an unknown fixup, or NaN/Inf in input (output untouched); OUT_OF_MEMORY. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_filter_cosine_power(const float* input, int input_size,
+                                                                     float specular_power,
+                                                                     hemilight_edge_fixup fixup, int output_size,
+                                                                     float* output);
+
+/* Irradiance E(n) = integral of L max(0, n.w) dw per output texel (a uniform map of radiance L
+ * gives pi L). use_sh = 0: the cosine-lobe filter (quadrature over a >= 16 x 16 input mip);
+ * use_sh = 1: the 9-coefficient SH fast path (exact for radiance in SH bands 0-2, otherwise SH
+ * truncation error). Errors as hemilight_cubemap_filter_cosine_power. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int input_size,
+                                                                   hemilight_edge_fixup fixup, int output_size,
+                                                                   int use_sh, float* output);
+
+/* Number of floats and levels of an RGB mip chain whose top level has size `size` (levels down to
+ * 1 x 1). Either output may be NULL. Errors: INVALID_ARGUMENT for size outside [1, 16384]. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_chain_floats(int size, size_t* floats, int* levels);
+
+/* A radiance mip chain (layout above) from an RGB cube map: level i is the cosine-power filter
+ * with the gloss mapping p_i = (size_i / (2 lobe_texels))^2, i.e. the lobe's width 1/sqrt(p)
+ * equals lobe_texels texels of that level (lobe_texels <= 0 means 1). capacity: floats available
+ * at output (at least hemilight_cubemap_chain_floats(output_size)). Errors as
+ * hemilight_cubemap_filter_cosine_power, and INVALID_ARGUMENT when capacity is too small or
+ * lobe_texels is NaN/Inf. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_filter_mip_chain(const float* input, int input_size,
+                                                                  hemilight_edge_fixup fixup, int output_size,
+                                                                  float lobe_texels, float* output, size_t capacity);
+
+/* Samples an RGB cube map or mip chain (level_count levels, layout above, top-level size `size`)
+ * along `direction` (need not be unit) at an explicit lod (clamped to [0, level_count - 1],
+ * trilinear between levels), bilinear per face or seamless. apply_fixup = 1 first transforms the
+ * direction with hemilight_cubemap_fixup_lookup(direction, size, lod) (lod < 0 is read as the
+ * fixed-size form and samples level 0): use it for STRETCH-filtered maps. Errors:
+ * INVALID_ARGUMENT for NULL pointers, size outside [1, 16384], level_count outside
+ * [1, levels of size], NaN/Inf direction or lod, a zero direction, an unknown sampling. */
+HEMILIGHT_API hemilight_status hemilight_cubemap_sample(const float* chain, int size, int level_count,
+                                                        const float direction[3], float lod,
+                                                        hemilight_cube_sampling sampling, int apply_fixup,
+                                                        float rgb[3]);
+
 #ifdef __cplusplus
 }
 #endif

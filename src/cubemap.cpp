@@ -173,14 +173,15 @@ cube_image procedural_environment(int size, int channels) {
 
 namespace {
 
-glm::vec4 texel(const cube_image& c, int face, int x, int y) noexcept {
-  const float* p = c.at(face, x, y);
+glm::vec4 texel(const raw_cube& c, int face, int x, int y) noexcept {
+  const float* p = c.pixels + ((std::size_t(face) * std::size_t(c.size) + std::size_t(y)) * std::size_t(c.size) +
+                               std::size_t(x)) * std::size_t(c.channels);
   return {p[0], p[1], p[2], c.channels == 4 ? p[3] : 1.0f};
 }
 
 // The texel that texel (x, y) of `face`, one step outside the face along one axis, is on the
 // neighbouring face: the extended texel centre's direction, looked up with the GL table.
-glm::vec4 texel_beyond_edge(const cube_image& c, int face, int x, int y) noexcept {
+glm::vec4 texel_beyond_edge(const raw_cube& c, int face, int x, int y) noexcept {
   const int n = c.size;
   const float u = (2.0f * static_cast<float>(x) + 1.0f) / static_cast<float>(n) - 1.0f;
   const float v = (2.0f * static_cast<float>(y) + 1.0f) / static_cast<float>(n) - 1.0f;
@@ -190,7 +191,7 @@ glm::vec4 texel_beyond_edge(const cube_image& c, int face, int x, int y) noexcep
   return texel(c, static_cast<int>(cc.face), tx, ty);
 }
 
-glm::vec4 fetch_seamless(const cube_image& c, int face, int x, int y) noexcept {
+glm::vec4 fetch_seamless(const raw_cube& c, int face, int x, int y) noexcept {
   const int n = c.size;
   const bool out_x = x < 0 || x >= n, out_y = y < 0 || y >= n;
   if (!out_x && !out_y) return texel(c, face, x, y);
@@ -202,7 +203,9 @@ glm::vec4 fetch_seamless(const cube_image& c, int face, int x, int y) noexcept {
 
 }  // namespace
 
-glm::vec4 sample_bilinear(const cube_image& c, const glm::vec3& d, cube_sampling mode) noexcept {
+namespace cubemap_detail {
+
+glm::vec4 sample_bilinear_raw(const raw_cube& c, const glm::vec3& d, cube_sampling mode) noexcept {
   const cube_coord cc = cube_face_from_direction(d);
   const int n = c.size, face = static_cast<int>(cc.face);
   const float fx = cc.s * static_cast<float>(n) - 0.5f, fy = cc.t * static_cast<float>(n) - 0.5f;
@@ -226,15 +229,32 @@ glm::vec4 sample_bilinear(const cube_image& c, const glm::vec3& d, cube_sampling
   return (t00 * (1.0f - ax) + t10 * ax) * (1.0f - ay) + (t01 * (1.0f - ax) + t11 * ax) * ay;
 }
 
-glm::vec4 sample_lod(const cubemap& map, const glm::vec3& d, float lod, cube_sampling mode) noexcept {
-  const int last = map.level_count() - 1;
-  if (!(lod > 0.0f)) return sample_bilinear(map.levels[0], d, mode);  // also NaN
-  if (lod >= static_cast<float>(last)) return sample_bilinear(map.levels[std::size_t(last)], d, mode);
+glm::vec4 sample_lod_raw(const raw_cube* levels, int level_count, const glm::vec3& d, float lod,
+                         cube_sampling mode) noexcept {
+  const int last = level_count - 1;
+  if (!(lod > 0.0f)) return sample_bilinear_raw(levels[0], d, mode);  // also NaN
+  if (lod >= static_cast<float>(last)) return sample_bilinear_raw(levels[last], d, mode);
   const int l0 = static_cast<int>(std::floor(lod));
   const float t = lod - static_cast<float>(l0);
-  const glm::vec4 a = sample_bilinear(map.levels[std::size_t(l0)], d, mode);
+  const glm::vec4 a = sample_bilinear_raw(levels[l0], d, mode);
   if (t == 0.0f) return a;
-  return a * (1.0f - t) + sample_bilinear(map.levels[std::size_t(l0 + 1)], d, mode) * t;
+  return a * (1.0f - t) + sample_bilinear_raw(levels[l0 + 1], d, mode) * t;
+}
+
+}  // namespace cubemap_detail
+
+glm::vec4 sample_bilinear(const cube_image& c, const glm::vec3& d, cube_sampling mode) noexcept {
+  return sample_bilinear_raw({c.pixels.data(), c.size, c.channels}, d, mode);
+}
+
+glm::vec4 sample_lod(const cubemap& map, const glm::vec3& d, float lod, cube_sampling mode) noexcept {
+  raw_cube levels[32];
+  const int count = std::min(map.level_count(), 32);
+  for (int l = 0; l < count; ++l) {
+    const cube_image& c = map.levels[std::size_t(l)];
+    levels[l] = {c.pixels.data(), c.size, c.channels};
+  }
+  return sample_lod_raw(levels, count, d, lod, mode);
 }
 
 glm::vec4 cubemap::sample(const glm::vec3& direction) const noexcept {

@@ -36,4 +36,16 @@ struct face_table {
   static std::shared_ptr<const face_table> get(int size);
 };
 
+/// A cube-map level seen through a pointer (the C ABI samples the caller's memory in place).
+struct raw_cube {
+  const float* pixels = nullptr;
+  int size = 0;
+  int channels = 3;
+};
+
+/// sample_bilinear and sample_lod on raw levels (same behaviour and preconditions).
+glm::vec4 sample_bilinear_raw(const raw_cube& level, const glm::vec3& direction, cube_sampling mode) noexcept;
+glm::vec4 sample_lod_raw(const raw_cube* levels, int level_count, const glm::vec3& direction, float lod,
+                         cube_sampling mode) noexcept;
+
 }  // namespace hemilight::cubemap_detail
