@@ -314,7 +314,15 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
       }
     }
   }
-  if (!(wsum > 0.0)) return glm::dvec4(0.0);  // cannot happen: d's own texel is in the lobe
+  if (!(wsum > 0.0)) {
+    // The lobe is narrower than the input's texels and no texel centre falls inside it: the
+    // integral of the piecewise-constant input against it is the texel that contains d.
+    const cube_coord cc = cube_face_from_direction(d);
+    const int x = std::clamp(static_cast<int>(cc.s * static_cast<float>(n)), 0, n - 1);
+    const int y = std::clamp(static_cast<int>(cc.t * static_cast<float>(n)), 0, n - 1);
+    const float* p = in.at(static_cast<int>(cc.face), x, y);
+    return glm::dvec4(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f);
+  }
   return glm::dvec4(acc[0], acc[1], acc[2], ch == 4 ? acc[3] : wsum) / wsum;  // RGB alpha: 1
 }
 

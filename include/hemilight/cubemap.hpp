@@ -90,8 +90,9 @@ double cubemap_texel_solid_angle(int n, int x, int y) noexcept;
 ///     as cube_face_from_direction), so on an edge or corner tie the other components shrink and
 ///     the result lies strictly inside that face: the face choice no longer depends on how the
 ///     hardware breaks ties (stretch edge texels coincide, so either face gives the same value);
-///   - the zero vector is returned unchanged (zero); NaN components make every comparison false,
-///     so z is taken as major and the NaN propagates (the C ABI rejects NaN and Inf instead);
+///   - the zero vector is returned unchanged (zero); a NaN component fails every comparison it
+///     is in, so the major axis is chosen among the others (z if all fail) and the NaN
+///     propagates into the result (the C ABI rejects NaN and Inf instead);
 ///   - lod at or past the last mip (2^lod >= size) gives scale 0: every lookup goes to the face
 ///     centre, which is where a 1 x 1 face's single texel is (the stretch mapping at size 1);
 ///   - the length of the vector changes; cube lookups do not care, normalise if you do.
@@ -183,7 +184,9 @@ struct filter_options {
 /// over the input texels w within the lobe's extent, read from the input mip chosen by the
 /// options (only level 0 of `input` is read; coarser mips are built from it). Constant input gives exactly that
 /// constant (to float rounding). power: p > 0 (p = 1 is the cosine lobe, normalised).
-/// Deterministic: bitwise identical for any thread count.
+/// Deterministic: bitwise identical for any thread count. A lobe narrower than the input's
+/// texels (sigma below ~1 input texel) is undersampled; where no input texel centre lies inside
+/// it, the output is the input texel that contains d (the limit of a very narrow lobe).
 /// Throws error(invalid_argument) for an invalid input (cubemap::validate), p not finite and
 /// > 0, output_size outside [1, cubemap_max_size], or bad options. Cost: about
 /// 6 out^2 * (pi/4) (3.7 texels_per_sigma)^2 weight evaluations for narrow lobes.
