@@ -172,7 +172,7 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_filter_cosine_power(const float
                                                                      float* output);
 
 /* Irradiance E(n) = integral of L max(0, n.w) dw per output texel (a uniform map of radiance L
- * gives pi L). use_sh = 0: the cosine-lobe filter (quadrature over a >= 16 x 16 input mip);
+ * gives pi L). use_sh = 0: the cosine-lobe filter (quadrature over the input mip of 16 x 16);
  * use_sh = 1: the 9-coefficient SH fast path (exact for radiance in SH bands 0-2, otherwise SH
  * truncation error). Errors as hemilight_cubemap_filter_cosine_power. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int input_size,

@@ -84,6 +84,9 @@ void check_options(const char* fn, const filter_options& o) {
                            " must be finite and > 0");
   if (o.min_input_size < 1)
     throw_invalid_argument(std::string(fn) + ": min_input_size " + std::to_string(o.min_input_size) + " must be >= 1");
+  if (o.irradiance_input_size < 1)
+    throw_invalid_argument(std::string(fn) + ": irradiance_input_size " + std::to_string(o.irradiance_input_size) +
+                           " must be >= 1");
 }
 
 // Level 0 of the input and coarser levels below it (as long as the size stays even), each
@@ -149,6 +152,12 @@ struct lobe {
     return e[0] + t * (e[1] - e[0]);
   }
 };
+
+// floor() without a libm call (SSE2 has no rounding instruction). |v| < 2^31.
+inline int fast_floor(double v) noexcept {
+  const int i = static_cast<int>(v);
+  return i - (v < static_cast<double>(i) ? 1 : 0);
+}
 
 // Range of face coordinate (along `c`) covered by the cap {w : d.w >= cos(theta)} on the face with
 // local direction components (dc, dr, da) of d. Returns false if the cap misses the face.
@@ -271,20 +280,26 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
     const int y1 = std::clamp(static_cast<int>(std::floor((v1 + 1.0) * h)) + 1, 0, n - 1);
     const glm::vec4* face_texels = level.centres->texels.data();
     const bool ellipse = dl.z > 0.0f && static_cast<double>(dl.z) * dl.z > s2;
+    const double k = cos_max * cos_max;
+    const double qa = static_cast<double>(dl.x) * dl.x - k;  // < 0 when `ellipse`
+    const double inv_2qa = ellipse ? 0.5 / qa : 0.0;
     for (int y = y0; y <= y1; ++y) {
       int xa = x0, xb = x1;
       if (ellipse) {
-        // This row's span of the cap: A u^2 + B u + C >= 0 from (d.(u, v, 1))^2 >= k (1 + u^2 + v^2).
-        const double k = cos_max * cos_max;
+        // This row's span of the cap: A u^2 + B u + C >= 0 from (d.(u, v, 1))^2 >= k (1 + u^2 + v^2),
+        // A < 0 in the ellipse case. Texel centres u = (2x + 1)/n - 1 between the roots; no margin
+        // is needed: a centre that rounding puts on the wrong side has a weight of ~cutoff.
         const double v = (2.0 * y + 1.0) / n - 1.0;
         const double e = dl.z + v * dl.y;
-        const double qa = static_cast<double>(dl.x) * dl.x - k, qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
+        const double qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
         const double disc = qb * qb - 4.0 * qa * qc;
         if (disc < 0.0) continue;
-        const double r0 = (-qb + std::sqrt(disc)) / (2.0 * qa), r1 = (-qb - std::sqrt(disc)) / (2.0 * qa);
-        // texel centres u = (2x + 1)/n - 1 inside [r0, r1], one texel of margin for rounding
-        xa = std::max(x0, static_cast<int>(std::ceil((std::min(r0, r1) + 1.0) * h - 0.5)) - 1);
-        xb = std::min(x1, static_cast<int>(std::floor((std::max(r0, r1) + 1.0) * h - 0.5)) + 1);
+        const double root = std::sqrt(disc);
+        // roots (-qb -+ root) / (2 qa); with qa < 0 the first is the smaller
+        const double r_lo = (-qb + root) * inv_2qa, r_hi = (-qb - root) * inv_2qa;
+        xa = std::max(x0, fast_floor((r_lo + 1.0) * h - 0.5) + 1);
+        xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5));
+        if (xb < xa) continue;
       }
       const glm::vec4* row = face_texels + std::size_t(y) * std::size_t(n);
       const float* px = in.at(f, 0, y);
@@ -327,9 +342,11 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
 }
 
 // Picks the input level for a lobe of power p.
-const chain_level& pick_level(const input_chain& chain, float power, const filter_options& o) {
-  const double need = std::max(2.0 * static_cast<double>(o.texels_per_sigma) * std::sqrt(static_cast<double>(power)),
-                               static_cast<double>(o.min_input_size));
+const chain_level& pick_level(const input_chain& chain, float power, bool irradiance, const filter_options& o) {
+  const double need =
+      irradiance ? static_cast<double>(o.irradiance_input_size)
+                 : std::max(2.0 * static_cast<double>(o.texels_per_sigma) * std::sqrt(static_cast<double>(power)),
+                            static_cast<double>(o.min_input_size));
   const chain_level* best = &chain.levels[0];
   for (const chain_level& l : chain.levels)
     if (static_cast<double>(l.image->size) >= need) best = &l;
@@ -337,7 +354,7 @@ const chain_level& pick_level(const input_chain& chain, float power, const filte
 }
 
 cube_image filter_chain(const input_chain& chain, float power, bool irradiance, int out_size, const filter_options& o) {
-  const chain_level& level = pick_level(chain, power, o);
+  const chain_level& level = pick_level(chain, power, irradiance, o);
   const cube_image& in = *level.image;
   const lobe lb(power, irradiance ? 1e-30f : o.cutoff);  // the cosine lobe: the whole hemisphere
   cube_image out = cube_image::make(out_size, in.channels);

@@ -606,7 +606,7 @@ TEST_CASE("irradiance: SH and the cosine filter against closed forms", "[cubemap
   INFO("SH " << worst_sh << ", cosine filter " << worst_filter);
   // SH: midpoint quadrature of a quadratic over 64^2 texels, O(h^2): measured 2e-5.
   CHECK(worst_sh < 1e-4);
-  // Filter: reads the 16^2 mip (min_input_size) and clips texels at the horizon by their
+  // Filter: reads the 16^2 mip (irradiance_input_size) and clips texels at the horizon by their
   // centres, an O(h^2) quadrature error on a coarser grid: measured 5.3e-4.
   CHECK(worst_filter < 1.5e-3);
 }
@@ -666,6 +666,12 @@ TEST_CASE("cubemap validation: bad images, powers, sizes and options name the pr
   filter_options bad;
   bad.cutoff = 2.0f;
   require_error([&] { (void)filter_irradiance(in, 4, bad); }, status::invalid_argument, "cutoff");
+  bad = {};
+  bad.irradiance_input_size = 0;
+  require_error([&] { (void)filter_irradiance(in, 4, bad); }, status::invalid_argument, "irradiance_input_size 0");
+  bad = {};
+  bad.texels_per_sigma = -1.0f;
+  require_error([&] { (void)filter_cosine_power(in, 4.0f, 4, bad); }, status::invalid_argument, "texels_per_sigma");
   bad = {};
   bad.fixup = static_cast<edge_fixup>(7);
   require_error([&] { (void)filter_cosine_power(in, 4.0f, 4, bad); }, status::invalid_argument, "fixup 7");
