@@ -505,17 +505,26 @@ sh9 project_sh9(const cube_image& level, int thread_count) {
     for (std::size_t r = begin; r < end; ++r) {
       const int f = static_cast<int>(r / std::size_t(n)), y = static_cast<int>(r % std::size_t(n));
       const face_frame& fr = frame_of(f);
-      sh9 acc;
+      // Float sums within the row (at most 16384 terms of similar size), double across rows.
+      std::array<glm::vec4, 9> acc{};
       for (int x = 0; x < n; ++x) {
         const glm::vec4& t = table->texels[std::size_t(y) * std::size_t(n) + std::size_t(x)];
-        const glm::dvec3 w = glm::dvec3(fr.column * t.x + fr.row * t.y + fr.axis * t.z);
-        const std::array<double, 9> b = sh9_basis(w);
+        const glm::vec3 w = fr.column * t.x + fr.row * t.y + fr.axis * t.z;
         const float* p = level.at(f, x, y);
-        const glm::dvec4 l(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f);
-        const glm::dvec4 lw = l * static_cast<double>(t.w);
-        for (std::size_t k = 0; k < 9; ++k) acc.coefficients[k] += lw * b[k];
+        const glm::vec4 lw = glm::vec4(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f) * t.w;
+        acc[0] += lw * 0.28209479177387814f;
+        acc[1] += lw * (0.4886025119029199f * w.y);
+        acc[2] += lw * (0.4886025119029199f * w.z);
+        acc[3] += lw * (0.4886025119029199f * w.x);
+        acc[4] += lw * (1.0925484305920792f * w.x * w.y);
+        acc[5] += lw * (1.0925484305920792f * w.y * w.z);
+        acc[6] += lw * (0.31539156525252005f * (3.0f * w.z * w.z - 1.0f));
+        acc[7] += lw * (1.0925484305920792f * w.x * w.z);
+        acc[8] += lw * (0.5462742152960396f * (w.x * w.x - w.y * w.y));
       }
-      partial[r] = acc;
+      sh9 row_sum;
+      for (std::size_t k = 0; k < 9; ++k) row_sum.coefficients[k] = glm::dvec4(acc[k]);
+      partial[r] = row_sum;
     }
   });
   sh9 total;
@@ -541,13 +550,30 @@ cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping
   if (m < 0 || m > 2) throw_invalid_argument("irradiance_from_sh9: mapping " + std::to_string(m) + " is not 0, 1 or 2");
   cube_image out = cube_image::make(size, channels);
   const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
+  // E(n) is a quadratic polynomial in n: fold the band factors and basis constants into one
+  // coefficient per monomial (1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2) and channel.
+  static constexpr double band[9] = {pi, 2.0 * pi / 3, 2.0 * pi / 3, 2.0 * pi / 3, pi / 4, pi / 4, pi / 4, pi / 4, pi / 4};
+  static constexpr double basis_constant[9] = {0.28209479177387814, 0.4886025119029199, 0.4886025119029199,
+                                               0.4886025119029199,  1.0925484305920792, 1.0925484305920792,
+                                               0.31539156525252005, 1.0925484305920792, 0.5462742152960396};
+  std::array<glm::vec4, 9> k;
+  for (std::size_t j = 0; j < 9; ++j) k[j] = glm::vec4(radiance.coefficients[j] * (band[j] * basis_constant[j]));
+  std::vector<float> coord(static_cast<std::size_t>(size));  // the mapping's face coordinate of each index
+  for (int i = 0; i < size; ++i) coord[std::size_t(i)] = static_cast<float>(cubemap_texel_coordinate(size, i, mapping));
   parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
+      const face_frame& fr = frame_of(f);
+      const glm::vec3 row_point = fr.axis + coord[std::size_t(y)] * fr.row;
       for (int x = 0; x < size; ++x) {
-        const glm::dvec4 e = sh9_irradiance(radiance, glm::dvec3(cubemap_texel_direction(size, f, x, y, mapping)));
+        const glm::vec3 p3 = row_point + coord[std::size_t(x)] * fr.column;
+        const glm::vec3 n = p3 / std::sqrt(glm::dot(p3, p3));
+        const glm::vec4 e = k[0] + k[1] * n.y + k[2] * n.z + k[3] * n.x + k[4] * (n.x * n.y) + k[5] * (n.y * n.z) +
+                            k[6] * (3.0f * n.z * n.z - 1.0f) + k[7] * (n.x * n.z) + k[8] * (n.x * n.x - n.y * n.y);
         float* p = out.at(f, x, y);
-        for (std::size_t c = 0; c < ch; ++c) p[c] = static_cast<float>(e[static_cast<glm::length_t>(c)]);
+        p[0] = e.x;
+        p[1] = e.y;
+        p[2] = e.z;
         if (ch == 4) p[3] = static_cast<float>(e.w / pi);  // alpha: its cosine-weighted mean, not scaled by pi
       }
     }
