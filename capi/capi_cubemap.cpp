@@ -30,6 +30,21 @@ bool check_fixup(const char* fn, hemilight_edge_fixup fixup, hemilight_status& s
   return false;
 }
 
+// The arguments every filter entry point shares; false (with st set) on the first bad one.
+bool check_filter_args(const char* fn, const float* input, int input_size, const float* output, int output_size,
+                       hemilight_edge_fixup fixup, hemilight_status& st) {
+  if (!input) {
+    st = invalid(fn, "input is NULL");
+    return false;
+  }
+  if (!output) {
+    st = invalid(fn, "output is NULL");
+    return false;
+  }
+  return check_cube_size(fn, "input_size", input_size, st) && check_cube_size(fn, "output_size", output_size, st) &&
+         check_fixup(fn, fixup, st);
+}
+
 std::size_t face_floats(int size) { return 6u * std::size_t(size) * std::size_t(size) * 3u; }
 
 // Copies an RGB cube map from the caller (validated: finite values) into a cubemap of one level.
@@ -102,11 +117,7 @@ hemilight_status hemilight_cubemap_filter_cosine_power(const float* input, int i
   const char* fn = "hemilight_cubemap_filter_cosine_power";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!input) return invalid(fn, "input is NULL");
-    if (!output) return invalid(fn, "output is NULL");
-    if (!check_cube_size(fn, "input_size", input_size, st) || !check_cube_size(fn, "output_size", output_size, st) ||
-        !check_fixup(fn, fixup, st))
-      return st;
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
     if (!std::isfinite(specular_power) || !(specular_power > 0.0f))
       return invalid(fn, "specular_power " + std::to_string(specular_power) + " must be finite and > 0");
     const hemilight::cubemap in = load_input(fn, input, input_size);
@@ -123,11 +134,7 @@ hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int inp
   const char* fn = "hemilight_cubemap_filter_irradiance";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!input) return invalid(fn, "input is NULL");
-    if (!output) return invalid(fn, "output is NULL");
-    if (!check_cube_size(fn, "input_size", input_size, st) || !check_cube_size(fn, "output_size", output_size, st) ||
-        !check_fixup(fn, fixup, st))
-      return st;
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
     if (use_sh != 0 && use_sh != 1) return invalid(fn, "use_sh is " + std::to_string(use_sh) + "; it must be 0 or 1");
     const hemilight::cubemap in = load_input(fn, input, input_size);
     const auto mapping = static_cast<hemilight::edge_fixup>(fixup);
@@ -162,11 +169,7 @@ hemilight_status hemilight_cubemap_filter_mip_chain(const float* input, int inpu
   const char* fn = "hemilight_cubemap_filter_mip_chain";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!input) return invalid(fn, "input is NULL");
-    if (!output) return invalid(fn, "output is NULL");
-    if (!check_cube_size(fn, "input_size", input_size, st) || !check_cube_size(fn, "output_size", output_size, st) ||
-        !check_fixup(fn, fixup, st))
-      return st;
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
     if (!std::isfinite(lobe_texels)) return invalid(fn, "lobe_texels is NaN or infinite");
     const std::size_t need = chain_floats(output_size, chain_levels(output_size));
     if (capacity < need)

@@ -5,6 +5,8 @@
 #include "hemilight/geometry.hpp"
 #include "hemilight/image_io.hpp"
 
+#include "test_support.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -20,24 +22,13 @@
 #include <tuple>
 
 using namespace hemilight;
+using hemilight::test::require_error;
+using hemilight::test::tmp_path;
 
 namespace {
 
 constexpr double pi = 3.14159265358979323846;
 
-std::string tmp_path(const std::string& name) { return std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name; }
-
-template <class F>
-void require_error(F&& f, status code, const std::string& needle) {
-  try {
-    f();
-    FAIL("no exception thrown; expected one containing '" << needle << "'");
-  } catch (const error& e) {
-    CHECK(e.code() == code);
-    CHECK(std::string(e.what()).find(needle) != std::string::npos);
-    if (std::string(e.what()).find(needle) == std::string::npos) INFO(e.what());
-  }
-}
 
 // The GL face table written out directly from the specification (not through geometry.hpp):
 // the direction of face coordinates (sc/|ma|, tc/|ma|) = (u, v).

@@ -2,6 +2,8 @@
 #include "hemilight/geometry.hpp"
 #include "hemilight/image_io.hpp"
 
+#include "test_support.hpp"
+
 #include <ImfChannelList.h>
 #include <ImfEnvmap.h>
 #include <ImfFrameBuffer.h>
@@ -18,11 +20,11 @@
 #include <random>
 
 using namespace hemilight;
+using hemilight::test::require_error;
+using hemilight::test::tmp_path;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string tmp_path(const std::string& name) { return std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name; }
 
 image random_image(int w, int h, int c, unsigned seed) {
   image img = image::make(w, h, c);
@@ -30,19 +32,6 @@ image random_image(int w, int h, int c, unsigned seed) {
   std::uniform_real_distribution<float> u(-10.0f, 1000.0f);
   for (float& v : img.pixels) v = u(rng);
   return img;
-}
-
-// Checks that f() throws hemilight::error with the given code and a message containing `needle`.
-template <class F>
-void require_error(F&& f, status code, const std::string& needle) {
-  try {
-    f();
-    FAIL("no exception thrown; expected one containing '" << needle << "'");
-  } catch (const error& e) {
-    INFO("message: " << e.what());
-    CHECK(e.code() == code);
-    CHECK(std::string(e.what()).find(needle) != std::string::npos);
-  }
 }
 
 std::vector<char> read_bytes(const std::string& path) {
