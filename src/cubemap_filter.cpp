@@ -178,6 +178,9 @@ bool cap_range(double dc, double da, double s2, double rho, double& lo, double& 
     lo = std::min(c_lo / a_lo, c_lo / a_hi);
     hi = std::max(c_hi / a_lo, c_hi / a_hi);
   }
+  // Near the ellipse's limit q -> 0 the bounds blow up; keep them where int conversion is safe.
+  lo = std::clamp(lo, -2.0, 2.0);
+  hi = std::clamp(hi, -2.0, 2.0);
   return hi >= -1.0 && lo <= 1.0;
 }
 
@@ -296,7 +299,9 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
         if (disc < 0.0) continue;
         const double root = std::sqrt(disc);
         // roots (-qb -+ root) / (2 qa); with qa < 0 the first is the smaller
-        const double r_lo = (-qb + root) * inv_2qa, r_hi = (-qb - root) * inv_2qa;
+        // clamped to the face (with a margin): near the ellipse's limit qa -> 0 and the roots blow up
+        const double r_lo = std::clamp((-qb + root) * inv_2qa, -2.0, 2.0);
+        const double r_hi = std::clamp((-qb - root) * inv_2qa, -2.0, 2.0);
         xa = std::max(x0, fast_floor((r_lo + 1.0) * h - 0.5) + 1);
         xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5));
         if (xb < xa) continue;
