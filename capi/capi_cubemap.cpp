@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace {
@@ -23,8 +24,18 @@ bool check_cube_size(const char* fn, const char* name, int size, hemilight_statu
   return false;
 }
 
-bool check_fixup(const char* fn, hemilight_edge_fixup fixup, hemilight_status& st) {
-  const int f = static_cast<int>(fixup);
+// The int a C caller passed as an enum. Read through memcpy: in C++ merely loading an enum object
+// whose value is outside the enumerators' range (say -1) is undefined behaviour, and C callers
+// may pass any int.
+template <class E>
+int enum_value(const E& e) noexcept {
+  static_assert(sizeof(E) == sizeof(int), "C enums are int-sized on every supported ABI");
+  int v = 0;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
+}
+
+bool check_fixup(const char* fn, int f, hemilight_status& st) {
   if (f >= 0 && f <= 2) return true;
   st = invalid(fn, "fixup " + std::to_string(f) + " is not HEMILIGHT_EDGE_FIXUP_NONE, _STRETCH or _WARP");
   return false;
@@ -32,7 +43,7 @@ bool check_fixup(const char* fn, hemilight_edge_fixup fixup, hemilight_status& s
 
 // The arguments every filter entry point shares; false (with st set) on the first bad one.
 bool check_filter_args(const char* fn, const float* input, int input_size, const float* output, int output_size,
-                       hemilight_edge_fixup fixup, hemilight_status& st) {
+                       int fixup, hemilight_status& st) {
   if (!input) {
     st = invalid(fn, "input is NULL");
     return false;
@@ -80,13 +91,14 @@ hemilight_status hemilight_cubemap_texel_direction(int size, int face, int x, in
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
     if (!direction) return invalid(fn, "direction is NULL");
-    if (!check_cube_size(fn, "size", size, st) || !check_fixup(fn, fixup, st)) return st;
+    const int fixup_value = enum_value(fixup);
+    if (!check_cube_size(fn, "size", size, st) || !check_fixup(fn, fixup_value, st)) return st;
     if (face < 0 || face > 5) return invalid(fn, "face " + std::to_string(face) + " is outside [0, 5]");
     if (x < 0 || x >= size || y < 0 || y >= size)
       return invalid(fn, "texel (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside a face of size " +
                              std::to_string(size));
     const glm::vec3 d =
-        hemilight::cubemap_texel_direction(size, face, x, y, static_cast<hemilight::edge_fixup>(fixup));
+        hemilight::cubemap_texel_direction(size, face, x, y, static_cast<hemilight::edge_fixup>(fixup_value));
     direction[0] = d.x;
     direction[1] = d.y;
     direction[2] = d.z;
@@ -117,12 +129,13 @@ hemilight_status hemilight_cubemap_filter_cosine_power(const float* input, int i
   const char* fn = "hemilight_cubemap_filter_cosine_power";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
+    const int fixup_value = enum_value(fixup);
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup_value, st)) return st;
     if (!std::isfinite(specular_power) || !(specular_power > 0.0f))
       return invalid(fn, "specular_power " + std::to_string(specular_power) + " must be finite and > 0");
     const hemilight::cubemap in = load_input(fn, input, input_size);
     hemilight::filter_options o;
-    o.fixup = static_cast<hemilight::edge_fixup>(fixup);
+    o.fixup = static_cast<hemilight::edge_fixup>(fixup_value);
     const hemilight::cube_image out = hemilight::filter_cosine_power(in, specular_power, output_size, o);
     std::copy(out.pixels.begin(), out.pixels.end(), output);
     return HEMILIGHT_OK;
@@ -134,10 +147,11 @@ hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int inp
   const char* fn = "hemilight_cubemap_filter_irradiance";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
+    const int fixup_value = enum_value(fixup);
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup_value, st)) return st;
     if (use_sh != 0 && use_sh != 1) return invalid(fn, "use_sh is " + std::to_string(use_sh) + "; it must be 0 or 1");
     const hemilight::cubemap in = load_input(fn, input, input_size);
-    const auto mapping = static_cast<hemilight::edge_fixup>(fixup);
+    const auto mapping = static_cast<hemilight::edge_fixup>(fixup_value);
     hemilight::cube_image out;
     if (use_sh) {
       out = hemilight::irradiance_from_sh9(hemilight::project_sh9(in.levels[0]), output_size, mapping, 3);
@@ -169,7 +183,8 @@ hemilight_status hemilight_cubemap_filter_mip_chain(const float* input, int inpu
   const char* fn = "hemilight_cubemap_filter_mip_chain";
   return guarded(fn, [&] {
     hemilight_status st = HEMILIGHT_OK;
-    if (!check_filter_args(fn, input, input_size, output, output_size, fixup, st)) return st;
+    const int fixup_value = enum_value(fixup);
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup_value, st)) return st;
     if (!std::isfinite(lobe_texels)) return invalid(fn, "lobe_texels is NaN or infinite");
     const std::size_t need = chain_floats(output_size, chain_levels(output_size));
     if (capacity < need)
@@ -177,7 +192,7 @@ hemilight_status hemilight_cubemap_filter_mip_chain(const float* input, int inpu
                              std::to_string(need));
     const hemilight::cubemap in = load_input(fn, input, input_size);
     hemilight::filter_options o;
-    o.fixup = static_cast<hemilight::edge_fixup>(fixup);
+    o.fixup = static_cast<hemilight::edge_fixup>(fixup_value);
     const hemilight::cubemap out =
         hemilight::filter_mip_chain(in, output_size, o, lobe_texels > 0.0f ? lobe_texels : 1.0f);
     float* dst = output;
@@ -203,8 +218,9 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
     if (!all_finite(direction, 3)) return invalid(fn, "direction has a NaN or infinite component");
     if (direction[0] == 0.0f && direction[1] == 0.0f && direction[2] == 0.0f) return invalid(fn, "direction is zero");
     if (!std::isfinite(lod)) return invalid(fn, "lod is NaN or infinite");
-    if (sampling != HEMILIGHT_CUBE_SAMPLING_CLAMP_PER_FACE && sampling != HEMILIGHT_CUBE_SAMPLING_SEAMLESS)
-      return invalid(fn, "sampling " + std::to_string(static_cast<int>(sampling)) + " is unknown");
+    const int sampling_value = enum_value(sampling);
+    if (sampling_value != HEMILIGHT_CUBE_SAMPLING_CLAMP_PER_FACE && sampling_value != HEMILIGHT_CUBE_SAMPLING_SEAMLESS)
+      return invalid(fn, "sampling " + std::to_string(sampling_value) + " is unknown");
     if (apply_fixup != 0 && apply_fixup != 1)
       return invalid(fn, "apply_fixup is " + std::to_string(apply_fixup) + "; it must be 0 or 1");
     hemilight::cubemap_detail::raw_cube levels[32];  // sampled in place: no copy of the chain
@@ -216,7 +232,7 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
     }
     glm::vec3 d(direction[0], direction[1], direction[2]);
     if (apply_fixup) d = hemilight::fixup_lookup(d, size, lod);
-    const auto mode = sampling == HEMILIGHT_CUBE_SAMPLING_SEAMLESS ? hemilight::cube_sampling::seamless
+    const auto mode = sampling_value == HEMILIGHT_CUBE_SAMPLING_SEAMLESS ? hemilight::cube_sampling::seamless
                                                                    : hemilight::cube_sampling::clamp_per_face;
     const glm::vec4 v = hemilight::cubemap_detail::sample_lod_raw(levels, level_count, d, std::max(0.0f, lod), mode);
     rgb[0] = v.x;
