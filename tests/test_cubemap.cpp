@@ -445,9 +445,9 @@ TEST_CASE("filter: a narrow bright source reproduces the analytic cosine-power l
 
 TEST_CASE("filter: fast filter against a plain brute-force sum, default options", "[cubemap]") {
   // Brute force: every texel of the 32^2 input, exact solid angles, no cutoff, double. The fast
-  // filter reads a coarser mip and cuts the lobe at 1e-4; the benchmark measures up to ~1.1% on
+  // filter reads a coarser mip and cuts the lobe at 1e-4; the benchmark measures up to ~0.3% on
   // the procedural sky with its sun at 256^2 (docs/cubemap.md). Here, input 32: measured up to
-  // 0.25% (p = 3), tolerance 1%.
+  // 0.04%; tolerance 0.5% (the default's documented bound with margin).
   const cube_image env = procedural_environment(32);
   const cubemap in = cubemap::from_image(env, false);
   const int out = 6;
@@ -467,7 +467,7 @@ TEST_CASE("filter: fast filter against a plain brute-force sum, default options"
           worst_ref = std::max(worst_ref, max_rel({lib_ref[i], lib_ref[i + 1], lib_ref[i + 2]}, ref));
         }
     INFO("p = " << p << ": fast filter max relative error " << worst << ", library reference " << worst_ref);
-    CHECK(worst < 0.01);
+    CHECK(worst < 0.005);
     CHECK(worst_ref < 1e-5);  // the library's reference is the same sum (float output)
   }
 }
