@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 namespace {
 
 using hemilight::capi::all_finite;
+using hemilight::capi::enum_value;
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
 
@@ -22,17 +22,6 @@ bool check_cube_size(const char* fn, const char* name, int size, hemilight_statu
   st = invalid(fn, std::string(name) + " " + std::to_string(size) + " is outside [1, " +
                        std::to_string(hemilight::cubemap_max_size) + "]");
   return false;
-}
-
-// The int a C caller passed as an enum. Read through memcpy: in C++ merely loading an enum object
-// whose value is outside the enumerators' range (say -1) is undefined behaviour, and C callers
-// may pass any int.
-template <class E>
-int enum_value(const E& e) noexcept {
-  static_assert(sizeof(E) == sizeof(int), "C enums are int-sized on every supported ABI");
-  int v = 0;
-  std::memcpy(&v, &e, sizeof v);
-  return v;
 }
 
 bool check_fixup(const char* fn, int f, hemilight_status& st) {

@@ -7,6 +7,7 @@
 #include "hemilight/error.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <new>
 #include <string>
@@ -37,6 +38,17 @@ hemilight_status guarded(const char* function, F&& f) noexcept {
   } catch (...) {
     return set_error(HEMILIGHT_ERROR_INTERNAL, std::string(function) + ": internal error (unknown exception)");
   }
+}
+
+/// The int a C caller passed as an enum. Read through memcpy: in C++ merely loading an enum object
+/// whose value is outside the enumerators' range (say -1) is undefined behaviour, and C callers
+/// may pass any int.
+template <class E>
+int enum_value(const E& e) noexcept {
+  static_assert(sizeof(E) == sizeof(int), "C enums are int-sized on every supported ABI");
+  int v = 0;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
 }
 
 /// True if all `count` floats are finite.
