@@ -184,20 +184,26 @@ bool cap_range(double dc, double da, double s2, double rho, double& lo, double& 
   return hi >= -1.0 && lo <= 1.0;
 }
 
-// Sums w L (per channel, into sums[0..3]) and w (sums[4]) over texels xa..xb of one row, w =
-// solid angle * tabulated lobe weight; the hot loop of the filter. SSE2 (every x86-64) does
-// four texels at a time; other targets use the scalar loop. Either way the order of the sums
-// depends only on (xa, xb), never on threads: results are deterministic.
-void accumulate_row(const lobe& lb, const glm::vec3& dl, const glm::vec4* row, const float* px, std::size_t ch, int xa,
-                    int xb, float sums[5]) {
-  float a0 = 0, a1 = 0, a2 = 0, a3 = 0, ws = 0;  // one row: at most a few hundred terms
-  int x = xa;
+// Running sums of w L per channel and of w for one output texel, w = solid angle * tabulated
+// lobe weight: SSE2 vectors (four texels per step) that live across all rows and faces of the
+// output texel and are reduced once at the end, plus scalar sums for what is not a multiple of
+// four texels. The order of the sums depends only on the output direction, never on threads:
+// results are deterministic.
+struct row_sums {
 #if defined(__SSE2__)
-  if (ch == 3 || ch == 4) {
+  __m128 a = _mm_setzero_ps(), b = _mm_setzero_ps(), c = _mm_setzero_ps(), w = _mm_setzero_ps();
+#endif
+  float s[5] = {0, 0, 0, 0, 0};  // R, G, B, A, weight
+
+  // Adds texels xa..xb of one row (`row`: face-local directions and solid angles, `px`: pixels).
+  void add(const lobe& lb, const glm::vec3& dl, const glm::vec4* row, const float* px, std::size_t ch, int xa,
+           int xb) noexcept {
+    int x = xa;
+#if defined(__SSE2__)
     const __m128 dx = _mm_set1_ps(dl.x), dy = _mm_set1_ps(dl.y), dz = _mm_set1_ps(dl.z);
     const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps(), inv = _mm_set1_ps(lb.inv_step);
     const __m128 top = _mm_set1_ps(static_cast<float>(lobe::steps + 1));
-    __m128 acc_a = zero, acc_b = zero, acc_c = zero, acc_w = zero;
+    const float* tab = lb.table.data();
     alignas(16) int idx[4];
     for (; x + 3 <= xb; x += 4) {
       __m128 tx = _mm_loadu_ps(&row[x].x), ty = _mm_loadu_ps(&row[x + 1].x);
@@ -208,58 +214,55 @@ void accumulate_row(const lobe& lb, const glm::vec3& dl, const glm::vec4* row, c
       const __m128i fi = _mm_cvttps_epi32(f);
       const __m128 t = _mm_sub_ps(f, _mm_cvtepi32_ps(fi));
       _mm_store_si128(reinterpret_cast<__m128i*>(idx), fi);
-      const float* tab = lb.table.data();
       const __m128 e0 = _mm_setr_ps(tab[idx[0]], tab[idx[1]], tab[idx[2]], tab[idx[3]]);
       const __m128 e1 = _mm_setr_ps(tab[idx[0] + 1], tab[idx[1] + 1], tab[idx[2] + 1], tab[idx[3] + 1]);
-      const __m128 w = _mm_mul_ps(tw, _mm_add_ps(e0, _mm_mul_ps(t, _mm_sub_ps(e1, e0))));
-      acc_w = _mm_add_ps(acc_w, w);
+      const __m128 wt = _mm_mul_ps(tw, _mm_add_ps(e0, _mm_mul_ps(t, _mm_sub_ps(e1, e0))));
+      w = _mm_add_ps(w, wt);
       const float* p = px + std::size_t(x) * ch;
       if (ch == 3) {
         // 12 floats r0 g0 b0 r1 | g1 b1 r2 g2 | b2 r3 g3 b3 times w0 w0 w0 w1 | w1 w1 w2 w2 | w2 w3 w3 w3
-        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(w, w, _MM_SHUFFLE(1, 0, 0, 0))));
-        acc_b = _mm_add_ps(acc_b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(w, w, _MM_SHUFFLE(2, 2, 1, 1))));
-        acc_c = _mm_add_ps(acc_c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(w, w, _MM_SHUFFLE(3, 3, 3, 2))));
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(1, 0, 0, 0))));
+        b = _mm_add_ps(b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(2, 2, 1, 1))));
+        c = _mm_add_ps(c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(3, 3, 3, 2))));
       } else {
-        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(w, w, _MM_SHUFFLE(0, 0, 0, 0))));
-        acc_b = _mm_add_ps(acc_b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(w, w, _MM_SHUFFLE(1, 1, 1, 1))));
-        acc_c = _mm_add_ps(acc_c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(w, w, _MM_SHUFFLE(2, 2, 2, 2))));
-        acc_a = _mm_add_ps(acc_a, _mm_mul_ps(_mm_loadu_ps(p + 12), _mm_shuffle_ps(w, w, _MM_SHUFFLE(3, 3, 3, 3))));
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_loadu_ps(p), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(0, 0, 0, 0))));
+        b = _mm_add_ps(b, _mm_mul_ps(_mm_loadu_ps(p + 4), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(1, 1, 1, 1))));
+        c = _mm_add_ps(c, _mm_mul_ps(_mm_loadu_ps(p + 8), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(2, 2, 2, 2))));
+        a = _mm_add_ps(a, _mm_mul_ps(_mm_loadu_ps(p + 12), _mm_shuffle_ps(wt, wt, _MM_SHUFFLE(3, 3, 3, 3))));
       }
     }
-    alignas(16) float va[4], vb[4], vc[4], vw[4];
-    _mm_store_ps(va, acc_a);
-    _mm_store_ps(vb, acc_b);
-    _mm_store_ps(vc, acc_c);
-    _mm_store_ps(vw, acc_w);
-    if (ch == 3) {
-      a0 = va[0] + va[3] + vb[2] + vc[1];
-      a1 = va[1] + vb[0] + vb[3] + vc[2];
-      a2 = va[2] + vb[1] + vc[0] + vc[3];
-    } else {
-      a0 = va[0] + vb[0] + vc[0];
-      a1 = va[1] + vb[1] + vc[1];
-      a2 = va[2] + vb[2] + vc[2];
-      a3 = va[3] + vb[3] + vc[3];
-    }
-    ws = (vw[0] + vw[1]) + (vw[2] + vw[3]);
-  }
 #endif
-  for (; x <= xb; ++x) {
-    const glm::vec4& t = row[x];
-    const float w = t.w * lb.tabulated_weight(dl.x * t.x + dl.y * t.y + dl.z * t.z);
-    const float* p = px + std::size_t(x) * ch;
-    a0 += w * p[0];
-    a1 += w * p[1];
-    a2 += w * p[2];
-    if (ch == 4) a3 += w * p[3];
-    ws += w;
+    for (; x <= xb; ++x) {
+      const glm::vec4& t = row[x];
+      const float wt = t.w * lb.tabulated_weight(dl.x * t.x + dl.y * t.y + dl.z * t.z);
+      const float* p = px + std::size_t(x) * ch;
+      for (std::size_t k = 0; k < ch; ++k) s[k] += wt * p[k];
+      s[4] += wt;
+    }
   }
-  sums[0] = a0;
-  sums[1] = a1;
-  sums[2] = a2;
-  sums[3] = a3;
-  sums[4] = ws;
-}
+
+  // Channel sums (R, G, B, A) and the weight sum.
+  void total(std::size_t ch, double out[5]) const noexcept {
+    for (int k = 0; k < 5; ++k) out[k] = s[k];
+#if defined(__SSE2__)
+    alignas(16) float va[4], vb[4], vc[4], vw[4];
+    _mm_store_ps(va, a);
+    _mm_store_ps(vb, b);
+    _mm_store_ps(vc, c);
+    _mm_store_ps(vw, w);
+    if (ch == 3) {
+      out[0] += double(va[0]) + va[3] + vb[2] + vc[1];
+      out[1] += double(va[1]) + vb[0] + vb[3] + vc[2];
+      out[2] += double(va[2]) + vb[1] + vc[0] + vc[3];
+    } else {
+      for (int k = 0; k < 4; ++k) out[k] += double(va[k]) + vb[k] + vc[k];
+    }
+    out[4] += (double(vw[0]) + vw[1]) + (double(vw[2]) + vw[3]);
+#else
+    (void)ch;
+#endif
+  }
+};
 
 // The filtered value along unit direction d over one input level.
 glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm::vec3& d) {
@@ -270,6 +273,7 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
   const double s2 = std::max(0.0, 1.0 - cos_max * cos_max);
   const double rho = std::sqrt(std::max(0.0, 2.0 - 2.0 * cos_max));  // chord = 2 sin(theta / 2)
   double acc[4] = {0, 0, 0, 0}, wsum = 0;
+  row_sums sums;  // the tabulated lobes' running sums
   for (int f = 0; f < 6; ++f) {
     const face_frame& fr = frame_of(f);
     const glm::vec3 dl(glm::dot(d, fr.column), glm::dot(d, fr.row), glm::dot(d, fr.axis));
@@ -316,10 +320,7 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
           xb = std::min(n - 1, xa + padded - 1);
           xa = xb - padded + 1;
         }
-        float sums[5];
-        accumulate_row(lb, dl, row, px, ch, xa, xb, sums);
-        for (std::size_t c = 0; c < 4; ++c) acc[c] += sums[c];
-        wsum += sums[4];
+        sums.add(lb, dl, row, px, ch, xa, xb);
         continue;
       }
       const float cmax = lb.cos_max;
@@ -333,6 +334,12 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
         wsum += w;
       }
     }
+  }
+  if (lb.tabulated) {
+    double t[5];
+    sums.total(ch, t);
+    for (std::size_t c = 0; c < 4; ++c) acc[c] += t[c];
+    wsum += t[4];
   }
   if (!(wsum > 0.0)) {
     // The lobe is narrower than the input's texels and no texel centre falls inside it: the
