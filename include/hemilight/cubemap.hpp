@@ -175,7 +175,7 @@ struct filter_options {
   /// face centre) are at most sigma / texels_per_sigma, sigma = 1/sqrt(p) the lobe's width.
   /// Larger is slower and closer to brute force (docs/cubemap.md has the measured curve): on the
   /// 256^2 test sky with a sun, 2.5 gives a max relative error of ~0.3% against brute force,
-  /// 1.5 is ~1.4x faster at up to ~1.5% (levels whose lobe is not much wider than the sun).
+  /// 1.5 is ~1.2x faster at up to ~1.5% (levels whose lobe is not much wider than the sun).
   float texels_per_sigma = 2.5f;
   /// Smallest input mip size the cosine-power filter reads (wide lobes are cheap to filter, and
   /// a bright compact source such as a sun needs several texels per lobe width: with 16 the
