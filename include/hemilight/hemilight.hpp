@@ -6,6 +6,9 @@
 //   image_io.hpp  float images and cube maps as OpenEXR
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
+//   scene.hpp     immutable triangle scenes with materials, lightmap UVs, sky and BVH
+//   reference_scenes.hpp  the reference scenes (Cornell box, hexagon room, ...) by name
+//   raster.hpp    the software hemicube rasterizer
 #pragma once
 
 #include "hemilight/error.hpp"
@@ -13,3 +16,6 @@
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+#include "hemilight/reference_scenes.hpp"
+#include "hemilight/scene.hpp"
