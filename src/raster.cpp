@@ -5,7 +5,15 @@
 #include <cfloat>
 #include <cmath>
 #include <limits>
+#include <cstring>
 #include <string>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#define HEMILIGHT_RASTER_SSE2 1
+#else
+#define HEMILIGHT_RASTER_SSE2 0
+#endif
 
 namespace hemilight {
 
@@ -14,7 +22,10 @@ namespace {
 constexpr int sub_bits = 8;                   // sub-texel bits of the fixed-point grid
 constexpr std::int64_t sub_one = 1 << sub_bits;
 constexpr std::int64_t sub_half = sub_one / 2;
-constexpr float guard_band = 2.0f;            // clip |u|, |v| <= 2 w: keeps fixed point bounded
+// Guard band: clip |u|, |v| <= 1000 w. Wide, so that big triangles crossing a face's edges are
+// rarely clipped (clipping multiplies the rows to walk), narrow enough that snapped coordinates
+// stay below 1001 * 2048 * 256 < 2^29 for N <= 4096 (edge-function terms below 2^60 in int64).
+constexpr float guard_band = 1000.0f;
 constexpr int max_clip_vertices = 3 + 5;      // each of the 5 clip planes adds at most one
 
 // A vertex in a face's clip space: u = c.p, v = r.p, w = a.p (geometry.hpp face axes).
@@ -125,9 +136,51 @@ inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, cons
 inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >= 0 ? a / sub_one : -((-a + sub_one - 1) / sub_one); }
 inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
 
+// floor(a / m) for m > 0 and |a|, m < 2^52: a double estimate (off by at most one, both are
+// exact doubles) made exact with integer checks; cheaper than a 64-bit division.
+inline std::int64_t floor_div(std::int64_t a, std::int64_t m) noexcept {
+  auto q = static_cast<std::int64_t>(static_cast<double>(a) / static_cast<double>(m));
+  while (q * m > a) --q;
+  while ((q + 1) * m <= a) ++q;
+  return q;
+}
+
+// Nearest integer, halves away from zero (deterministic, no libm call). |x| < 2^30 here.
+inline std::int64_t round_to_int(double x) noexcept {
+  return static_cast<std::int64_t>(x >= 0.0 ? x + 0.5 : x - 0.5);
+}
+
 struct fixed_point {
   std::int64_t x, y;
 };
+
+// The resolve loops, separate and with restrict pointers so that the byte stores of the flags
+// do not force reloads (char stores may alias anything) and the division vectorises.
+void resolve_texels(std::size_t count, const float* __restrict depth, const float* __restrict lengths,
+                    const std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
+                    float* __restrict distance, float* __restrict radiance, std::uint8_t* __restrict flags) noexcept {
+  for (std::size_t i = 0; i < count; ++i) distance[i] = lengths[i] / depth[i];
+  // Stores are the bottleneck here: one 16-byte store per texel writes its RGB plus one float
+  // that the next texel overwrites (the last texel is written exactly).
+  std::size_t i = 0;
+#if HEMILIGHT_RASTER_SSE2
+  for (; i + 1 < count; ++i) _mm_storeu_ps(radiance + 3 * i, _mm_loadu_ps(&shades[ids[i]].r));
+#endif
+  for (; i < count; ++i) {
+    const hemicube_rasterizer::shade& sh = shades[ids[i]];
+    radiance[3 * i] = sh.r;
+    radiance[3 * i + 1] = sh.g;
+    radiance[3 * i + 2] = sh.b;
+  }
+  // Flags eight at a time (count = 3 N^2 is a multiple of 4; the tail is scalar).
+  i = 0;
+  for (; i + 8 <= count; i += 8) {
+    std::uint8_t packed[8];  // gathered in registers, stored at once
+    for (std::size_t k = 0; k < 8; ++k) packed[k] = static_cast<std::uint8_t>(shades[ids[i + k]].flags);
+    std::memcpy(flags + i, packed, 8);
+  }
+  for (; i < count; ++i) flags[i] = static_cast<std::uint8_t>(shades[ids[i]].flags);
+}
 
 }  // namespace
 
@@ -179,6 +232,7 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
     throw_invalid_argument("hemicube_rasterizer: near_distance is " + std::to_string(options.near_distance) +
                            "; it must be finite and >= 0 (0 = default)");
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
+  simd_ = options.simd;
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -223,14 +277,18 @@ void hemicube_rasterizer::prepare(int resolution) {
     n_ = resolution;
   }
   depth_.assign(count, 0.0f);
-  ids_.resize(count);
+  ids_.assign(count, 0u);
+  // Record 0 stands for "nothing hit" (the sky): texels start there.
   draws_.clear();
+  draws_.push_back(draw_record{});
+  draws_.front().index = no_triangle;
+  shades_.clear();
+  shades_.push_back({0.0f, 0.0f, 0.0f, texel_miss});
   stats_ = {};
 }
 
 std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < ids_.size());
-  if (depth_[texel] == 0.0f) return no_triangle;
   return draws_[ids_[texel]].index;
 }
 
@@ -298,6 +356,7 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
   }
   const auto draw = static_cast<std::uint32_t>(draws_.size());
   draws_.push_back(rec);
+  shades_.push_back({rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags});
   for (int f = 0; f < 5; ++f)
     if (faces >> f & 1u) {
       ++stats_.face_triangles;
@@ -341,30 +400,73 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
   if (count < 3) return;
 
   // Project and snap. Side faces: v in [0, 1] maps to rows [0, N/2).
-  const float half = 0.5f * static_cast<float>(n);
-  const float v_offset = face == 0 ? 1.0f : 0.0f;
+  // In double: coordinates up to 2^29 keep their 1/256-texel precision.
+  const double scale = 0.5 * n * static_cast<double>(sub_one);
+  const double v_offset = face == 0 ? 1.0 : 0.0;
   fixed_point fx[max_clip_vertices + 1];
   for (int i = 0; i < count; ++i) {
-    const float iw = 1.0f / poly[i].w;
-    const float x = (poly[i].u * iw + 1.0f) * half * static_cast<float>(sub_one);
-    const float y = (poly[i].v * iw + v_offset) * half * static_cast<float>(sub_one);
-    fx[i] = {static_cast<std::int64_t>(std::lrint(x)), static_cast<std::int64_t>(std::lrint(y))};
+    const double iw = 1.0 / static_cast<double>(poly[i].w);
+    fx[i] = {round_to_int((poly[i].u * iw + 1.0) * scale), round_to_int((poly[i].v * iw + v_offset) * scale)};
   }
 
   // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
   // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
+  // Evaluated per row in double, then per texel in float.
   const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
   const double inv_k = 1.0 / static_cast<double>(rec.plane);
   const double step = 2.0 / n;
   const double u0 = 1.0 / n - 1.0, v0 = face == 0 ? 1.0 / n - 1.0 : 1.0 / n;
   const auto dzdx = static_cast<float>(nm.u * step * inv_k);
-  const auto dzdy = static_cast<float>(nm.v * step * inv_k);
-  const auto z00 = static_cast<float>((nm.w + nm.u * u0 + nm.v * v0) * inv_k);
+  const double dzdy = nm.v * step * inv_k;
+  const double z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
 
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   float* depth = depth_.data() + face_offset;
   std::uint32_t* ids = ids_.data() + face_offset;
   std::uint32_t* counts = M == mode::count ? counts_->data() + face_offset : nullptr;
+
+  // Writes the texels [lo, hi] of row y.
+  const auto span = [&](int y, int lo, int hi) {
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
+    if (M == mode::count) {
+      for (int x = lo; x <= hi; ++x) ++counts[row + static_cast<std::size_t>(x)];
+      return;
+    }
+    const auto zrow = static_cast<float>(z00 + dzdy * y);
+    float* drow = depth + row;
+    std::uint32_t* irow = ids + row;
+    int x = lo;
+#if HEMILIGHT_RASTER_SSE2
+    if (simd_) {
+      // Four texels at a time; the same operations in the same order as the scalar loop below,
+      // so the results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like
+      // the scalar select.
+      const __m128 zr = _mm_set1_ps(zrow), dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
+      const __m128i id = _mm_set1_epi32(static_cast<int>(draw)), lane = _mm_setr_epi32(0, 1, 2, 3);
+      for (; x + 3 <= hi; x += 4) {
+        const __m128 xf = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x), lane));
+        const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
+        const __m128 old = _mm_loadu_ps(drow + x);
+        const __m128 closer = _mm_cmpgt_ps(z, old);
+        _mm_storeu_ps(drow + x, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
+        __m128i* ip = reinterpret_cast<__m128i*>(irow + x);
+        const __m128i mask = _mm_castps_si128(closer);
+        _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
+      }
+    }
+#endif
+    // The scalar reference path (and the tail of the SIMD one).
+    for (; x <= hi; ++x) {
+      float z = zrow + dzdx * static_cast<float>(x);
+      // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and a
+      // covered texel must stay covered: clamp to the smallest positive depth (the farthest).
+      z = z > FLT_MIN ? z : FLT_MIN;
+      if (z > drow[x]) {
+        drow[x] = z;
+        irow[x] = draw;
+      }
+    }
+  };
 
   // Fan of the clipped polygon.
   for (int i = 1; i + 1 < count; ++i) {
@@ -383,9 +485,9 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
 
     // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
     // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
-    // d.x < 0: of two triangles sharing an edge exactly one owns it.
+    // d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
+    // texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
     std::int64_t ex[3], ey[3], e0[3];
-    double inv_ex[3];
     for (int k = 0; k < 3; ++k) {
       const fixed_point& a = p[k];
       const fixed_point& b = p[(k + 1) % 3];
@@ -394,48 +496,76 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
       ex[k] = -dy * sub_one;
       ey[k] = dx * sub_one;
       e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
-      inv_ex[k] = ex[k] != 0 ? 1.0 / static_cast<double>(ex[k]) : 0.0;
+    }
+
+    if ((x_end - x_begin + 1) * (y_end - y_begin + 1) <= 8) {
+      // Small box (most triangles of big scenes): test each texel.
+      for (std::int64_t y = y_begin; y <= y_end; ++y)
+        for (std::int64_t x = x_begin; x <= x_end; ++x)
+          if (ex[0] * x + ey[0] * y + e0[0] >= 0 && ex[1] * x + ey[1] * y + e0[1] >= 0 &&
+              ex[2] * x + ey[2] * y + e0[2] >= 0)
+            span(static_cast<int>(y), static_cast<int>(x), static_cast<int>(x));
+      continue;
+    }
+
+    // Exact incremental spans. Edge k bounds x from the left when ex > 0:
+    // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
+    // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
+    // per row with additions only (a Bresenham-style exact walk).
+    struct walk {
+      int kind;  // +1 left bound, -1 right bound, 0 constant in x
+      std::int64_t bound, rem, m, q_step, r_step, value, value_step;
+    } w[3] = {};
+    for (int k = 0; k < 3; ++k) {
+      walk& e = w[k];
+      const std::int64_t r = ey[k] * y_begin + e0[k];
+      if (ex[k] > 0) {
+        e.kind = 1;
+        e.m = ex[k];
+        const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
+        e.bound = -floor_div(-num, e.m);
+        e.rem = e.bound * e.m - num;
+        const std::int64_t d = -ey[k];                     // num steps by d per row
+        e.q_step = floor_div(d, e.m);
+        e.r_step = d - e.q_step * e.m;
+      } else if (ex[k] < 0) {
+        e.kind = -1;
+        e.m = -ex[k];
+        e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
+        e.rem = r - e.bound * e.m;
+        e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
+        e.r_step = ey[k] - e.q_step * e.m;
+      } else {
+        e.kind = 0;
+        e.value = r;
+        e.value_step = ey[k];
+      }
     }
     for (std::int64_t y = y_begin; y <= y_end; ++y) {
       std::int64_t lo = x_begin, hi = x_end;
-      for (int k = 0; k < 3 && lo <= hi; ++k) {
-        const std::int64_t r = ey[k] * y + e0[k];  // E at x = 0 (with the tie bias)
-        if (ex[k] > 0) {
-          // r + ex x >= 0  <=>  x >= ceil(-r / ex): estimate in double, then make it exact.
-          auto x = static_cast<std::int64_t>(std::ceil(static_cast<double>(-r) * inv_ex[k]));
-          while (r + ex[k] * x < 0) ++x;
-          while (r + ex[k] * (x - 1) >= 0) --x;
-          lo = std::max(lo, x);
-        } else if (ex[k] < 0) {
-          // x <= floor(r / -ex)
-          auto x = static_cast<std::int64_t>(std::floor(static_cast<double>(r) * -inv_ex[k]));
-          while (r + ex[k] * x < 0) --x;
-          while (r + ex[k] * (x + 1) >= 0) ++x;
-          hi = std::min(hi, x);
-        } else if (r < 0) {
-          hi = lo - 1;
+      for (walk& e : w) {
+        if (e.kind > 0) {
+          lo = std::max(lo, e.bound);
+          e.bound += e.q_step;
+          e.rem -= e.r_step;
+          if (e.rem < 0) {
+            e.bound += 1;
+            e.rem += e.m;
+          }
+        } else if (e.kind < 0) {
+          hi = std::min(hi, e.bound);
+          e.bound += e.q_step;
+          e.rem += e.r_step;
+          if (e.rem >= e.m) {
+            e.bound += 1;
+            e.rem -= e.m;
+          }
+        } else {
+          if (e.value < 0) hi = lo - 1;
+          e.value += e.value_step;
         }
       }
-      if (lo > hi) continue;
-      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
-      if (M == mode::count) {
-        for (std::int64_t x = lo; x <= hi; ++x) ++counts[row + static_cast<std::size_t>(x)];
-        continue;
-      }
-      const float zrow = z00 + dzdy * static_cast<float>(y);
-      float* drow = depth + row;
-      std::uint32_t* irow = ids + row;
-      for (std::int64_t x = lo; x <= hi; ++x) {
-        float z = zrow + dzdx * static_cast<float>(x);
-        // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and
-        // a covered texel must still be covered: clamp to the smallest positive depth (farthest).
-        z = z > FLT_MIN ? z : FLT_MIN;
-        const auto xi = static_cast<std::size_t>(x);
-        if (z > drow[xi]) {
-          drow[xi] = z;
-          irow[xi] = draw;
-        }
-      }
+      if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
     }
   }
 }
@@ -446,45 +576,41 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   check_arguments(who, position, basis, resolution);
   if (texture) texture->validate(who);
   prepare(resolution);
+  const glm::vec3 sky = scene_->sky_radiance();
+  shades_.front() = {sky.x, sky.y, sky.z, texel_miss};
   draw_all<mode::depth>(position, basis, texture);
 
-  // Resolve: exact distance along the texel-centre ray, radiance, flags.
+  // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
+  // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
+  // triangle's exact plane evaluated at the texel centre, so this is the ray-plane intersection.
   out.resize(resolution);
   out.position = position;
   out.basis = basis;
-  const glm::vec3 sky = scene_->sky_radiance();
   const std::size_t count = hemicube_texel_count(resolution);
+  const float* depth = depth_.data();
+  const float* lengths = lengths_.data();
+  const std::uint32_t* ids = ids_.data();
+  const shade* shades = shades_.data();
+  float* distance = out.distance.data();
+  float* radiance = out.radiance.data();
+  std::uint8_t* flags = out.flags.data();
+  resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags);
+  if (!texture || !scene_->has_lightmap_uvs()) return;
+  // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
   const std::vector<std::uint32_t>& indices = scene_->indices();
   for (std::size_t i = 0; i < count; ++i) {
-    float* rad = out.radiance.data() + 3 * i;
-    if (depth_[i] == 0.0f) {
-      rad[0] = sky.x;
-      rad[1] = sky.y;
-      rad[2] = sky.z;
-      out.distance[i] = std::numeric_limits<float>::infinity();
-      out.flags[i] = texel_miss;
-      continue;
-    }
-    const draw_record& rec = draws_[ids_[i]];
-    const glm::vec3& d = directions_[i];
-    float t = rec.plane / glm::dot(rec.normal, d);
-    // Ray nearly parallel to the plane: fall back to the rasterized depth (also exact in theory).
-    if (!(t > 0.0f) || !(t < std::numeric_limits<float>::max())) t = lengths_[i] / depth_[i];
-    out.distance[i] = t;
-    out.flags[i] = rec.flags;
-    glm::vec3 l = rec.radiance;
-    if (rec.textured) {
-      const glm::vec3 q = t * d - rec.v0;
-      const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-      const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
-      const glm::vec2& uv0 = uvs[indices[tri]];
-      const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
-      l = texture->sample(uv);
-    }
-    rad[0] = l.x;
-    rad[1] = l.y;
-    rad[2] = l.z;
+    const draw_record& rec = draws_[ids[i]];
+    if (!rec.textured) continue;
+    const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
+    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
+    const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
+    const glm::vec2& uv0 = uvs[indices[tri]];
+    const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+    const glm::vec3 l = texture->sample(uv);
+    radiance[3 * i] = l.x;
+    radiance[3 * i + 1] = l.y;
+    radiance[3 * i + 2] = l.z;
   }
 }
 

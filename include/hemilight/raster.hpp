@@ -9,7 +9,7 @@
 //      the tangent plane (z <= 0) or outside all five face frusta, and each surviving node keeps
 //      the mask of faces it can touch. Each triangle is moved to the local frame once.
 //   2. Visibility, per face: homogeneous clipping against the near plane w >= near (w is the
-//      distance along the face's forward axis) and a guard band |u|, |v| <= 2 w; projection;
+//      distance along the face's forward axis) and a guard band |u|, |v| <= 1000 w; projection;
 //      snapping to fixed point with 8 sub-texel bits; 64-bit integer edge functions with a
 //      tie-breaking rule (an edge owns the texel centres exactly on it iff it runs upwards, or
 //      horizontally towards -x): triangles sharing an edge leave no gap and cover no texel twice.
@@ -24,9 +24,9 @@
 //      see nothing give the sky's radiance, +inf and texel_miss.
 //
 // Precision. Clip-space vertices are finite floats; after guard-band clipping every projected
-// coordinate is within [-N/2, 3N/2] texels of the face, i.e. |X| < 1.5 * 4096 * 256 < 2^21 in
-// fixed point for every valid N, so edge-function products stay below 2^43 and are exact in
-// 64-bit integers. Watertightness (every texel centre inside a closed mesh around the point
+// coordinate is within 1001 N/2 texels of the face, i.e. |X| < 1001 * 2048 * 256 < 2^29 in
+// fixed point (computed in double, so still 1/256 texel) for every valid N, so edge-function
+// terms stay below 2^60 and are exact in 64-bit integers. Watertightness (every texel centre inside a closed mesh around the point
 // is covered exactly once) therefore holds for every N <= 4096 and every finite geometry, as long
 // as the geometry is further than the near distance from the point along each face's axis.
 // Clipped vertices on a shared edge are computed from the edge's endpoints in a canonical order,
@@ -43,8 +43,9 @@
 // Threads: the scene is shared and immutable; a hemicube_rasterizer owns its scratch memory and is
 // used by one thread at a time. N threads = N rasterizers, no locks.
 //
-// SIMD: there is one (scalar, portable) path; the span loops are written so the compiler can
-// vectorise them. Any future SIMD path must be tested against it.
+// SIMD: the depth test of a span runs four texels at a time with SSE2 (always available on
+// x86-64); raster_options::simd = false selects the scalar reference path, which gives
+// bit-identical results (tested). Other targets use the scalar path.
 #pragma once
 
 #include "hemilight/geometry.hpp"
@@ -90,6 +91,9 @@ struct raster_options {
   /// Near-plane distance along each face's forward axis (scene units). 0 = the default,
   /// default_near_distance(scene). Must be finite and >= 0.
   float near_distance = 0.0f;
+  /// Use the SSE2 depth-test loop where the target has SSE2 (every x86-64). false selects the
+  /// scalar reference path; both give bit-identical buffers (tested).
+  bool simd = true;
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
@@ -158,6 +162,11 @@ class hemicube_rasterizer {
     std::uint8_t flags;    ///< texel_flags of the texels it wins
     bool textured;         ///< UVs + texture: radiance comes from the texture
   };
+  /// What the resolve pass copies to the texels a draw record wins (internal).
+  struct shade {
+    float r, g, b;
+    std::uint32_t flags;
+  };
 
  private:
   enum class mode { depth, count };
@@ -173,13 +182,15 @@ class hemicube_rasterizer {
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
+  bool simd_ = true;
   int n_ = 0;
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
-  std::vector<std::uint32_t> ids_;     // draw record of the nearest fragment per texel
+  std::vector<std::uint32_t> ids_;     // draw record of the nearest fragment per texel (0 = none)
   std::vector<std::uint32_t>* counts_ = nullptr;
   std::vector<glm::vec3> directions_;  // unit texel-centre directions, local frame
   std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
-  std::vector<draw_record> draws_;
+  std::vector<draw_record> draws_;     // [0] = nothing hit
+  std::vector<shade> shades_;          // radiance + flags of each draw record, compact for the resolve
   std::vector<std::uint32_t> stack_;
   raster_statistics stats_;
 };
