@@ -154,32 +154,48 @@ struct fixed_point {
   std::int64_t x, y;
 };
 
-// The resolve loops, separate and with restrict pointers so that the byte stores of the flags
-// do not force reloads (char stores may alias anything) and the division vectorises.
+// The resolve loops, with restrict pointers so that the byte stores of the flags do not force
+// reloads (char stores may alias anything). Texels never written have depth 0 (their id is
+// stale): they are set to record 0, the sky. Stores are the bottleneck: one 16-byte store per texel
+// writes its RGB plus one float that the next texel overwrites (the last texel is written
+// exactly), and the flags go out eight at a time.
 void resolve_texels(std::size_t count, const float* __restrict depth, const float* __restrict lengths,
-                    const std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
-                    float* __restrict distance, float* __restrict radiance, std::uint8_t* __restrict flags) noexcept {
-  for (std::size_t i = 0; i < count; ++i) distance[i] = lengths[i] / depth[i];
-  // Stores are the bottleneck here: one 16-byte store per texel writes its RGB plus one float
-  // that the next texel overwrites (the last texel is written exactly).
+                    std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
+                    float* __restrict distance, float* __restrict radiance, std::uint8_t* __restrict flags,
+                    bool simd) noexcept {
   std::size_t i = 0;
 #if HEMILIGHT_RASTER_SSE2
-  for (; i + 1 < count; ++i) _mm_storeu_ps(radiance + 3 * i, _mm_loadu_ps(&shades[ids[i]].r));
+  if (simd) {
+    // One pass, four texels at a time: distance, id of unwritten texels -> 0, radiance, flags.
+    const __m128 zero = _mm_setzero_ps();
+    for (; i + 4 < count; i += 4) {  // '<': the 16-byte radiance stores never pass the end
+      const __m128 d = _mm_loadu_ps(depth + i);
+      _mm_storeu_ps(distance + i, _mm_div_ps(_mm_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
+      const __m128i id = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)),
+                                       _mm_castps_si128(_mm_cmpgt_ps(d, zero)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(ids + i), id);
+      std::uint32_t lane[4];
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
+      std::uint8_t packed[4];
+      for (std::size_t k = 0; k < 4; ++k) {
+        const hemicube_rasterizer::shade& sh = shades[lane[k]];
+        _mm_storeu_ps(radiance + 3 * (i + k), _mm_loadu_ps(&sh.r));
+        packed[k] = static_cast<std::uint8_t>(sh.flags);
+      }
+      std::memcpy(flags + i, packed, 4);
+    }
+  }
 #endif
+  // Scalar reference (and tail): the same values.
   for (; i < count; ++i) {
+    distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
+    ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
     const hemicube_rasterizer::shade& sh = shades[ids[i]];
     radiance[3 * i] = sh.r;
     radiance[3 * i + 1] = sh.g;
     radiance[3 * i + 2] = sh.b;
+    flags[i] = static_cast<std::uint8_t>(sh.flags);
   }
-  // Flags eight at a time (count = 3 N^2 is a multiple of 4; the tail is scalar).
-  i = 0;
-  for (; i + 8 <= count; i += 8) {
-    std::uint8_t packed[8];  // gathered in registers, stored at once
-    for (std::size_t k = 0; k < 8; ++k) packed[k] = static_cast<std::uint8_t>(shades[ids[i + k]].flags);
-    std::memcpy(flags + i, packed, 8);
-  }
-  for (; i < count; ++i) flags[i] = static_cast<std::uint8_t>(shades[ids[i]].flags);
 }
 
 }  // namespace
@@ -277,7 +293,7 @@ void hemicube_rasterizer::prepare(int resolution) {
     n_ = resolution;
   }
   depth_.assign(count, 0.0f);
-  ids_.assign(count, 0u);
+  ids_.resize(count);  // stale ids are masked by depth 0 (never written)
   // Record 0 stands for "nothing hit" (the sky): texels start there.
   draws_.clear();
   draws_.push_back(draw_record{});
@@ -289,7 +305,7 @@ void hemicube_rasterizer::prepare(int resolution) {
 
 std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < ids_.size());
-  return draws_[ids_[texel]].index;
+  return draws_[ids_[texel]].index;  // the resolve set unwritten texels to record 0
 }
 
 template <hemicube_rasterizer::mode M>
@@ -384,6 +400,7 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
     any_out |= code;
   }
   if (all_out) return;
+  if (any_out) ++stats_.clipped;
   for (int k = 0; k < 5 && count >= 3; ++k) {
     if (!(any_out >> k & 1u)) continue;
     int out = 0;
@@ -427,6 +444,8 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
 
   // Writes the texels [lo, hi] of row y.
   const auto span = [&](int y, int lo, int hi) {
+    ++stats_.spans;
+    stats_.fragments += static_cast<std::size_t>(hi - lo + 1);
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
     if (M == mode::count) {
       for (int x = lo; x <= hi; ++x) ++counts[row + static_cast<std::size_t>(x)];
@@ -437,7 +456,7 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
     std::uint32_t* irow = ids + row;
     int x = lo;
 #if HEMILIGHT_RASTER_SSE2
-    if (simd_) {
+    if (simd_ && hi - lo >= 3) {
       // Four texels at a time; the same operations in the same order as the scalar loop below,
       // so the results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like
       // the scalar select.
@@ -498,13 +517,32 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
       e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
     }
 
-    if ((x_end - x_begin + 1) * (y_end - y_begin + 1) <= 8) {
-      // Small box (most triangles of big scenes): test each texel.
-      for (std::int64_t y = y_begin; y <= y_end; ++y)
-        for (std::int64_t x = x_begin; x <= x_end; ++x)
-          if (ex[0] * x + ey[0] * y + e0[0] >= 0 && ex[1] * x + ey[1] * y + e0[1] >= 0 &&
-              ex[2] * x + ey[2] * y + e0[2] >= 0)
-            span(static_cast<int>(y), static_cast<int>(x), static_cast<int>(x));
+    if (x_end - x_begin < 24 && (x_end - x_begin + 1) * (y_end - y_begin + 1) <= 96) {
+      // Small box (most triangles of big scenes): step the edge functions texel by texel
+      // (additions only; a texel is in iff the OR of the three values is not negative) and
+      // write each row's run at once (the triangle is convex: the run is contiguous).
+      std::int64_t row0 = ex[0] * x_begin + ey[0] * y_begin + e0[0];
+      std::int64_t row1 = ex[1] * x_begin + ey[1] * y_begin + e0[1];
+      std::int64_t row2 = ex[2] * x_begin + ey[2] * y_begin + e0[2];
+      for (std::int64_t y = y_begin; y <= y_end; ++y, row0 += ey[0], row1 += ey[1], row2 += ey[2]) {
+        std::int64_t a = row0, b = row1, c = row2;
+        std::int64_t x = x_begin;
+        while (x <= x_end && (a | b | c) < 0) {
+          a += ex[0];
+          b += ex[1];
+          c += ex[2];
+          ++x;
+        }
+        if (x > x_end) continue;
+        const std::int64_t first = x;
+        while (x <= x_end && (a | b | c) >= 0) {
+          a += ex[0];
+          b += ex[1];
+          c += ex[2];
+          ++x;
+        }
+        span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
+      }
       continue;
     }
 
@@ -589,12 +627,12 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   const std::size_t count = hemicube_texel_count(resolution);
   const float* depth = depth_.data();
   const float* lengths = lengths_.data();
-  const std::uint32_t* ids = ids_.data();
+  std::uint32_t* ids = ids_.data();
   const shade* shades = shades_.data();
   float* distance = out.distance.data();
   float* radiance = out.radiance.data();
   std::uint8_t* flags = out.flags.data();
-  resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags);
+  resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags, simd_);
   if (!texture || !scene_->has_lightmap_uvs()) return;
   // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();

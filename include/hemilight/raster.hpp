@@ -105,6 +105,9 @@ struct raster_statistics {
   std::size_t nodes_visited = 0;       ///< BVH nodes tested
   std::size_t triangles_tested = 0;    ///< triangles moved to the local frame and tested per face
   std::size_t face_triangles = 0;      ///< (triangle, face) pairs sent to clipping and rasterization
+  std::size_t clipped = 0;             ///< of those, how many needed clipping
+  std::size_t spans = 0;               ///< row spans written (each a depth-tested run of texels)
+  std::size_t fragments = 0;           ///< texels depth-tested (or counted), summed over spans
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
