@@ -660,6 +660,7 @@ void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame
   counts_ = &counts;
   draw_all<mode::count>(position, basis, nullptr);
   counts_ = nullptr;
+  std::fill(ids_.begin(), ids_.end(), 0u);  // seen_triangle() after this: no_triangle everywhere
 }
 
 }  // namespace hemilight

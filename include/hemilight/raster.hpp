@@ -19,9 +19,14 @@
 //   3. Resolve, per texel: the texel-centre ray is intersected with the plane of the triangle
 //      that won, giving the Euclidean distance (not the projected depth) and, for a radiance
 //      texture, perspective-correct UVs. Front faces (and two-sided triangles from either side)
-//      give the texture's bilinear value at that UV, or the triangle's emission; one-sided
-//      triangles seen from behind occlude but give radiance 0 and texel_back_face; texels that
-//      see nothing give the sky's radiance, +inf and texel_miss.
+//      give the texture's bilinear value at that UV, or the triangle's emission, and flag
+//      texel_hit_front (0); one-sided triangles seen from behind occlude but give radiance 0 and
+//      texel_back_face; texels that see nothing give the sky's radiance, +inf and texel_miss.
+//      The distance is |D| / (1/w) with D = a + u c + v r the texel centre's direction on the
+//      face and 1/w the triangle's plane evaluated there: the ray-plane intersection, accurate
+//      to ~1e-6 relative except at grazing incidence (|cos| < 1e-3), where it degrades like
+//      1e-7 / |cos|. A texel covered by a triangle seen almost exactly edge-on can get a huge
+//      (up to ~1e38) but finite distance; it is still flagged as a hit.
 //
 // Precision. Clip-space vertices are finite floats; after guard-band clipping every projected
 // coordinate is within 1001 N/2 texels of the face, i.e. |X| < 1001 * 2048 * 256 < 2^29 in
@@ -144,7 +149,9 @@ class hemicube_rasterizer {
                        std::vector<std::uint32_t>& counts);
 
   /// After render(): the scene triangle (scene_desc numbering) seen through a texel, or
-  /// no_triangle for a miss. Precondition: texel < 3 N^2 of the last render (asserted).
+  /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). A debugging and
+  /// testing aid; the buffer itself does not carry triangle numbers.
+  /// Precondition: texel < 3 N^2 of the last render (asserted).
   std::uint32_t seen_triangle(std::size_t texel) const noexcept;
 
   /// The near distance in use (the option, or the scene's default).
