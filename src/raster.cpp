@@ -480,10 +480,11 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
       // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and a
       // covered texel must stay covered: clamp to the smallest positive depth (the farthest).
       z = z > FLT_MIN ? z : FLT_MIN;
-      if (z > drow[x]) {
-        drow[x] = z;
-        irow[x] = draw;
-      }
+      // Selects, not a branch: short spans would mispredict on every texel.
+      const float old = drow[x];
+      const bool closer = z > old;
+      drow[x] = closer ? z : old;
+      irow[x] = closer ? draw : irow[x];
     }
   };
 
@@ -582,22 +583,19 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
     for (std::int64_t y = y_begin; y <= y_end; ++y) {
       std::int64_t lo = x_begin, hi = x_end;
       for (walk& e : w) {
+        // The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
         if (e.kind > 0) {
           lo = std::max(lo, e.bound);
-          e.bound += e.q_step;
           e.rem -= e.r_step;
-          if (e.rem < 0) {
-            e.bound += 1;
-            e.rem += e.m;
-          }
+          const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
+          e.bound += e.q_step - carry;
+          e.rem += carry & e.m;
         } else if (e.kind < 0) {
           hi = std::min(hi, e.bound);
-          e.bound += e.q_step;
-          e.rem += e.r_step;
-          if (e.rem >= e.m) {
-            e.bound += 1;
-            e.rem -= e.m;
-          }
+          e.rem += e.r_step - e.m;
+          const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
+          e.bound += e.q_step + 1 + keep;
+          e.rem += keep & e.m;
         } else {
           if (e.value < 0) hi = lo - 1;
           e.value += e.value_step;
