@@ -359,13 +359,25 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
   // A plane through the point is seen edge-on: it covers no texel centre.
   if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
   rec.index = tri.index;
+  // The rest of the record (material, texture gradients) is filled in when the triangle first
+  // covers a texel centre: most triangles of big scenes cover none.
+  std::uint32_t draw = 0;
+  for (int f = 0; f < 5; ++f)
+    if (faces >> f & 1u) {
+      ++stats_.face_triangles;
+      raster_face<M>(f, local, rec, draw, basis, tri, texture);
+    }
+}
+
+std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
+                                                 const radiance_texture* texture) {
   const material& m = scene_->triangle_material(tri.index);
   const bool back = rec.plane > 0.0f && !m.two_sided;
   rec.flags = back ? texel_back_face : texel_hit_front;
   rec.radiance = back ? glm::vec3(0.0f) : m.emission;
   rec.textured = !back && texture && scene_->has_lightmap_uvs();
   if (rec.textured) {
-    const glm::vec3 le1 = basis.to_local(e1), le2 = basis.to_local(e2);
+    const glm::vec3 le1 = basis.to_local(tri.v1 - tri.v0), le2 = basis.to_local(tri.v2 - tri.v0);
     const float nn = glm::dot(rec.normal, rec.normal);
     rec.grad_b1 = glm::cross(le2, rec.normal) / nn;
     rec.grad_b2 = glm::cross(rec.normal, le1) / nn;
@@ -373,16 +385,13 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
   const auto draw = static_cast<std::uint32_t>(draws_.size());
   draws_.push_back(rec);
   shades_.push_back({rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags});
-  for (int f = 0; f < 5; ++f)
-    if (faces >> f & 1u) {
-      ++stats_.face_triangles;
-      raster_face<M>(f, local, rec, draw);
-    }
+  return draw;
 }
 
 template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], const draw_record& rec,
-                                      std::uint32_t draw) {
+void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
+                                      const frame& basis, const scene::triangle& tri,
+                                      const radiance_texture* texture) {
   const int n = n_;
   const int rows = face == 0 ? n : n / 2;
   const float near = near_;
@@ -502,6 +511,7 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], con
     const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
     const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
     if (x_begin > x_end || y_begin > y_end) continue;
+    if (draw == 0) draw = commit_record(rec, basis, tri, texture);
 
     // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
     // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and

@@ -188,7 +188,10 @@ class hemicube_rasterizer {
   void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis,
                      const radiance_texture* texture);
   template <mode M>
-  void raster_face(int face, const glm::vec3 (&local)[3], const draw_record& rec, std::uint32_t draw);
+  void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
+                   const scene::triangle& tri, const radiance_texture* texture);
+  std::uint32_t commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
+                              const radiance_texture* texture);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
