@@ -48,9 +48,11 @@
 // Threads: the scene is shared and immutable; a hemicube_rasterizer owns its scratch memory and is
 // used by one thread at a time. N threads = N rasterizers, no locks.
 //
-// SIMD: the depth test of a span runs four texels at a time with SSE2 (always available on
-// x86-64); raster_options::simd = false selects the scalar reference path, which gives
-// bit-identical results (tested). Other targets use the scalar path.
+// SIMD (SSE2, always available on x86-64): triangles up to 32 texels across are rasterized four
+// texels at a time with 32-bit edge functions relative to their bounding box (coverage mask and
+// depth test in the same registers); the depth test of longer spans, and the resolve, also run
+// four texels at a time. raster_options::simd = false selects the scalar reference path, which
+// gives bit-identical buffers (tested). Other targets use the scalar path.
 #pragma once
 
 #include "hemilight/geometry.hpp"
@@ -111,8 +113,9 @@ struct raster_statistics {
   std::size_t triangles_tested = 0;    ///< triangles moved to the local frame and tested per face
   std::size_t face_triangles = 0;      ///< (triangle, face) pairs sent to clipping and rasterization
   std::size_t clipped = 0;             ///< of those, how many needed clipping
-  std::size_t spans = 0;               ///< row spans written (each a depth-tested run of texels)
-  std::size_t fragments = 0;           ///< texels depth-tested (or counted), summed over spans
+  std::size_t spans = 0;               ///< row spans written by the span paths (not by the SSE2
+                                       ///< small-triangle path, which has no spans)
+  std::size_t fragments = 0;           ///< texels depth-tested (or counted) by the span paths
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
