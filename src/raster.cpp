@@ -386,6 +386,51 @@ std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexce
   return draws_[ids_[texel]].index;  // the resolve set unwritten texels to record 0
 }
 
+unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
+                                                               const glm::vec3& position, const frame& basis) const {
+  // A node far away compared with its size may fall between texel centres on every face it
+  // touches: then none of its triangles can cover a centre. Bound the node by its bounding
+  // sphere (centre c, radius R, local frame); on a face where it lies in front of the near plane,
+  // u = c.p / a.p over the sphere is bounded by the corners of (c.c +- R) / (a.c -+ R) (a ratio
+  // over a box with positive denominators takes its extremes at the corners). The margin (1/50
+  // texel) exceeds the rasterizer's snapping (1/512 texel) and the float error of this test, so
+  // the culling never changes a rendered texel.
+  const glm::vec3 c = basis.to_local(0.5f * (node.lo + node.hi) - position);
+  const float radius = 0.5f * glm::length(node.hi - node.lo);
+  const float n = static_cast<float>(n_);
+  const float margin = 0.02f;
+  for (int f = 0; f < 5; ++f) {
+    if (!(mask >> f & 1u)) continue;
+    const clip_vertex cc = to_clip(f, c);
+    // Only nodes that span a few texels at most (and are in front of the near plane).
+    if (!(cc.w - radius >= near_) || radius * n > 4.0f * cc.w) continue;
+    const float inv_near = 1.0f / (cc.w - radius), inv_far = 1.0f / (cc.w + radius);
+    const float u0 = std::min((cc.u - radius) * inv_near, (cc.u - radius) * inv_far);
+    const float u1 = std::max((cc.u + radius) * inv_near, (cc.u + radius) * inv_far);
+    const float v0 = std::min((cc.v - radius) * inv_near, (cc.v - radius) * inv_far);
+    const float v1 = std::max((cc.v + radius) * inv_near, (cc.v + radius) * inv_far);
+    // Texel coordinates; centres at k + 1/2. Relative float error of the bounds is ~1e-6.
+    const float half = 0.5f * n, v_offset = f == 0 ? 1.0f : 0.0f;
+    const float x0 = (u0 + 1.0f) * half, x1 = (u1 + 1.0f) * half;
+    const float y0 = (v0 + v_offset) * half, y1 = (v1 + v_offset) * half;
+    const float m = margin + 1e-5f * (std::fabs(x0) + std::fabs(x1) + std::fabs(y0) + std::fabs(y1));
+    // Is there an integer k in the face with x0 - m <= k + 1/2 <= x1 + m? The range is a few
+    // texels wide; clamped to the face (a little beyond it), floor is a truncation of a positive
+    // value (no libm call).
+    const float rows = f == 0 ? n : half;
+    const auto has_centre = [](float lo, float hi, float count) {
+      // Integers K = k + 2 in [a, b] with K in [2, count + 1]; a, b shifted to be >= 1.
+      const float a = std::max(lo - 0.5f, -1.0f) + 2.0f, b = std::min(hi - 0.5f, count) + 2.0f;
+      if (!(b >= 2.0f) || !(a <= b)) return false;  // also false for NaN
+      const int floor_b = static_cast<int>(b);      // truncation = floor (b > 0)
+      const int ceil_a = static_cast<int>(a) + (static_cast<float>(static_cast<int>(a)) < a ? 1 : 0);
+      return std::max(ceil_a, 2) <= std::min(floor_b, static_cast<int>(count) + 1);
+    };
+    if (!has_centre(x0 - m, x1 + m, n) || !has_centre(y0 - m, y1 + m, rows)) mask &= ~(1u << f);
+  }
+  return mask;
+}
+
 template <hemicube_rasterizer::mode M>
 void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
@@ -403,7 +448,8 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
     stack_.pop_back();
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
-    const unsigned mask = parent_mask & node_faces(node, position, basis);
+    unsigned mask = parent_mask & node_faces(node, position, basis);
+    if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis);
     if (!mask) continue;
     if (node.count == 0) {
       stack_.push_back(node.first + 1);

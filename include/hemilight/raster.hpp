@@ -6,8 +6,11 @@
 //
 // Pipeline (per hemicube, all in the point's local frame, normal = +z):
 //   1. Culling: the scene's BVH is traversed once; a node is dropped when it lies entirely below
-//      the tangent plane (z <= 0) or outside all five face frusta, and each surviving node keeps
-//      the mask of faces it can touch. Each triangle is moved to the local frame once.
+//      the tangent plane (z <= 0), outside all five face frusta, or (small, far nodes) between
+//      the texel centres of every face it touches; each surviving node keeps the mask of faces
+//      it can touch. Each triangle is moved to the local frame once. The culling is
+//      conservative: it never changes a rendered texel. There is no occlusion culling: the cost
+//      follows the triangles above the tangent plane that are not too small to matter at N.
 //   2. Visibility, per face: homogeneous clipping against the near plane w >= near (w is the
 //      distance along the face's forward axis) and a guard band |u|, |v| <= 1000 w; projection;
 //      snapping to fixed point with 8 sub-texel bits; 64-bit integer edge functions with a
@@ -185,6 +188,8 @@ class hemicube_rasterizer {
   enum class mode { depth, count };
   void check_arguments(const char* who, const glm::vec3& position, const frame& basis, int resolution) const;
   void prepare(int resolution);
+  unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
+                                            const frame& basis) const;
   template <mode M>
   void draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture);
   template <mode M>
