@@ -4,8 +4,8 @@
 // pseudo-random surface points of its scene (area-weighted, with the surface normal, lifted by
 // 1e-4 of the scene size), one after another, the way a baker visits lightmap texels.
 //   name: raster/<scene>/N:<n>/threads:<t>
-// Multi-threaded runs hand batches of 64 hemicubes to hemilight::parallel_for (one rasterizer per
-// worker) and are timed in real time. The 1M-triangle scene uses 3 repetitions (a full run with
+// Multi-threaded runs hand batches of hemicubes (256 for the small scenes, 64 for 10k triangles,
+// 16 above) to hemilight::parallel_for (one rasterizer per worker) and are timed in real time. The 1M-triangle scene uses 3 repetitions (a full run with
 // the default 5 takes several minutes), whatever --benchmark_repetitions says.
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
@@ -100,7 +100,8 @@ void render_all_threads(benchmark::State& state, std::size_t scene_index, int n)
   const int workers = resolve_thread_count(0);
   std::vector<hemicube_rasterizer> rasterizers(static_cast<std::size_t>(workers), hemicube_rasterizer(b.built));
   std::vector<hemicube_buffer> buffers(static_cast<std::size_t>(workers));
-  const std::size_t batch = 64;
+  // Batches long enough to amortise the thread starts of parallel_for (~20 us per worker).
+  const std::size_t batch = b.built->drawable_triangle_count() < 5000 ? 256 : (b.built->drawable_triangle_count() < 50000 ? 64 : 16);
   std::size_t offset = 0;
   for (auto _ : state) {
     parallel_for(batch, 0, 1, [&](int worker, std::size_t begin, std::size_t end) {
