@@ -93,6 +93,17 @@ constexpr unsigned face_planes[5] = {
 };
 
 inline unsigned outcode(const glm::vec3& p) noexcept {
+#if HEMILIGHT_RASTER_SSE2
+  // The same twelve differences as below, four per register (x + (-y) is x - y exactly; the sign
+  // of a zero cannot change a "< 0" test), so both versions give the same bits.
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 a = _mm_add_ps(_mm_setr_ps(p.x, p.x, -p.x, -p.x), _mm_setr_ps(-p.y, p.y, -p.y, p.y));
+  const __m128 b = _mm_sub_ps(_mm_setr_ps(p.x, -p.x, p.y, -p.y), _mm_set1_ps(p.z));
+  const __m128 c = _mm_add_ps(_mm_set1_ps(p.z), _mm_setr_ps(-p.x, p.x, -p.y, p.y));
+  return static_cast<unsigned>(p.z < 0) | static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(a, zero))) << 1 |
+         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(b, zero))) << 5 |
+         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(c, zero))) << 9;
+#else
   unsigned c = 0;
   if (p.z < 0) c |= below;
   if (p.x - p.y < 0) c |= x_lt_y;
@@ -108,6 +119,7 @@ inline unsigned outcode(const glm::vec3& p) noexcept {
   if (p.z - p.y < 0) c |= z_lt_y;
   if (p.z + p.y < 0) c |= z_lt_my;
   return c;
+#endif
 }
 
 // Faces whose frustum a world-space box may touch, given the local frame. Each local linear
@@ -133,7 +145,9 @@ inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, cons
 }
 
 // floor(a / 2^sub_bits) and ceil(a / 2^sub_bits) for any sign.
-inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >= 0 ? a / sub_one : -((-a + sub_one - 1) / sub_one); }
+// (Arithmetic right shift: floor for negative values too; every supported compiler does this,
+// and C++20 requires it.)
+inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >> sub_bits; }
 inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
 
 // floor(a / m) for m > 0 and |a|, m < 2^52: a double estimate (off by at most one, both are
@@ -526,9 +540,19 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
   unsigned all_out = 31, any_out = 0;
   for (int i = 0; i < 3; ++i) {
     poly[i] = to_clip(face, local[i]);
-    unsigned code = 0;
-    for (int k = 0; k < 5; ++k)
-      if (clip_distance(k, poly[i], near) < 0.0f) code |= 1u << k;
+    // The five plane tests of clip_distance, written out (no switch in the loop).
+    const clip_vertex& c = poly[i];
+    const float gw = guard_band * c.w;
+#if HEMILIGHT_RASTER_SSE2
+    // gw + (-u) is gw - u exactly: the same bits as the scalar expressions.
+    const __m128 d = _mm_add_ps(_mm_set1_ps(gw), _mm_setr_ps(-c.u, c.u, -c.v, c.v));
+    const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) |
+                          static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps()))) << 1;
+#else
+    const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) | static_cast<unsigned>(gw - c.u < 0.0f) << 1 |
+                          static_cast<unsigned>(gw + c.u < 0.0f) << 2 | static_cast<unsigned>(gw - c.v < 0.0f) << 3 |
+                          static_cast<unsigned>(gw + c.v < 0.0f) << 4;
+#endif
     all_out &= code;
     any_out |= code;
   }

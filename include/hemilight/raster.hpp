@@ -55,7 +55,9 @@
 // texels at a time with 32-bit edge functions relative to their bounding box (coverage mask and
 // depth test in the same registers); the depth test of longer spans, and the resolve, also run
 // four texels at a time. raster_options::simd = false selects the scalar reference path, which
-// gives bit-identical buffers (tested). Other targets use the scalar path.
+// gives bit-identical buffers (tested). (The culling outcodes also use SSE2, unconditionally:
+// they are the same exact float comparisons, four per instruction.) Other targets use the
+// scalar path.
 #pragma once
 
 #include "hemilight/geometry.hpp"
