@@ -10,7 +10,8 @@ from bench_csv import load_gbench, medians
 
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 m = medians(load_gbench(f"{out}/raster.csv"))
-# name: raster/<scene>/N:<n>/threads:<t>/real_time
+# name: raster/<scene>/N:<n>/threads:<t>[/...]; items_per_second is per CPU second for one thread,
+# per wall-clock second for all threads./real_time
 series = {}
 for name, row in m.items():
     parts = name.split("/")
@@ -40,7 +41,7 @@ ax.set_xticks(ns)
 ax.set_xticklabels([str(n) for n in ns])
 ax.minorticks_off()
 ax.set_xlabel("hemicube resolution N (3 N² texels)")
-ax.set_ylabel("hemicubes per second (median)")
+ax.set_ylabel("hemicubes per second (median; 1 thread: per CPU second)")
 ax.set_title("hemicube_rasterizer::render, render only")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=6.5, ncol=2, loc="lower left")
