@@ -409,8 +409,12 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
   // over a box with positive denominators takes its extremes at the corners). The margin (1/50
   // texel) exceeds the rasterizer's snapping (1/512 texel) and the float error of this test, so
   // the culling never changes a rendered texel.
-  const glm::vec3 c = basis.to_local(0.5f * (node.lo + node.hi) - position);
-  const float radius = 0.5f * glm::length(node.hi - node.lo);
+  const glm::vec3 centre = 0.5f * (node.lo + node.hi);
+  const glm::vec3 c = basis.to_local(centre - position);
+  // Grown by the float error of moving points to the local frame (the triangles' vertices carry
+  // the same kind of error, ~1 ulp of the world coordinates): far from the origin it matters.
+  const glm::vec3 scale = glm::max(glm::abs(centre), glm::abs(position));
+  const float radius = 0.5f * glm::length(node.hi - node.lo) + 1e-6f * (scale.x + scale.y + scale.z);
   const float n = static_cast<float>(n_);
   const float margin = 0.02f;
   for (int f = 0; f < 5; ++f) {
