@@ -6,10 +6,14 @@
 //   image_io.hpp  float images and cube maps as OpenEXR
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
+//   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
+//   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
 #pragma once
 
+#include "hemilight/cache.hpp"
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
+#include "hemilight/integrate.hpp"
 #include "hemilight/parallel.hpp"
