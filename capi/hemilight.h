@@ -116,6 +116,34 @@ HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, 
 HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size,
                                                               int half_float);
 
+/* ---- scenes ------------------------------------------------------------------------------------
+ * A scene is an immutable set of triangles, each with a constant outgoing radiance (RGB), and a
+ * constant sky radiance seen where nothing is hit. It may be shared by any number of threads.
+ * Front faces wind counter-clockwise: their normal is (v1 - v0) x (v2 - v0). Triangles made here
+ * are one-sided: a hemicube texel that sees a back face gets radiance 0 and counts in
+ * backface_fraction. Zero-area triangles are accepted and never drawn. */
+typedef struct hemilight_scene hemilight_scene;
+
+/* Creates a scene, copying the arrays (the caller may free them afterwards):
+ *   positions          3 * vertex_count floats (x, y, z), finite
+ *   indices            3 * triangle_count vertex indices, each < vertex_count
+ *   triangle_radiance  3 * triangle_count floats (RGB per triangle), finite and >= 0
+ *   sky_radiance       3 floats, finite and >= 0
+ * An empty scene (vertex_count = triangle_count = 0; the arrays may then be NULL) is valid: every
+ * texel sees the sky. On success *out receives the scene; release it with hemilight_scene_release.
+ * Errors (nothing written to *out): INVALID_ARGUMENT for a NULL pointer with a nonzero count, a
+ * NULL out or sky_radiance, counts over 2^31 - 1, NaN/Inf positions, out-of-range indices,
+ * negative or non-finite radiance; the message names the argument and the index, e.g.
+ * "indices[17] = 900 is out of range: 12 vertices". OUT_OF_MEMORY if allocation fails.
+ * Cost: O(T log^2 T) for T triangles (building the culling hierarchy); ~100 bytes per triangle. */
+HEMILIGHT_API hemilight_status hemilight_scene_create(const float* positions, size_t vertex_count,
+                                                      const uint32_t* indices, size_t triangle_count,
+                                                      const float* triangle_radiance, const float sky_radiance[3],
+                                                      hemilight_scene** out);
+
+/* Releases a scene made by hemilight_scene_create. NULL is fine (does nothing). */
+HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
+
 #ifdef __cplusplus
 }
 #endif

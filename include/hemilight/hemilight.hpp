@@ -6,6 +6,9 @@
 //   image_io.hpp  float images and cube maps as OpenEXR
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
+//   scene.hpp     immutable triangle scenes with materials, lightmap UVs, sky and BVH
+//   reference_scenes.hpp  the reference scenes (Cornell box, hexagon room, ...) by name
+//   raster.hpp    the software hemicube rasterizer
 //   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
 //   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
 #pragma once
@@ -17,3 +20,6 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/integrate.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+#include "hemilight/reference_scenes.hpp"
+#include "hemilight/scene.hpp"
