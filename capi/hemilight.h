@@ -144,6 +144,74 @@ HEMILIGHT_API hemilight_status hemilight_scene_create(const float* positions, si
 /* Releases a scene made by hemilight_scene_create. NULL is fine (does nothing). */
 HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
 
+/* ---- irradiance at a point: render + integrate ------------------------------------------------ */
+
+/* What one hemicube sees, reduced. Gradients follow the irradiance-caching convention, per colour
+ * channel c:  E_c(x', n') ~= E_c + (n x n') . rotation_gradient[c] + (x' - x) . translation_gradient[c],
+ * both world-space vectors in the tangent plane (translation gradient: the great-arc wall
+ * estimator, docs/integration.md). */
+typedef struct hemilight_irradiance {
+  float irradiance[3];              /* E per channel: integral of L cos(theta) d omega (uniform sky L: pi L) */
+  float rotation_gradient[3][3];    /* [channel][xyz], world space */
+  float translation_gradient[3][3]; /* [channel][xyz], world space, per scene unit */
+  float harmonic_mean_distance;     /* split-sphere distance (scene units); +inf if nothing was hit */
+  float min_distance;               /* nearest hit (scene units); +inf if nothing was hit */
+  float backface_fraction;          /* projected-solid-angle fraction seeing back faces, [0, 1] */
+} hemilight_irradiance;
+
+/* Renders the hemicube of resolution N at `position` with normal `normal` and integrates it.
+ * The normal need not be unit length (it is normalised) but must be finite and nonzero. The point
+ * itself does not see the surface it lies on; offset it from the surface if that surface is not in
+ * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
+ * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
+ * normal, a zero normal, N odd or outside [2, 4096]. Cost: one hemicube (Cornell box, N = 64: tens
+ * of microseconds); the first call for a new N builds its weight tables (~5 ms at N = 64). */
+HEMILIGHT_API hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3],
+                                                           const float normal[3], int resolution,
+                                                           hemilight_irradiance* out);
+
+/* ---- irradiance cache ---------------------------------------------------------------------------- */
+
+/* Progress callback: called from the calling thread with the fraction of points done, [0, 1];
+ * return nonzero to go on, 0 to cancel (the call then returns HEMILIGHT_ERROR_CANCELLED and
+ * writes nothing). */
+typedef int (*hemilight_progress_fn)(void* user, float fraction);
+
+typedef struct hemilight_cache_options {
+  int resolution;         /* hemicube N, even, 2..4096 (default 64) */
+  float error_threshold;  /* Ward's a, (0, 1]: larger = fewer hemicubes, more error (default 0.2) */
+  float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
+                                   min = (median point spacing) / a, max = 0.2 x the points' extent */
+  int use_gradients;      /* 0 or 1: interpolate with rotation and translation gradients (default 1) */
+  int thread_count;       /* 0 = all cores (default 0) */
+  hemilight_progress_fn progress; /* may be NULL (default NULL) */
+  void* progress_user;    /* passed to progress */
+} hemilight_cache_options;
+
+/* Fills options with the defaults above. NULL is ignored. */
+HEMILIGHT_API void hemilight_cache_options_init(hemilight_cache_options* options);
+
+typedef struct hemilight_cache_stats {
+  size_t hemicubes;       /* hemicubes rendered */
+  size_t records;         /* cache records kept */
+  double seconds;         /* wall time */
+  size_t invalid_samples; /* hemicubes rejected because they saw > 10% back faces (inside geometry) */
+} hemilight_cache_stats;
+
+/* Irradiance (RGB) at `count` points (positions and normals: 3 * count floats each; normals unit
+ * length within 1e-3) through the irradiance cache: hemicubes are rendered at few points, the
+ * rest is interpolated (docs and include/hemilight/cache.hpp). The result is deterministic: the
+ * same input gives bitwise the same output for any thread_count. Points inside geometry (their
+ * hemicube sees mostly back faces) are filled from valid records around them.
+ * irradiance_rgb receives 3 * count floats; stats may be NULL.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL scene/positions/normals/options/output,
+ * count 0, NaN/Inf positions, non-unit normals, options out of range (the message names the
+ * field); CANCELLED when the progress callback returned 0. */
+HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions,
+                                                          const float* normals, size_t count,
+                                                          const hemilight_cache_options* options,
+                                                          float* irradiance_rgb, hemilight_cache_stats* stats);
+
 #ifdef __cplusplus
 }
 #endif

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstring>
+#include <memory>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -496,6 +498,37 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   result.records = std::move(records);
   result.stats = stats;
   return result;
+}
+
+irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
+  if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");
+  if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
+  struct context {
+    hemicube_rasterizer raster;
+    hemicube_integrator integrator;
+    hemicube_buffer buffer;
+  };
+  auto contexts = std::make_shared<std::vector<std::unique_ptr<context>>>();
+  for (int w = 0; w < workers; ++w)
+    contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
+                                                          hemicube_integrator(o.resolution, o.integrate), {}}));
+  return [contexts, o](int worker, const glm::vec3& x, const glm::vec3& n) {
+    if (worker < 0 || std::size_t(worker) >= contexts->size())
+      throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
+    context& c = *(*contexts)[std::size_t(worker)];
+    frame f = make_frame(n);
+    if (o.roll) {
+      std::uint32_t bits[3];
+      std::memcpy(bits, &x, sizeof bits);
+      const std::uint64_t h = mix((std::uint64_t(bits[0]) << 32 | bits[1]) ^ mix(bits[2]));
+      const float angle = float(h >> 40) * (6.2831853f / float(1u << 24));
+      const glm::vec3 t = std::cos(angle) * f.t + std::sin(angle) * f.b;
+      f.b = glm::cross(f.n, t);
+      f.t = t;
+    }
+    c.raster.render(x, f, o.resolution, c.buffer, o.texture);
+    return c.integrator.integrate(c.buffer);
+  };
 }
 
 }  // namespace hemilight

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "hemilight/integrate.hpp"
+#include "hemilight/raster.hpp"
 
 #include <array>
 #include <cstdint>
@@ -90,6 +91,24 @@ struct cache_stats {
 /// [0, thread count): use it to pick a per-thread rasterizer/integrator. Must be deterministic
 /// in its arguments (apart from worker) and thread-safe across different workers.
 using irradiance_sampler = std::function<irradiance_sample(int worker, const glm::vec3& position, const glm::vec3& normal)>;
+
+/// How make_hemicube_sampler renders and integrates.
+struct hemicube_sampler_options {
+  int resolution = 64;            ///< hemicube N (even, 2..4096)
+  raster_options raster;          ///< near plane etc.
+  integrate_options integrate;    ///< estimator etc. (the defaults are the cache's)
+  /// Turn each hemicube about its normal by an angle hashed from the position's bits:
+  /// deterministic, and it turns the texel grid's aliasing into fine noise instead of bands.
+  bool roll = true;
+  const radiance_texture* texture = nullptr;  ///< optional radiance texture (bounce passes); must outlive the sampler
+};
+
+/// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
+/// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache). Throws
+/// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
+/// options. The sampler throws error(invalid_argument) for a worker index out of range.
+irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
+                                         int workers);
 
 /// What cache_irradiance returns.
 struct cache_result {
