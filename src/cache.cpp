@@ -133,18 +133,29 @@ class record_bvh {
 };
 
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
+// `spread` (optional) receives the range (max - min) of the luminance the covering records
+// predict for the point, and `own` whether one of them sits at the point itself.
 float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
-                  const glm::vec3& n, const cache_options& o, glm::vec3& out) {
+                  const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
+                  bool* own = nullptr) {
   glm::vec3 sum(0.0f);
-  float wsum = 0.0f;
+  float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  bool at_record = false;
   bvh.query(x, [&](std::uint32_t i) {
     const cache_record& r = records[i];
     const float w = record_weight(r, x, n, o);
     if (w <= 0.0f || record_is_behind(r, x, n)) return;
-    sum += w * extrapolate(r, x, n, o.use_gradients);
+    const glm::vec3 e = extrapolate(r, x, n, o.use_gradients);
+    sum += w * e;
     wsum += w;
+    const float l = luminance(e);
+    lo = std::min(lo, l);
+    hi = std::max(hi, l);
+    at_record = at_record || r.position == x;
   });
   out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+  if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
+  if (own) *own = at_record;
   return wsum;
 }
 
@@ -297,16 +308,29 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   cache_stats stats;
   float spacing = a * o.max_radius;
   const float finest = a * o.min_radius;
-  // Invalid samples: position and exclusion radius (half their min distance).
+  // Invalid samples: position and exclusion radius (0.9 x their min distance).
   std::vector<std::pair<glm::vec3, float>> invalid_balls;
 
   for (;;) {
-    // 1. Coverage of every open point (parallel, read-only on the records).
+    // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
+    // when a record's weight passes the threshold and, with refine_disagreement, the covering
+    // records agree on it: their predictions span at most a x max(E, floor) (luminance).
+    float floor_e = 0.0f;
+    if (!records.empty()) {
+      double mean = 0.0;
+      for (const cache_record& r : records) mean += luminance(r.irradiance);
+      floor_e = 0.05f * float(mean / double(records.size()));
+    }
     parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         if (inside[i]) continue;
-        glm::vec3 tmp;
-        covered[i] = interpolate(records, bvh, positions[i], normals[i], o, tmp) > 0.0f ? 1 : 0;
+        glm::vec3 value;
+        float spread = 0.0f;
+        bool own = false;
+        const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own);
+        bool ok = w > 0.0f;
+        if (ok && o.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e);
+        covered[i] = ok ? 1 : 0;
       }
     });
     std::size_t open = 0;
@@ -368,7 +392,9 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       if (s.backface_fraction > o.invalid_backface_fraction) {
         ++stats.invalid_samples;
         inside[i] = 1;
-        const float ball = std::isfinite(s.min_distance) ? 0.5f * s.min_distance : 0.0f;
+        // Nothing lies nearer than min_distance in the visible half-space: points within most
+        // of that distance are inside the same closed region.
+        const float ball = std::isfinite(s.min_distance) ? 0.9f * s.min_distance : 0.0f;
         invalid_balls.emplace_back(positions[i], ball);
         continue;
       }

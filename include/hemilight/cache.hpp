@@ -19,8 +19,9 @@
 // It runs in rounds. Each round finds the points no record covers, picks among them, in a fixed
 // pseudo-random order, seeds at least `spacing` apart (spacing halves every round, from
 // a x max_radius down to a x min_radius), renders the seeds' hemicubes in parallel, and appends
-// the new records in seed order. Samples that see more than invalid_backface_fraction back faces
-// (the point is inside geometry) never become records; their points, and points within half the
+// the new records in seed order. A point counts as covered when a record's weight passes 1/a
+// and (refine_disagreement) the covering records' predictions agree within a. Samples that see more than invalid_backface_fraction back faces
+// (the point is inside geometry) never become records; their points, and points within 0.9 x the
 // invalid sample's min distance, are filled at the end from the nearest valid records.
 #pragma once
 
@@ -67,6 +68,11 @@ struct cache_options {
   bool gradient_radius_limit = true;       ///< R_i <= E_i / |g_t,i|
   bool neighbour_clamp = true;             ///< R_i <= R_j + |x_i - x_j|
   bool shrink_disagreeing = true;          ///< shrink records whose gradients disagree
+  /// A point also counts as uncovered while the records covering it disagree: their first-order
+  /// predictions at the point span more than a x max(E, 5% of the mean record E) in luminance.
+  /// This places records along shadow edges and other discontinuities the split-sphere radius
+  /// cannot see, down to min_radius.
+  bool refine_disagreement = true;
   cache_weight weight = cache_weight::ward;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
   int thread_count = 0;                    ///< 0 = all cores
