@@ -190,42 +190,17 @@ hemicube_integrator::hemicube_integrator(int resolution, const integrate_options
 
 namespace {
 
-constexpr std::size_t lanes = 8;
-
-// Sums K quantities over i in [begin, end): f(i, v) fills v[0..K). Eight independent float lanes
-// per block of at most `block` indices (the compiler vectorises them without reassociating one
-// sum), block totals added into Acc. With Acc = double the result is accurate to about the
-// float rounding of one block (a row of N texels), independent of the hemicube's size.
-template <class Inner, class Acc, std::size_t K, class F>
-void blocked_sum(std::size_t begin, std::size_t end, std::size_t block, F&& f, Acc (&totals)[K]) {
-  for (std::size_t b0 = begin; b0 < end; b0 += block) {
-    const std::size_t b1 = std::min(end, b0 + block);
-    Inner part[K][lanes] = {};
-    std::size_t i = b0;
-    for (; i + lanes <= b1; i += lanes)
-      for (std::size_t l = 0; l < lanes; ++l) {
-        Inner v[K];
-        f(i + l, v);
-        for (std::size_t k = 0; k < K; ++k) part[k][l] += v[k];
-      }
-    for (; i < b1; ++i) {
-      Inner v[K];
-      f(i, v);
-      for (std::size_t k = 0; k < K; ++k) part[k][0] += v[k];
-    }
-    for (std::size_t k = 0; k < K; ++k) {
-      Inner sum = 0;
-      for (std::size_t l = 0; l < lanes; ++l) sum += part[k][l];
-      totals[k] += Acc(sum);
-    }
-  }
-}
+// Every sum below runs over blocks of at most `block` texels; inside a block it is one SIMD
+// reduction in Inner ("#pragma omp simd reduction" lets the compiler split it into vector lanes;
+// built with -fopenmp-simd, no OpenMP runtime), and block totals are added in double. With
+// Inner = float each result is accurate to about the float rounding of one block, whatever N.
+constexpr std::size_t block = 1024;
 
 }  // namespace
 
 template <class Acc>
 irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
-  // Inner sums in Acc's precision when double was asked for, else float lanes per row.
+  // Sums inside a block in Acc's precision (float, or double when asked for).
   using Inner = Acc;
   const integration_table& t = *table_;
   const std::size_t count = hemicube_texel_count(n_);
@@ -240,42 +215,42 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   const float* vx = t.vx.data();
   const float* vy = t.vy.data();
   const float* vz = t.vz.data();
-  // Float lanes sum at most `block` terms before their totals go into double: relative error
-  // <= (block / lanes) x 6e-8 per sum, independent of the resolution.
-  const std::size_t block = 1024;
-
-  // Planar copies of the radiance (scalar: stride-3 loads) and 1/distance (0 for misses).
+  // Planar copies of the radiance (stride-3 loads) and 1/distance (0 for misses).
   for (std::size_t i = 0; i < count; ++i) {
     r[i] = rad[3 * i];
     g[i] = rad[3 * i + 1];
     b[i] = rad[3 * i + 2];
   }
-  for (std::size_t i = 0; i < count; ++i) {
-    assert(dist[i] > 0.0f);
-    inv[i] = 1.0f / dist[i];
-  }
   float min_d = std::numeric_limits<float>::infinity();
-  {
-    float mn[lanes];
-    std::fill(mn, mn + lanes, min_d);
-    std::size_t i = 0;
-    for (; i + lanes <= count; i += lanes)
-      for (std::size_t l = 0; l < lanes; ++l) mn[l] = dist[i + l] < mn[l] ? dist[i + l] : mn[l];
-    for (; i < count; ++i) min_d = std::min(min_d, dist[i]);
-    for (std::size_t l = 0; l < lanes; ++l) min_d = std::min(min_d, mn[l]);
+#pragma omp simd reduction(min : min_d)
+  for (std::size_t i = 0; i < count; ++i) {
+    inv[i] = 1.0f / dist[i];
+    min_d = dist[i] < min_d ? dist[i] : min_d;
   }
+  assert(min_d > 0.0f);
 
   // Pass 1: E, total projected solid angle, harmonic sum, back faces.
   double s1[6] = {};
-  blocked_sum<Inner, double, 6>(0, count, block, [&](std::size_t i, Inner* v) {
-    const Inner p = Inner(vz[i]);
-    v[0] = Inner(r[i]) * p;
-    v[1] = Inner(g[i]) * p;
-    v[2] = Inner(b[i]) * p;
-    v[3] = p;
-    v[4] = p * Inner(inv[i]);
-    v[5] = p * Inner((flags[i] >> 1) & 1u);  // texel_back_face is bit 1
-  }, s1);
+  for (std::size_t b0 = 0; b0 < count; b0 += block) {
+    const std::size_t b1 = std::min(count, b0 + block);
+    Inner e0 = 0, e1 = 0, e2 = 0, pt = 0, hs = 0, bk = 0;
+#pragma omp simd reduction(+ : e0, e1, e2, pt, hs, bk)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner p = Inner(vz[i]);
+      e0 += Inner(r[i]) * p;
+      e1 += Inner(g[i]) * p;
+      e2 += Inner(b[i]) * p;
+      pt += p;
+      hs += p * Inner(inv[i]);
+      bk += p * Inner((flags[i] >> 1) & 1u);  // texel_back_face is bit 1
+    }
+    s1[0] += double(e0);
+    s1[1] += double(e1);
+    s1[2] += double(e2);
+    s1[3] += double(pt);
+    s1[4] += double(hs);
+    s1[5] += double(bk);
+  }
   irradiance_sample out;
   out.irradiance = glm::vec3(float(s1[0]), float(s1[1]), float(s1[2]));
   const double total = s1[3], harmonic = s1[4];
@@ -286,15 +261,26 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
 
   if (options_.rotation_gradient) {
     double phi[6] = {};  // (x, y) of the vector irradiance per channel
-    blocked_sum<Inner, double, 6>(0, count, block, [&](std::size_t i, Inner* v) {
-      const Inner x = Inner(vx[i]), y = Inner(vy[i]);
-      v[0] = Inner(r[i]) * x;
-      v[1] = Inner(r[i]) * y;
-      v[2] = Inner(g[i]) * x;
-      v[3] = Inner(g[i]) * y;
-      v[4] = Inner(b[i]) * x;
-      v[5] = Inner(b[i]) * y;
-    }, phi);
+    for (std::size_t b0 = 0; b0 < count; b0 += block) {
+      const std::size_t b1 = std::min(count, b0 + block);
+      Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+      for (std::size_t i = b0; i < b1; ++i) {
+        const Inner x = Inner(vx[i]), y = Inner(vy[i]);
+        a0 += Inner(r[i]) * x;
+        a1 += Inner(r[i]) * y;
+        a2 += Inner(g[i]) * x;
+        a3 += Inner(g[i]) * y;
+        a4 += Inner(b[i]) * x;
+        a5 += Inner(b[i]) * y;
+      }
+      phi[0] += double(a0);
+      phi[1] += double(a1);
+      phi[2] += double(a2);
+      phi[3] += double(a3);
+      phi[4] += double(a4);
+      phi[5] += double(a5);
+    }
     // g_r = n x Phi; in the local frame z x (x, y, z) = (-y, x, 0).
     for (std::size_t c = 0; c < 3; ++c)
       out.rotation_gradient[c] = f.to_world(glm::vec3(-float(phi[2 * c + 1]), float(phi[2 * c]), 0.0f));
@@ -304,15 +290,26 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     const float* sx = t.simple_x.data();
     const float* sy = t.simple_y.data();
     double acc[6] = {};
-    blocked_sum<Inner, double, 6>(0, count, block, [&](std::size_t i, Inner* v) {
-      const Inner wx = Inner(sx[i]) * Inner(inv[i]), wy = Inner(sy[i]) * Inner(inv[i]);
-      v[0] = Inner(r[i]) * wx;
-      v[1] = Inner(r[i]) * wy;
-      v[2] = Inner(g[i]) * wx;
-      v[3] = Inner(g[i]) * wy;
-      v[4] = Inner(b[i]) * wx;
-      v[5] = Inner(b[i]) * wy;
-    }, acc);
+    for (std::size_t b0 = 0; b0 < count; b0 += block) {
+      const std::size_t b1 = std::min(count, b0 + block);
+      Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+      for (std::size_t i = b0; i < b1; ++i) {
+        const Inner wx = Inner(sx[i]) * Inner(inv[i]), wy = Inner(sy[i]) * Inner(inv[i]);
+        a0 += Inner(r[i]) * wx;
+        a1 += Inner(r[i]) * wy;
+        a2 += Inner(g[i]) * wx;
+        a3 += Inner(g[i]) * wy;
+        a4 += Inner(b[i]) * wx;
+        a5 += Inner(b[i]) * wy;
+      }
+      acc[0] += double(a0);
+      acc[1] += double(a1);
+      acc[2] += double(a2);
+      acc[3] += double(a3);
+      acc[4] += double(a4);
+      acc[5] += double(a5);
+    }
     for (std::size_t c = 0; c < 3; ++c)
       out.translation_gradient[c] = f.to_world(glm::vec3(float(acc[2 * c]), float(acc[2 * c + 1]), 0.0f));
   } else if (options_.translation != translation_estimator::none) {
@@ -327,18 +324,31 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     // The tables hold zero coefficients where i + step is not a neighbour (row and face ends),
     // so both passes run over one contiguous range.
     auto walls = [&](std::size_t step, const float* cx, const float* cy) {
-      blocked_sum<Inner, double, 6>(0, count - step, block, [&](std::size_t i, Inner* v) {
-        const Inner w = Inner(std::min(std::max(inv[i], inv[i + step]), cap));
-        const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
-        const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
-                    db = Inner(b[i + step]) - Inner(b[i]);
-        v[0] = dr * wx;
-        v[1] = dr * wy;
-        v[2] = dg * wx;
-        v[3] = dg * wy;
-        v[4] = db * wx;
-        v[5] = db * wy;
-      }, acc);
+      const std::size_t end = count - step;
+      for (std::size_t b0 = 0; b0 < end; b0 += block) {
+        const std::size_t b1 = std::min(end, b0 + block);
+        Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+        for (std::size_t i = b0; i < b1; ++i) {
+          const float near_inv = inv[i] > inv[i + step] ? inv[i] : inv[i + step];
+          const Inner w = Inner(near_inv < cap ? near_inv : cap);
+          const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
+          const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
+                      db = Inner(b[i + step]) - Inner(b[i]);
+          a0 += dr * wx;
+          a1 += dr * wy;
+          a2 += dg * wx;
+          a3 += dg * wy;
+          a4 += db * wx;
+          a5 += db * wy;
+        }
+        acc[0] += double(a0);
+        acc[1] += double(a1);
+        acc[2] += double(a2);
+        acc[3] += double(a3);
+        acc[4] += double(a4);
+        acc[5] += double(a5);
+      }
     };
     walls(1, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
           arc ? t.right_great_arc_y.data() : t.right_classified_y.data());
