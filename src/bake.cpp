@@ -383,8 +383,14 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   radiance_texture texture_view;
   const int tex_rings = o.dilation < 0 ? -1 : std::max(o.dilation, 2);
 
+  // The cache's fraction can step back between rounds; the bake reports the running maximum.
+  float reported = 0.0f;
+  const auto report = [&](float f) {
+    reported = std::max(reported, std::min(f, 1.0f));
+    return o.progress(reported);
+  };
   for (int pass = 0; pass < o.bounces; ++pass) {
-    if (o.progress && !o.progress(float(pass) / float(o.bounces)))
+    if (o.progress && !report(float(pass) / float(o.bounces)))
       throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
     hemicube_sampler_options so;
     so.resolution = o.resolution;
@@ -410,7 +416,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
     if (o.use_cache) {
-      if (o.progress) co.progress = [&](float f) { return o.progress(base + span * f); };
+      if (o.progress) co.progress = [&](float f) { return report(base + span * f); };
       cache_result cr = cache_irradiance(positions.data(), normals.data(), count, sampler, co);
       for (std::size_t i = 0; i < count; ++i) {
         e[i] = cr.irradiance[i];
@@ -425,7 +431,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
       std::vector<float> backface(count, 0.0f);
       const std::size_t block = 2048;
       for (std::size_t b = 0; b < count; b += block) {
-        if (o.progress && !o.progress(base + span * float(b) / float(count)))
+        if (o.progress && !report(base + span * float(b) / float(count)))
           throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
         const std::size_t end = std::min(count, b + block);
         parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
@@ -472,7 +478,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     }
     if (pass == 0 && o.indirect_only) e_first = e;
   }
-  if (o.progress && !o.progress(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+  if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
 
   r.irradiance = image::make(o.width, o.height, 3);
   r.valid.assign(texels, 0);

@@ -81,7 +81,8 @@ struct bake_options {
   /// error is measured against.
   bool use_cache = true;
   int thread_count = 0;  ///< 0 = all cores
-  /// Called from the calling thread with the fraction of the whole bake done, in [0, 1]; return
+  /// Called from the calling thread with the fraction of the whole bake done, in [0, 1] and never
+  /// decreasing; return
   /// false to cancel (error(status::cancelled) is thrown, nothing is returned). May be empty.
   std::function<bool(float fraction)> progress;
 };
