@@ -46,6 +46,13 @@ void check_input(const char* who, const bake_input& in) {
   if (d.vertex_count > 0 && !d.positions) throw_invalid_argument(std::string(who) + ": positions is null");
   if (!d.lightmap_uvs)
     throw_invalid_argument(std::string(who) + ": the scene has no lightmap UVs (scene_desc::lightmap_uvs is null)");
+  // Albedo above 1 would make the bounces diverge (scene::create only rejects negative values).
+  if (d.materials)
+    for (std::size_t i = 0; i < d.triangle_count; ++i)
+      for (int c = 0; c < 3; ++c)
+        if (!(d.materials[i].albedo[c] >= 0.0f && d.materials[i].albedo[c] <= 1.0f))
+          throw_invalid_argument(std::string(who) + ": materials[" + std::to_string(i) + "].albedo = " +
+                                 num(d.materials[i].albedo[c]) + " is outside [0, 1]");
   for (std::size_t i = 0; i < 3 * d.triangle_count; ++i)
     if (d.indices[i] >= d.vertex_count)
       throw_invalid_argument(std::string(who) + ": indices[" + std::to_string(i) + "] = " + std::to_string(d.indices[i]) +

@@ -126,7 +126,8 @@ struct bake_input {
 ///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces < 1 or > 64,
 ///     bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN, dilation < -1, cache
 ///     options out of range); no lightmap UVs; a UV outside [0, 1] ("lightmap_uvs[7].u = 1.2 is
-///     outside [0, 1]"); a triangle with nonzero 3D area but zero UV area; a non-finite normal;
+///     outside [0, 1]"); a triangle with nonzero 3D area but zero UV area; a non-finite normal; an
+///     albedo outside [0, 1];
 ///     everything scene::create rejects; no texel sampled (nothing to bake);
 ///   cancelled: the progress callback returned false.
 /// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): about
