@@ -163,6 +163,16 @@ void texel_bounds(const tri_data& t, int w, int h, int& x0, int& y0, int& x1, in
   y1 = std::clamp(int(std::ceil(maxy)) - 1, 0, h - 1);
 }
 
+// Calls f(x, y, k) for every texel of the lightmap in the bounding box of a drawn triangle.
+template <class F>
+void for_each_texel_in_bounds(const tri_data& t, int w, int h, F&& f) {
+  if (!t.drawn) return;
+  int x0, y0, x1, y1;
+  texel_bounds(t, w, h, x0, y0, x1, y1);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) f(x, y, std::size_t(y) * std::size_t(w) + std::size_t(x));
+}
+
 void check_options(const bake_options& o) {
   const char* who = "bake_lightmap";
   check_size(who, o.width, o.height);
@@ -214,25 +224,18 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
   std::vector<double> sum_area(texels, 0.0), owner_area(texels, 0.0);
   std::vector<glm::dvec2> sum_centroid(texels, glm::dvec2(0.0)), owner_centroid(texels, glm::dvec2(0.0));
   std::vector<std::uint32_t> owner(texels, none);
-  for (std::size_t i = 0; i < d.triangle_count; ++i) {
-    const tri_data& t = tris[i];
-    if (!t.drawn) continue;
-    int x0, y0, x1, y1;
-    texel_bounds(t, width, height, x0, y0, x1, y1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const clip_d c = clip_texel(t.t, x, y);
-        if (!(c.area > 0.0)) continue;
-        const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
-        sum_area[k] += c.area;
-        sum_centroid[k] += c.area * c.centroid;
-        if (c.area > owner_area[k]) {
-          owner_area[k] = c.area;
-          owner[k] = std::uint32_t(i);
-          owner_centroid[k] = c.centroid;
-        }
+  for (std::size_t i = 0; i < d.triangle_count; ++i)
+    for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
+      const clip_d c = clip_texel(tris[i].t, x, y);
+      if (!(c.area > 0.0)) return;
+      sum_area[k] += c.area;
+      sum_centroid[k] += c.area * c.centroid;
+      if (c.area > owner_area[k]) {
+        owner_area[k] = c.area;
+        owner[k] = std::uint32_t(i);
+        owner_centroid[k] = c.centroid;
       }
-  }
+    });
   std::vector<glm::dvec2> centroid(texels);
   for (std::size_t k = 0; k < texels; ++k)
     centroid[k] = sum_area[k] > 0.0 ? sum_centroid[k] / sum_area[k] : glm::dvec2(0.0);
@@ -242,25 +245,18 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
   const double eps = 1e-9;
   std::vector<std::uint32_t> through(texels, none);
   std::vector<double> through_area(texels, 0.0);
-  for (std::size_t i = 0; i < d.triangle_count; ++i) {
-    const tri_data& t = tris[i];
-    if (!t.drawn) continue;
-    int x0, y0, x1, y1;
-    texel_bounds(t, width, height, x0, y0, x1, y1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
-        if (owner[k] == none || through[k] == owner[k]) continue;
-        double b1, b2;
-        if (!barycentric(t.t, centroid[k], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) continue;
-        const clip_d c = clip_texel(t.t, x, y);
-        if (!(c.area > 0.0)) continue;
-        if (std::uint32_t(i) == owner[k] || through[k] == none || c.area > through_area[k]) {
-          through[k] = std::uint32_t(i);
-          through_area[k] = c.area;
-        }
+  for (std::size_t i = 0; i < d.triangle_count; ++i)
+    for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
+      if (owner[k] == none || through[k] == owner[k]) return;
+      double b1, b2;
+      if (!barycentric(tris[i].t, centroid[k], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) return;
+      const clip_d c = clip_texel(tris[i].t, x, y);
+      if (!(c.area > 0.0)) return;
+      if (std::uint32_t(i) == owner[k] || through[k] == none || c.area > through_area[k]) {
+        through[k] = std::uint32_t(i);
+        through_area[k] = c.area;
       }
-  }
+    });
 
   lightmap_samples s;
   s.width = width;
