@@ -257,8 +257,9 @@ TEST_CASE("White furnace: bounces converge along the geometric series and indire
           for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(r.irradiance.pixels[3 * k + std::size_t(c)] - expected));
       INFO("bounces " << bounces << (indirect ? " indirect only" : " full") << ": worst |E - closed form| " << worst);
       // The room is closed and uniform: every hemicube texel sees the same radiance, so only the
-      // float sums of the weights (pi to ~1e-6) and the texture's float values differ: 1e-4 pi.
-      CHECK(worst < 1e-4 * pi);
+      // float sums of the weights (pi to ~1e-6 relative) and float rounding of the texture
+      // values remain (measured < 1e-6): 1e-5 pi.
+      CHECK(worst < 1e-5 * pi);
     }
   }
 }
@@ -349,13 +350,16 @@ TEST_CASE("Cancelling from the progress callback throws cancelled in any pass", 
 
 TEST_CASE("Reference mode renders a hemicube per sampled texel and agrees with the cache", "[bake]") {
   small_cornell c;
-  const scene_mesh& m = c.mesh;
+  scene_mesh m64 = cornell_box();  // 64 x 64: dense enough for the cache to interpolate
+  generate_lightmap_uvs(m64, 64, 2);
   bake_options o = c.options;
+  o.width = o.height = 64;
   o.bounces = 1;
-  const bake_result cached = bake_lightmap(input_of(m), o);
+  const bake_result cached = bake_lightmap(input_of(m64), o);
   o.use_cache = false;
-  const bake_result ref = bake_lightmap(input_of(m), o);
+  const bake_result ref = bake_lightmap(input_of(m64), o);
   CHECK(ref.stats.hemicubes == ref.stats.sampled_texels);
+  CHECK(cached.stats.hemicubes < cached.stats.sampled_texels);
   double num = 0, den = 0;
   for (std::size_t k = 0; k < ref.sampled.size(); ++k)
     if (ref.sampled[k] && ref.valid[k] && cached.valid[k])
@@ -365,7 +369,8 @@ TEST_CASE("Reference mode renders a hemicube per sampled texel and agrees with t
         den += double(ref.irradiance.pixels[i]) * ref.irradiance.pixels[i];
       }
   INFO("relative RMS difference " << std::sqrt(num / den));
-  // a = 0.2 (default): the cache's interpolation error is of that order per texel; RMS well below.
+  // a = 0.2 (default): the cache interpolates within about a per texel; the RMS over the map is
+  // lower (measured 0.077 at N = 16, whose hemicubes are themselves noisy from texel to texel).
   CHECK(std::sqrt(num / den) < 0.1);
 }
 
