@@ -212,6 +212,78 @@ HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene*
                                                           const hemilight_cache_options* options,
                                                           float* irradiance_rgb, hemilight_cache_stats* stats);
 
+/* ---- lightmap baker -------------------------------------------------------------------------------- */
+
+/* Per-triangle material of a baked mesh. */
+typedef struct hemilight_bake_material {
+  float emission[3]; /* emitted radiance (RGB), each >= 0 and finite */
+  float albedo[3];   /* diffuse reflectance (RGB), each in [0, 1] */
+  int two_sided;     /* 0: seen from behind a triangle occludes but is black; 1: both sides look like the front */
+} hemilight_bake_material;
+
+/* One mesh of the scene to bake. All meshes share one lightmap (one UV space). Front faces wind
+ * counter-clockwise (normal (v1 - v0) x (v2 - v0)). */
+typedef struct hemilight_bake_mesh {
+  const float* positions;    /* 3 * vertex_count floats, finite */
+  const float* normals;      /* 3 * vertex_count floats (shading normals, any length > 0), or NULL: face normals */
+  const float* lightmap_uvs; /* 2 * vertex_count floats (u, v), each in [0, 1] */
+  size_t vertex_count;
+  const uint32_t* indices;   /* 3 * triangle_count vertex indices of this mesh (< vertex_count) */
+  size_t triangle_count;
+  const hemilight_bake_material* materials; /* triangle_count materials, or NULL: `material` for every triangle */
+  hemilight_bake_material material;
+} hemilight_bake_mesh;
+
+/* Bake options; fill with hemilight_bake_options_init, then change what you need. */
+typedef struct hemilight_bake_options {
+  int width, height;       /* lightmap size in texels, each 1..8192 (default 256 x 256) */
+  int resolution;          /* hemicube N, even, 2..4096 (default 64) */
+  int bounces;             /* 1 = direct light only, up to 64 (default 1) */
+  int indirect_only;       /* 0 or 1: store everything but the first bounce (default 0) */
+  float error_threshold;   /* irradiance cache's Ward a, (0, 1] (default 0.2) */
+  float min_coverage;      /* texels covered less than this fraction get no sample, [0, 1] (default 0.01) */
+  int dilation;            /* rings of dilation around charts, >= 0, or -1 to fill every texel (default 16) */
+  int use_cache;           /* 1: irradiance cache; 0: a hemicube at every texel (reference, slow) (default 1) */
+  int thread_count;        /* 0 = all cores (default 0) */
+  float sky_radiance[3];   /* constant radiance seen where nothing is hit, each >= 0 (default 0) */
+  hemilight_progress_fn progress; /* fraction of the whole bake, never decreasing; 0 cancels (default NULL) */
+  void* progress_user;
+} hemilight_bake_options;
+
+/* Fills options with the defaults above. NULL is ignored. */
+HEMILIGHT_API void hemilight_bake_options_init(hemilight_bake_options* options);
+
+typedef struct hemilight_bake_stats {
+  size_t sampled_texels;     /* texels that got a sample (coverage >= min_coverage) */
+  size_t invalid_texels;     /* sampled texels inside geometry, filled from valid neighbours */
+  size_t dilated_texels;     /* empty texels filled by dilation */
+  size_t overlapping_texels; /* texels covered by overlapping UV triangles (over 1.001 texel in total) */
+  size_t hemicubes;          /* hemicubes rendered, all bounces */
+  size_t records;            /* irradiance cache records, all bounces */
+  double seconds;            /* wall time */
+} hemilight_bake_stats;
+
+/* Bakes the irradiance lightmap (RGB float E = integral of L cos(theta) d omega) of the meshes:
+ * exact UV coverage per texel, a sample at the centroid of the covered part offset along the
+ * normal, hemicubes through the irradiance cache, `bounces` passes, dilation around the charts
+ * (include/hemilight/bake.hpp and docs/bake.md). Texel (x, y) is at irradiance_rgb[3 (y width + x)],
+ * its centre at uv ((x + 0.5) / width, (y + 0.5) / height): v grows with the row. Deterministic:
+ * the same input gives bitwise the same output for any thread_count.
+ * irradiance_rgb: at least 3 width height floats (irradiance_capacity, in floats).
+ * valid: NULL, or at least width height bytes (valid_capacity): 1 where the texel was sampled
+ *   and its samples were valid (not inside geometry), 0 for dilated or invalid texels.
+ * stats may be NULL. Write the result with hemilight_exr_save_rgb.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
+ * NULL options/irradiance_rgb, capacities too small, options out of range (the message names the
+ * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs outside [0, 1],
+ * indices out of range, a triangle with 3D area but zero UV area, invalid materials, no texel
+ * covered; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
+ * Cost: see hemilight_cache_irradiance, once per bounce. */
+HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
+                                                       const hemilight_bake_options* options, float* irradiance_rgb,
+                                                       size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
+                                                       hemilight_bake_stats* stats);
+
 #ifdef __cplusplus
 }
 #endif

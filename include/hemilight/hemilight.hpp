@@ -11,8 +11,10 @@
 //   raster.hpp    the software hemicube rasterizer
 //   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
 //   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
+//   bake.hpp      the lightmap baker: UV coverage, samples, bounces, dilation
 #pragma once
 
+#include "hemilight/bake.hpp"
 #include "hemilight/cache.hpp"
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
