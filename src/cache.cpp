@@ -289,8 +289,12 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   if (o.max_radius == 0.0f) o.max_radius = 0.2f * diagonal;
   o.max_radius = std::max(o.max_radius, o.min_radius);
 
+  // Coverage can drop between rounds (radii shrink), so the reported fraction is the running
+  // maximum: progress never goes backwards.
+  float reported = 0.0f;
   auto report = [&](float fraction) {
-    if (o.progress && !o.progress(fraction)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
+    reported = std::max(reported, fraction);
+    if (o.progress && !o.progress(reported)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
   };
 
   std::vector<cache_record> records;
@@ -376,9 +380,10 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         samples[k] = sampler(worker, positions[seeds[k]], normals[seeds[k]]);
         const std::size_t finished = ++done;
         // Worker 0 is the calling thread: the only one that calls progress.
-        if (worker == 0 && o.progress &&
-            !o.progress(covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f))
-          cancel = true;
+        if (worker == 0 && o.progress) {
+          reported = std::max(reported, covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f);
+          if (!o.progress(reported)) cancel = true;
+        }
       }
     });
     if (cancel) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");

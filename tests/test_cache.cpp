@@ -196,9 +196,12 @@ TEST_CASE("cache: cancellation throws and returns nothing", "[cache]") {
   std::vector<glm::vec3> p, n;
   floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.1f, p, n);
   int calls = 0;
+  float last = 0.0f;
   cache_options o;
   o.progress = [&](float f) {
     CHECK((f >= 0.0f && f <= 1.0f));
+    CHECK(f >= last);  // never goes backwards
+    last = f;
     return ++calls < 3;
   };
   bool cancelled = false;
