@@ -8,10 +8,6 @@
 #include <string>
 #include <vector>
 
-struct hemilight_scene {
-  std::shared_ptr<const hemilight::scene> scene;
-};
-
 namespace {
 
 using hemilight::capi::all_finite;
