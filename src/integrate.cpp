@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <type_traits>
 
 namespace hemilight {
 
@@ -196,26 +197,44 @@ namespace {
 // Inner = float each result is accurate to about the float rounding of one block, whatever N.
 constexpr std::size_t block = 1024;
 
-}  // namespace
+// Sum over the walls between texel i and i + step of (L_b - L_a) * coefficient * 1 / r_wall, per
+// channel and coefficient component, into acc[6]. Hot loop of the integrator.
+template <class Inner>
+inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const float* g, const float* b, const float* inv,
+                                                          const float* cx, const float* cy, std::size_t step,
+                                                          std::size_t end, float cap, double* acc) {
+  for (std::size_t b0 = 0; b0 < end; b0 += block) {
+    const std::size_t b1 = std::min(end, b0 + block);
+    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const float near_inv = inv[i] > inv[i + step] ? inv[i] : inv[i + step];
+      const Inner w = Inner(near_inv < cap ? near_inv : cap);
+      const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
+      const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
+                  db = Inner(b[i + step]) - Inner(b[i]);
+      a0 += dr * wx;
+      a1 += dr * wy;
+      a2 += dg * wx;
+      a3 += dg * wy;
+      a4 += db * wx;
+      a5 += db * wy;
+    }
+    acc[0] += double(a0);
+    acc[1] += double(a1);
+    acc[2] += double(a2);
+    acc[3] += double(a3);
+    acc[4] += double(a4);
+    acc[5] += double(a5);
+  }
+}
 
-template <class Acc>
-irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
-  // Sums inside a block in Acc's precision (float, or double when asked for).
-  using Inner = Acc;
-  const integration_table& t = *table_;
-  const std::size_t count = hemicube_texel_count(n_);
-  const std::size_t row = static_cast<std::size_t>(n_);
-  const float* rad = buffer.radiance.data();
-  const float* dist = buffer.distance.data();
-  const std::uint8_t* flags = buffer.flags.data();
-  float* r = r_.data();
-  float* g = g_.data();
-  float* b = b_.data();
-  float* inv = inv_r_.data();
-  const float* vx = t.vx.data();
-  const float* vy = t.vy.data();
-  const float* vz = t.vz.data();
-  // Planar copies of the radiance (stride-3 loads) and 1/distance (0 for misses).
+// Deinterleaves the radiance, inverts the distances, and sums pass 1 (E per channel, total
+// projected solid angle, harmonic sum, back faces) into s1[6]; returns the min distance.
+template <class Inner>
+inline __attribute__((always_inline)) float texel_sums_impl(const float* rad, const float* dist, const std::uint8_t* flags,
+                                                            const float* vz, float* r, float* g, float* b, float* inv,
+                                                            std::size_t count, double* s1) {
   for (std::size_t i = 0; i < count; ++i) {
     r[i] = rad[3 * i];
     g[i] = rad[3 * i + 1];
@@ -227,10 +246,6 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     inv[i] = 1.0f / dist[i];
     min_d = dist[i] < min_d ? dist[i] : min_d;
   }
-  assert(min_d > 0.0f);
-
-  // Pass 1: E, total projected solid angle, harmonic sum, back faces.
-  double s1[6] = {};
   for (std::size_t b0 = 0; b0 < count; b0 += block) {
     const std::size_t b1 = std::min(count, b0 + block);
     Inner e0 = 0, e1 = 0, e2 = 0, pt = 0, hs = 0, bk = 0;
@@ -251,6 +266,90 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     s1[4] += double(hs);
     s1[5] += double(bk);
   }
+  return min_d;
+}
+
+// Sums L_i (x, y) of the texels' vector solid angles per channel into phi[6] (for g_r).
+template <class Inner>
+inline __attribute__((always_inline)) void vector_sums_impl(const float* r, const float* g, const float* b, const float* vx,
+                                                            const float* vy, std::size_t count, double* phi) {
+  for (std::size_t b0 = 0; b0 < count; b0 += block) {
+    const std::size_t b1 = std::min(count, b0 + block);
+    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner x = Inner(vx[i]), y = Inner(vy[i]);
+      a0 += Inner(r[i]) * x;
+      a1 += Inner(r[i]) * y;
+      a2 += Inner(g[i]) * x;
+      a3 += Inner(g[i]) * y;
+      a4 += Inner(b[i]) * x;
+      a5 += Inner(b[i]) * y;
+    }
+    phi[0] += double(a0);
+    phi[1] += double(a1);
+    phi[2] += double(a2);
+    phi[3] += double(a3);
+    phi[4] += double(a4);
+    phi[5] += double(a5);
+  }
+}
+
+// The float kernel is compiled twice where the compiler can dispatch at load time (GCC/Clang on
+// x86-64 Linux: an AVX2 clone and the portable SSE2 default, picked by the CPU); the two give the
+// same sums up to the order of float additions inside a block.
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void wall_sums_float(const float* r, const float* g, const float* b, const float* inv, const float* cx, const float* cy,
+                     std::size_t step, std::size_t end, float cap, double* acc) {
+  wall_sums_impl<float>(r, g, b, inv, cx, cy, step, end, cap, acc);
+}
+
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void vector_sums_float(const float* r, const float* g, const float* b, const float* vx, const float* vy, std::size_t count,
+                       double* phi) {
+  vector_sums_impl<float>(r, g, b, vx, vy, count, phi);
+}
+
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+float texel_sums_float(const float* rad, const float* dist, const std::uint8_t* flags, const float* vz, float* r, float* g,
+                       float* b, float* inv, std::size_t count, double* s1) {
+  return texel_sums_impl<float>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+}
+
+}  // namespace
+
+template <class Acc>
+irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
+  // Sums inside a block in Acc's precision (float, or double when asked for).
+  using Inner = Acc;
+  const integration_table& t = *table_;
+  const std::size_t count = hemicube_texel_count(n_);
+  const std::size_t row = static_cast<std::size_t>(n_);
+  const float* rad = buffer.radiance.data();
+  const float* dist = buffer.distance.data();
+  const std::uint8_t* flags = buffer.flags.data();
+  float* r = r_.data();
+  float* g = g_.data();
+  float* b = b_.data();
+  float* inv = inv_r_.data();
+  const float* vx = t.vx.data();
+  const float* vy = t.vy.data();
+  const float* vz = t.vz.data();
+  // Planar copies of the radiance and 1/distance (0 for misses), min distance, and pass 1:
+  // E, total projected solid angle, harmonic sum, back faces.
+  double s1[6] = {};
+  float min_d;
+  if constexpr (std::is_same<Inner, float>::value)
+    min_d = texel_sums_float(rad, dist, flags, vz, r, g, b, inv, count, s1);
+  else
+    min_d = texel_sums_impl<Inner>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+  assert(min_d > 0.0f);
   irradiance_sample out;
   out.irradiance = glm::vec3(float(s1[0]), float(s1[1]), float(s1[2]));
   const double total = s1[3], harmonic = s1[4];
@@ -261,26 +360,10 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
 
   if (options_.rotation_gradient) {
     double phi[6] = {};  // (x, y) of the vector irradiance per channel
-    for (std::size_t b0 = 0; b0 < count; b0 += block) {
-      const std::size_t b1 = std::min(count, b0 + block);
-      Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
-#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
-      for (std::size_t i = b0; i < b1; ++i) {
-        const Inner x = Inner(vx[i]), y = Inner(vy[i]);
-        a0 += Inner(r[i]) * x;
-        a1 += Inner(r[i]) * y;
-        a2 += Inner(g[i]) * x;
-        a3 += Inner(g[i]) * y;
-        a4 += Inner(b[i]) * x;
-        a5 += Inner(b[i]) * y;
-      }
-      phi[0] += double(a0);
-      phi[1] += double(a1);
-      phi[2] += double(a2);
-      phi[3] += double(a3);
-      phi[4] += double(a4);
-      phi[5] += double(a5);
-    }
+    if constexpr (std::is_same<Inner, float>::value)
+      vector_sums_float(r, g, b, vx, vy, count, phi);
+    else
+      vector_sums_impl<Inner>(r, g, b, vx, vy, count, phi);
     // g_r = n x Phi; in the local frame z x (x, y, z) = (-y, x, 0).
     for (std::size_t c = 0; c < 3; ++c)
       out.rotation_gradient[c] = f.to_world(glm::vec3(-float(phi[2 * c + 1]), float(phi[2 * c]), 0.0f));
@@ -324,31 +407,10 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     // The tables hold zero coefficients where i + step is not a neighbour (row and face ends),
     // so both passes run over one contiguous range.
     auto walls = [&](std::size_t step, const float* cx, const float* cy) {
-      const std::size_t end = count - step;
-      for (std::size_t b0 = 0; b0 < end; b0 += block) {
-        const std::size_t b1 = std::min(end, b0 + block);
-        Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
-#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
-        for (std::size_t i = b0; i < b1; ++i) {
-          const float near_inv = inv[i] > inv[i + step] ? inv[i] : inv[i + step];
-          const Inner w = Inner(near_inv < cap ? near_inv : cap);
-          const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
-          const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
-                      db = Inner(b[i + step]) - Inner(b[i]);
-          a0 += dr * wx;
-          a1 += dr * wy;
-          a2 += dg * wx;
-          a3 += dg * wy;
-          a4 += db * wx;
-          a5 += db * wy;
-        }
-        acc[0] += double(a0);
-        acc[1] += double(a1);
-        acc[2] += double(a2);
-        acc[3] += double(a3);
-        acc[4] += double(a4);
-        acc[5] += double(a5);
-      }
+      if constexpr (std::is_same<Inner, float>::value)
+        wall_sums_float(r, g, b, inv, cx, cy, step, count - step, cap, acc);
+      else
+        wall_sums_impl<Inner>(r, g, b, inv, cx, cy, step, count - step, cap, acc);
     };
     walls(1, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
           arc ? t.right_great_arc_y.data() : t.right_classified_y.data());
