@@ -11,7 +11,7 @@ case "$mode" in main|test) ;; *) echo "usage: bash .ci/build.sh main|test" >&2; 
 
 # Debian packages the build, tests, examples and benchmarks need (DESIGN.md: no vendored copies).
 packages=(cmake g++ make pkg-config libglm-dev catch2 libopenexr-dev libbenchmark-dev python3-matplotlib
-          glslang-tools)
+          glslang-tools libassimp-dev libpng-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -31,8 +31,7 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHEMILIGHT_WERROR="${HEMILIGH
 cmake --build "$build" -j "$jobs"
 
 if [ "$mode" = main ]; then
-  mkdir -p out
-  "$build/examples/hemicube_weights" out/hemicube_weights.exr 64
+  "$build/examples/hemilight_bake" --out out
 else
   ctest --test-dir "$build" --output-on-failure -j "$jobs"
 fi

@@ -5,12 +5,20 @@
 #include "hemilight.h"
 
 #include "hemilight/error.hpp"
+#include "hemilight/scene.hpp"
+
+#include <memory>
 
 #include <cmath>
 #include <cstring>
 #include <exception>
 #include <new>
 #include <string>
+
+/// The opaque scene handle of the C ABI: a shared, immutable C++ scene.
+struct hemilight_scene {
+  std::shared_ptr<const hemilight::scene> scene;
+};
 
 namespace hemilight::capi {
 

@@ -116,6 +116,173 @@ HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, 
 HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size,
                                                               int half_float);
 
+/* ---- scenes ------------------------------------------------------------------------------------
+ * A scene is an immutable set of triangles, each with a constant outgoing radiance (RGB), and a
+ * constant sky radiance seen where nothing is hit. It may be shared by any number of threads.
+ * Front faces wind counter-clockwise: their normal is (v1 - v0) x (v2 - v0). Triangles made here
+ * are one-sided: a hemicube texel that sees a back face gets radiance 0 and counts in
+ * backface_fraction. Zero-area triangles are accepted and never drawn. */
+typedef struct hemilight_scene hemilight_scene;
+
+/* Creates a scene, copying the arrays (the caller may free them afterwards):
+ *   positions          3 * vertex_count floats (x, y, z), finite
+ *   indices            3 * triangle_count vertex indices, each < vertex_count
+ *   triangle_radiance  3 * triangle_count floats (RGB per triangle), finite and >= 0
+ *   sky_radiance       3 floats, finite and >= 0
+ * An empty scene (vertex_count = triangle_count = 0; the arrays may then be NULL) is valid: every
+ * texel sees the sky. On success *out receives the scene; release it with hemilight_scene_release.
+ * Errors (nothing written to *out): INVALID_ARGUMENT for a NULL pointer with a nonzero count, a
+ * NULL out or sky_radiance, counts over 2^31 - 1, NaN/Inf positions, out-of-range indices,
+ * negative or non-finite radiance; the message names the argument and the index, e.g.
+ * "indices[17] = 900 is out of range: 12 vertices". OUT_OF_MEMORY if allocation fails.
+ * Cost: O(T log^2 T) for T triangles (building the culling hierarchy); ~100 bytes per triangle. */
+HEMILIGHT_API hemilight_status hemilight_scene_create(const float* positions, size_t vertex_count,
+                                                      const uint32_t* indices, size_t triangle_count,
+                                                      const float* triangle_radiance, const float sky_radiance[3],
+                                                      hemilight_scene** out);
+
+/* Releases a scene made by hemilight_scene_create. NULL is fine (does nothing). */
+HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
+
+/* ---- irradiance at a point: render + integrate ------------------------------------------------ */
+
+/* What one hemicube sees, reduced. Gradients follow the irradiance-caching convention, per colour
+ * channel c:  E_c(x', n') ~= E_c + (n x n') . rotation_gradient[c] + (x' - x) . translation_gradient[c],
+ * both world-space vectors in the tangent plane (translation gradient: the great-arc wall
+ * estimator, docs/integration.md). */
+typedef struct hemilight_irradiance {
+  float irradiance[3];              /* E per channel: integral of L cos(theta) d omega (uniform sky L: pi L) */
+  float rotation_gradient[3][3];    /* [channel][xyz], world space */
+  float translation_gradient[3][3]; /* [channel][xyz], world space, per scene unit */
+  float harmonic_mean_distance;     /* split-sphere distance (scene units); +inf if nothing was hit */
+  float min_distance;               /* nearest hit (scene units); +inf if nothing was hit */
+  float backface_fraction;          /* projected-solid-angle fraction seeing back faces, [0, 1] */
+} hemilight_irradiance;
+
+/* Renders the hemicube of resolution N at `position` with normal `normal` and integrates it.
+ * The normal need not be unit length (it is normalised) but must be finite and nonzero. The point
+ * itself does not see the surface it lies on; offset it from the surface if that surface is not in
+ * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
+ * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
+ * normal, a zero normal, N odd or outside [2, 4096]. Cost: one hemicube (Cornell box, N = 64: tens
+ * of microseconds); the first call for a new N builds its weight tables (~5 ms at N = 64). */
+HEMILIGHT_API hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3],
+                                                           const float normal[3], int resolution,
+                                                           hemilight_irradiance* out);
+
+/* ---- irradiance cache ---------------------------------------------------------------------------- */
+
+/* Progress callback: called from the calling thread with the fraction of points done, [0, 1];
+ * return nonzero to go on, 0 to cancel (the call then returns HEMILIGHT_ERROR_CANCELLED and
+ * writes nothing). */
+typedef int (*hemilight_progress_fn)(void* user, float fraction);
+
+typedef struct hemilight_cache_options {
+  int resolution;         /* hemicube N, even, 2..4096 (default 64) */
+  float error_threshold;  /* Ward's a, (0, 1]: larger = fewer hemicubes, more error (default 0.2) */
+  float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
+                                   min = (median point spacing) / a, max = 0.2 x the points' extent */
+  int use_gradients;      /* 0 or 1: interpolate with rotation and translation gradients (default 1) */
+  int thread_count;       /* 0 = all cores (default 0) */
+  hemilight_progress_fn progress; /* may be NULL (default NULL) */
+  void* progress_user;    /* passed to progress */
+} hemilight_cache_options;
+
+/* Fills options with the defaults above. NULL is ignored. */
+HEMILIGHT_API void hemilight_cache_options_init(hemilight_cache_options* options);
+
+typedef struct hemilight_cache_stats {
+  size_t hemicubes;       /* hemicubes rendered */
+  size_t records;         /* cache records kept */
+  double seconds;         /* wall time */
+  size_t invalid_samples; /* hemicubes rejected because they saw > 10% back faces (inside geometry) */
+} hemilight_cache_stats;
+
+/* Irradiance (RGB) at `count` points (positions and normals: 3 * count floats each; normals unit
+ * length within 1e-3) through the irradiance cache: hemicubes are rendered at few points, the
+ * rest is interpolated (docs and include/hemilight/cache.hpp). The result is deterministic: the
+ * same input gives bitwise the same output for any thread_count. Points inside geometry (their
+ * hemicube sees mostly back faces) are filled from valid records around them.
+ * irradiance_rgb receives 3 * count floats; stats may be NULL.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL scene/positions/normals/options/output,
+ * count 0, NaN/Inf positions, non-unit normals, options out of range (the message names the
+ * field); CANCELLED when the progress callback returned 0. */
+HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions,
+                                                          const float* normals, size_t count,
+                                                          const hemilight_cache_options* options,
+                                                          float* irradiance_rgb, hemilight_cache_stats* stats);
+
+/* ---- lightmap baker -------------------------------------------------------------------------------- */
+
+/* Per-triangle material of a baked mesh. */
+typedef struct hemilight_bake_material {
+  float emission[3]; /* emitted radiance (RGB), each >= 0 and finite */
+  float albedo[3];   /* diffuse reflectance (RGB), each in [0, 1] */
+  int two_sided;     /* 0: seen from behind a triangle occludes but is black; 1: both sides look like the front */
+} hemilight_bake_material;
+
+/* One mesh of the scene to bake. All meshes share one lightmap (one UV space). Front faces wind
+ * counter-clockwise (normal (v1 - v0) x (v2 - v0)). */
+typedef struct hemilight_bake_mesh {
+  const float* positions;    /* 3 * vertex_count floats, finite */
+  const float* normals;      /* 3 * vertex_count floats (shading normals, any length > 0), or NULL: face normals */
+  const float* lightmap_uvs; /* 2 * vertex_count floats (u, v), each in [0, 1] */
+  size_t vertex_count;
+  const uint32_t* indices;   /* 3 * triangle_count vertex indices of this mesh (< vertex_count) */
+  size_t triangle_count;
+  const hemilight_bake_material* materials; /* triangle_count materials, or NULL: `material` for every triangle */
+  hemilight_bake_material material;
+} hemilight_bake_mesh;
+
+/* Bake options; fill with hemilight_bake_options_init, then change what you need. */
+typedef struct hemilight_bake_options {
+  int width, height;       /* lightmap size in texels, each 1..8192 (default 256 x 256) */
+  int resolution;          /* hemicube N, even, 2..4096 (default 64) */
+  int bounces;             /* 1 = direct light only, up to 64 (default 1) */
+  int indirect_only;       /* 0 or 1: store everything but the first bounce (default 0) */
+  float error_threshold;   /* irradiance cache's Ward a, (0, 1] (default 0.2) */
+  float min_coverage;      /* texels covered less than this fraction get no sample, [0, 1] (default 0.01) */
+  int dilation;            /* rings of dilation around charts, >= 0, or -1 to fill every texel (default 16) */
+  int use_cache;           /* 1: irradiance cache; 0: a hemicube at every texel (reference, slow) (default 1) */
+  int thread_count;        /* 0 = all cores (default 0) */
+  float sky_radiance[3];   /* constant radiance seen where nothing is hit, each >= 0 (default 0) */
+  hemilight_progress_fn progress; /* fraction of the whole bake, never decreasing; 0 cancels (default NULL) */
+  void* progress_user;
+} hemilight_bake_options;
+
+/* Fills options with the defaults above. NULL is ignored. */
+HEMILIGHT_API void hemilight_bake_options_init(hemilight_bake_options* options);
+
+typedef struct hemilight_bake_stats {
+  size_t sampled_texels;     /* texels that got a sample (coverage >= min_coverage) */
+  size_t invalid_texels;     /* sampled texels inside geometry, filled from valid neighbours */
+  size_t dilated_texels;     /* empty texels filled by dilation */
+  size_t overlapping_texels; /* texels covered by overlapping UV triangles (over 1.001 texel in total) */
+  size_t hemicubes;          /* hemicubes rendered, all bounces */
+  size_t records;            /* irradiance cache records, all bounces */
+  double seconds;            /* wall time */
+} hemilight_bake_stats;
+
+/* Bakes the irradiance lightmap (RGB float E = integral of L cos(theta) d omega) of the meshes:
+ * exact UV coverage per texel, a sample at the centroid of the covered part offset along the
+ * normal, hemicubes through the irradiance cache, `bounces` passes, dilation around the charts
+ * (include/hemilight/bake.hpp and docs/bake.md). Texel (x, y) is at irradiance_rgb[3 (y width + x)],
+ * its centre at uv ((x + 0.5) / width, (y + 0.5) / height): v grows with the row. Deterministic:
+ * the same input gives bitwise the same output for any thread_count.
+ * irradiance_rgb: at least 3 width height floats (irradiance_capacity, in floats).
+ * valid: NULL, or at least width height bytes (valid_capacity): 1 where the texel was sampled
+ *   and its samples were valid (not inside geometry), 0 for dilated or invalid texels.
+ * stats may be NULL. Write the result with hemilight_exr_save_rgb.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
+ * NULL options/irradiance_rgb, capacities too small, options out of range (the message names the
+ * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs outside [0, 1],
+ * indices out of range, a triangle with 3D area but zero UV area, invalid materials, no texel
+ * covered; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
+ * Cost: see hemilight_cache_irradiance, once per bounce. */
+HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
+                                                       const hemilight_bake_options* options, float* irradiance_rgb,
+                                                       size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
+                                                       hemilight_bake_stats* stats);
 /* ---- cube maps -----------------------------------------------------------------------------------
  * Float RGB cube maps: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), face-major, each
  * size x size texels, rows along the GL t coordinate, columns along s, RGB interleaved

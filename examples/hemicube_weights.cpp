@@ -33,17 +33,8 @@ int main(int argc, char** argv) {
     hemilight::image cross = hemilight::image::make(2 * n, 2 * n, 3, 0.0f);
     const float peak = table->projected_solid_angle()[hemilight::hemicube_texel_index(n, {hemilight::hemicube_face::top, n / 2, n / 2})];
     for (std::size_t i = 0; i < table->size(); ++i) {
-      const hemilight::hemicube_texel t = hemilight::hemicube_texel_from_index(n, i);
-      const int h = n / 2;
-      int px = 0, py = 0;  // position in the cross, py measured upwards in hemicube +y
-      switch (t.face) {
-        case hemilight::hemicube_face::top: px = h + t.x; py = h + t.y; break;
-        case hemilight::hemicube_face::pos_x: px = h + n + t.y; py = h + t.x; break;          // columns along +y
-        case hemilight::hemicube_face::neg_x: px = h - 1 - t.y; py = h + n - 1 - t.x; break;  // columns along -y
-        case hemilight::hemicube_face::pos_y: px = h + n - 1 - t.x; py = h + n + t.y; break;  // columns along -x
-        case hemilight::hemicube_face::neg_y: px = h + t.x; py = h - 1 - t.y; break;          // columns along +x
-      }
-      float* p = cross.at(px, 2 * n - 1 - py);
+      const glm::ivec2 px = hemilight::hemicube_cross_pixel(n, hemilight::hemicube_texel_from_index(n, i));
+      float* p = cross.at(px.x, px.y);
       const float w = table->projected_solid_angle()[i] / peak;
       p[0] = p[1] = p[2] = w;
     }

@@ -115,9 +115,72 @@ static void test_exr(const char* dir) {
   free(faces_back);
 }
 
+static void test_scene(void) {
+  /* A box's floor (two triangles) and one emitting triangle. */
+  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1, 0, 1, 0, 1, 1, 0, 0, 1, 1};
+  const uint32_t indices[] = {0, 2, 1, 0, 3, 2, 4, 5, 6};
+  const float radiance[] = {0, 0, 0, 0, 0, 0, 1, 2, 3};
+  const uint32_t bad_indices[] = {0, 2, 1, 0, 3, 2, 4, 5, 900};
+  const float bad_radiance[] = {0, 0, 0, 0, -1, 0, 1, 2, 3};
+  const float sky[3] = {0.5f, 0.5f, 0.5f};
+  const float bad_sky[3] = {0.5f, -1.0f, 0.5f};
+  float nan_positions[sizeof positions / sizeof positions[0]];
+  hemilight_scene* scene = NULL;
+  hemilight_scene* untouched = (hemilight_scene*)&scene; /* any non-NULL sentinel */
+  hemilight_scene* out = untouched;
+  size_t k;
+
+  CHECK(hemilight_scene_create(positions, 7, indices, 3, radiance, sky, &scene) == HEMILIGHT_OK);
+  CHECK(scene != NULL);
+  hemilight_scene_release(scene);
+  hemilight_scene_release(NULL); /* must not crash */
+
+  /* An empty scene is valid, with NULL arrays. */
+  scene = NULL;
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &scene) == HEMILIGHT_OK);
+  CHECK(scene != NULL);
+  hemilight_scene_release(scene);
+
+  /* Zero-area triangles are accepted. */
+  {
+    const uint32_t degenerate[] = {0, 0, 1};
+    scene = NULL;
+    CHECK(hemilight_scene_create(positions, 7, degenerate, 1, radiance, sky, &scene) == HEMILIGHT_OK);
+    hemilight_scene_release(scene);
+  }
+
+  /* Failures name the argument and write nothing. */
+  for (k = 0; k < sizeof positions / sizeof positions[0]; ++k) nan_positions[k] = positions[k];
+  nan_positions[4] = (float)NAN;
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, radiance, sky, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "out is NULL");
+  CHECK_FAILS(hemilight_scene_create(NULL, 7, indices, 3, radiance, sky, &out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "positions is NULL");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, NULL, 3, radiance, sky, &out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "indices is NULL");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, NULL, sky, &out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "triangle_radiance is NULL");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, radiance, NULL, &out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "sky_radiance is NULL");
+  CHECK_FAILS(hemilight_scene_create(nan_positions, 7, indices, 3, radiance, sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_scene_create: positions[1].y is nan");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, bad_indices, 3, radiance, sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "indices[8] = 900 is out of range: 7 vertices");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, bad_radiance, sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "triangle_radiance[4]");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, radiance, bad_sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "sky_radiance");
+  CHECK_FAILS(hemilight_scene_create(positions, (size_t)-1, indices, 3, radiance, sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "vertex_count");
+  CHECK_FAILS(hemilight_scene_create(positions, 7, indices, (size_t)-1 / 2, radiance, sky, &out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "triangle_count");
+  CHECK(out == untouched);
+}
+
 int main(int argc, char** argv) {
   const char* dir = argc > 1 ? argv[1] : ".";
   test_version();
+  test_scene();
   test_hemicube();
   test_exr(dir);
   printf("%d passed, %d failed\n", passed, failed);

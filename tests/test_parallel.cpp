@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -38,12 +39,33 @@ TEST_CASE("parallel_for with one worker runs on the calling thread", "[parallel]
 }
 
 TEST_CASE("parallel_for rethrows the first exception after all workers stop", "[parallel]") {
-  std::atomic<int> calls{0};
+  // Two workers: the exception comes out of parallel_for, and only after every body has
+  // returned (no worker still running). How many chunks the other worker finishes meanwhile
+  // depends on scheduling, so it is not asserted.
+  std::atomic<int> calls{0}, active{0}, after_return{0};
   CHECK_THROWS_AS(parallel_for(1000, 2, 1,
                                [&](int, std::size_t b, std::size_t) {
+                                 ++active;
                                  ++calls;
+                                 if (b == 5) {
+                                   --active;
+                                   throw std::runtime_error("boom");
+                                 }
+                                 --active;
+                               }),
+                  std::runtime_error);
+  CHECK(active == 0);
+  after_return = calls.load();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  CHECK(calls == after_return);  // no worker went on after the return
+  // One worker: chunks run in order on the calling thread, so the throw at chunk 5 stops it
+  // after exactly 6 calls.
+  int serial = 0;
+  CHECK_THROWS_AS(parallel_for(1000, 1, 1,
+                               [&](int, std::size_t b, std::size_t) {
+                                 ++serial;
                                  if (b == 5) throw std::runtime_error("boom");
                                }),
                   std::runtime_error);
-  CHECK(calls < 1000);  // handing out stopped early
+  CHECK(serial == 6);
 }

@@ -63,4 +63,33 @@ struct hemicube_buffer {
   }
 };
 
+/// Where a texel lands in the unfolded-cross picture of a hemicube: a 2N x 2N image with the top
+/// face at [N/2, 3N/2)^2 and each side face folded out next to the edge it shares with the top
+/// face (horizon towards the middle). Picture row 0 is the top of the picture and hemicube +y
+/// points up in it, +x to the right. Returns (column, row) of the picture. Precondition: N valid
+/// and t inside its face (asserted by hemicube_texel_index's checks where used). Cost: O(1).
+inline glm::ivec2 hemicube_cross_pixel(int n, hemicube_texel t) noexcept {
+  const int h = n / 2;
+  int px = 0, py = 0;  // py measured upwards (hemicube +y)
+  switch (t.face) {
+    case hemicube_face::top: px = h + t.x; py = h + t.y; break;
+    case hemicube_face::pos_x: px = h + n + t.y; py = h + t.x; break;          // columns along +y
+    case hemicube_face::neg_x: px = h - 1 - t.y; py = h + n - 1 - t.x; break;  // columns along -y
+    case hemicube_face::pos_y: px = h + n - 1 - t.x; py = h + n + t.y; break;  // columns along -x
+    case hemicube_face::neg_y: px = h + t.x; py = h - 1 - t.y; break;          // columns along +x
+  }
+  return {px, 2 * n - 1 - py};
+}
+
+/// Debug aid: writes a hemicube buffer as three 2N x 2N float EXR images laid out as the
+/// unfolded cross of hemicube_cross_pixel (the four corners, outside the cross, are 0):
+///   <path_prefix>_radiance.exr  RGB radiance;
+///   <path_prefix>_distance.exr  distance in R, G and B (misses written as 0, not +inf, so
+///                               viewers can scale the picture; the flags image shows them);
+///   <path_prefix>_flags.exr     R = 1 for texel_miss, G = 1 for texel_back_face, B = 1 on every
+///                               texel of the cross.
+/// Throws error(invalid_argument) for a buffer whose arrays do not match its resolution, and
+/// error(io) as write_exr (image_io.hpp). Cost: O(N^2) plus the file writes.
+void write_hemicube_exr(const std::string& path_prefix, const hemicube_buffer& buffer);
+
 }  // namespace hemilight

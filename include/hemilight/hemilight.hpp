@@ -6,12 +6,24 @@
 //   image_io.hpp  float images and cube maps as OpenEXR
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
+//   scene.hpp     immutable triangle scenes with materials, lightmap UVs, sky and BVH
+//   reference_scenes.hpp  the reference scenes (Cornell box, hexagon room, ...) by name
+//   raster.hpp    the software hemicube rasterizer
+//   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
+//   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
+//   bake.hpp      the lightmap baker: UV coverage, samples, bounces, dilation
 //   cubemap.hpp   environment cube maps: mappings, sampling, lookup fixup, filtering, SH
 #pragma once
 
+#include "hemilight/bake.hpp"
+#include "hemilight/cache.hpp"
 #include "hemilight/cubemap.hpp"
 #include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
+#include "hemilight/integrate.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+#include "hemilight/reference_scenes.hpp"
+#include "hemilight/scene.hpp"

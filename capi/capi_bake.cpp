@@ -1,0 +1,156 @@
+// The C ABI of the lightmap baker: meshes concatenated into one scene, bake_lightmap, outputs
+// copied into the caller's buffers only after everything succeeded.
+#include "capi_internal.hpp"
+
+#include "hemilight/bake.hpp"
+
+#include <string>
+#include <vector>
+
+namespace {
+
+using hemilight::capi::all_finite;
+using hemilight::capi::guarded;
+using hemilight::capi::invalid;
+
+hemilight::material to_material(const hemilight_bake_material& m) {
+  hemilight::material r;
+  r.emission = glm::vec3(m.emission[0], m.emission[1], m.emission[2]);
+  r.albedo = glm::vec3(m.albedo[0], m.albedo[1], m.albedo[2]);
+  r.two_sided = m.two_sided != 0;
+  return r;
+}
+
+}  // namespace
+
+extern "C" {
+
+void hemilight_bake_options_init(hemilight_bake_options* options) {
+  if (!options) return;
+  *options = hemilight_bake_options{};
+  options->width = options->height = 256;
+  options->resolution = 64;
+  options->bounces = 1;
+  options->indirect_only = 0;
+  options->error_threshold = 0.2f;
+  options->min_coverage = 0.01f;
+  options->dilation = 16;
+  options->use_cache = 1;
+  options->thread_count = 0;
+  options->progress = nullptr;
+  options->progress_user = nullptr;
+}
+
+hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
+                                         const hemilight_bake_options* options, float* irradiance_rgb,
+                                         size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
+                                         hemilight_bake_stats* stats) {
+  const char* fn = "hemilight_bake_lightmap";
+  return guarded(fn, [&] {
+    if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
+    if (mesh_count == 0) return invalid(fn, "mesh_count is 0: there is nothing to bake");
+    if (!meshes) return invalid(fn, "meshes is NULL");
+    if (!irradiance_rgb) return invalid(fn, "irradiance_rgb is NULL");
+    const hemilight_bake_options& o = *options;
+    if (o.width < 1 || o.width > hemilight::max_lightmap_size || o.height < 1 || o.height > hemilight::max_lightmap_size)
+      return invalid(fn, "options->width x height = " + std::to_string(o.width) + " x " + std::to_string(o.height) +
+                             " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
+    const size_t texels = size_t(o.width) * size_t(o.height);
+    if (irradiance_capacity < 3 * texels)
+      return invalid(fn, "irradiance_capacity " + std::to_string(irradiance_capacity) + " is below 3 x width x height = " +
+                             std::to_string(3 * texels) + " floats");
+    if (valid && valid_capacity < texels)
+      return invalid(fn, "valid_capacity " + std::to_string(valid_capacity) + " is below width x height = " + std::to_string(texels));
+    for (const char* f : {"indirect_only", "use_cache"}) {
+      const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
+      if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
+    }
+    if (!all_finite(o.sky_radiance, 3) || o.sky_radiance[0] < 0 || o.sky_radiance[1] < 0 || o.sky_radiance[2] < 0)
+      return invalid(fn, "options->sky_radiance must be finite and >= 0");
+
+    // Concatenate the meshes (indices offset by the vertices before them).
+    std::vector<glm::vec3> positions, normals;
+    std::vector<glm::vec2> uvs;
+    std::vector<std::uint32_t> indices;
+    std::vector<hemilight::material> materials;
+    bool any_normals = false;
+    size_t total_vertices = 0, total_triangles = 0;
+    for (size_t m = 0; m < mesh_count; ++m) {
+      total_vertices += meshes[m].vertex_count;
+      total_triangles += meshes[m].triangle_count;
+      if (meshes[m].normals) any_normals = true;
+      if (total_vertices > hemilight::max_scene_elements || total_triangles > hemilight::max_scene_elements)
+        return hemilight::capi::set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY,
+                                          std::string(fn) + ": more than 2^31 - 1 vertices or triangles in total");
+    }
+    for (size_t m = 0; m < mesh_count; ++m) {
+      const hemilight_bake_mesh& mesh = meshes[m];
+      const std::string name = "meshes[" + std::to_string(m) + "]";
+      if (mesh.vertex_count > 0 && (!mesh.positions || !mesh.lightmap_uvs))
+        return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
+      if (mesh.triangle_count > 0 && !mesh.indices)
+        return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
+      const auto base = std::uint32_t(positions.size());
+      for (size_t v = 0; v < mesh.vertex_count; ++v) {
+        positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
+        uvs.emplace_back(mesh.lightmap_uvs[2 * v], mesh.lightmap_uvs[2 * v + 1]);
+        if (any_normals)
+          normals.push_back(mesh.normals ? glm::vec3(mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2])
+                                         : glm::vec3(0.0f));  // zero: the baker falls back to the face normal
+      }
+      for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) {
+        if (mesh.indices[i] >= mesh.vertex_count)
+          return invalid(fn, name + ".indices[" + std::to_string(i) + "] = " + std::to_string(mesh.indices[i]) +
+                                 " is out of range: " + std::to_string(mesh.vertex_count) + " vertices");
+        indices.push_back(base + mesh.indices[i]);
+      }
+      for (size_t t = 0; t < mesh.triangle_count; ++t)
+        materials.push_back(to_material(mesh.materials ? mesh.materials[t] : mesh.material));
+    }
+    hemilight::bake_input in;
+    in.scene.positions = positions.data();
+    in.scene.vertex_count = positions.size();
+    in.scene.indices = indices.data();
+    in.scene.triangle_count = materials.size();
+    in.scene.materials = materials.data();
+    in.scene.lightmap_uvs = uvs.data();
+    in.scene.sky_radiance = glm::vec3(o.sky_radiance[0], o.sky_radiance[1], o.sky_radiance[2]);
+    in.normals = any_normals ? normals.data() : nullptr;
+    hemilight::bake_options bo;
+    bo.width = o.width;
+    bo.height = o.height;
+    bo.resolution = o.resolution;
+    bo.bounces = o.bounces;
+    bo.indirect_only = o.indirect_only == 1;
+    bo.cache.error_threshold = o.error_threshold;
+    bo.min_coverage = o.min_coverage;
+    bo.dilation = o.dilation;
+    bo.use_cache = o.use_cache == 1;
+    bo.thread_count = o.thread_count;
+    if (o.progress) {
+      const hemilight_progress_fn progress = o.progress;
+      void* user = o.progress_user;
+      bo.progress = [progress, user](float f) { return progress(user, f) != 0; };
+    }
+    hemilight::bake_result r;
+    try {
+      r = hemilight::bake_lightmap(in, bo);
+    } catch (const hemilight::error& e) {
+      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
+    }
+    std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
+    if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
+    if (stats) {
+      stats->sampled_texels = r.stats.sampled_texels;
+      stats->invalid_texels = r.stats.invalid_texels;
+      stats->dilated_texels = r.stats.dilated_texels;
+      stats->overlapping_texels = r.stats.overlapping_texels;
+      stats->hemicubes = r.stats.hemicubes;
+      stats->records = r.stats.records;
+      stats->seconds = r.stats.seconds;
+    }
+    return HEMILIGHT_OK;
+  });
+}
+
+}  // extern "C"

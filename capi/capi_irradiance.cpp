@@ -1,0 +1,139 @@
+// The C ABI's irradiance entry points: one hemicube at a point, and the irradiance cache.
+#include "capi_internal.hpp"
+
+#include "hemilight/cache.hpp"
+#include "hemilight/integrate.hpp"
+#include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace {
+
+using hemilight::capi::all_finite;
+using hemilight::capi::guarded;
+using hemilight::capi::invalid;
+
+std::string triple(const float* v) {
+  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+}  // namespace
+
+extern "C" {
+
+hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3], const float normal[3],
+                                             int resolution, hemilight_irradiance* out) {
+  const char* fn = "hemilight_sample_irradiance";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!position) return invalid(fn, "position is NULL");
+    if (!normal) return invalid(fn, "normal is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (!all_finite(position, 3)) return invalid(fn, "position " + triple(position) + " is not finite");
+    if (!all_finite(normal, 3)) return invalid(fn, "normal " + triple(normal) + " is not finite");
+    const glm::vec3 n(normal[0], normal[1], normal[2]);
+    const float len = glm::length(n);
+    if (!(len > 0.0f) || !std::isfinite(len)) return invalid(fn, "normal " + triple(normal) + " has no direction (zero length)");
+    if (!hemilight::is_valid_hemicube_resolution(resolution))
+      return invalid(fn, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
+    // The integrator (weight tables) and the buffer are kept per thread between calls; the
+    // rasterizer is made per call, so no thread keeps a released scene alive.
+    struct context {
+      std::unique_ptr<hemilight::hemicube_integrator> integrator;
+      hemilight::hemicube_buffer buffer;
+    };
+    thread_local context c;
+    if (!c.integrator || c.integrator->resolution() != resolution)
+      c.integrator = std::make_unique<hemilight::hemicube_integrator>(resolution);
+    const glm::vec3 x(position[0], position[1], position[2]);
+    hemilight::hemicube_rasterizer raster(scene->scene);
+    raster.render(x, hemilight::make_frame(n / len), resolution, c.buffer);
+    const hemilight::irradiance_sample s = c.integrator->integrate(c.buffer);
+    hemilight_irradiance r;
+    for (int ch = 0; ch < 3; ++ch) {
+      r.irradiance[ch] = s.irradiance[ch];
+      for (int k = 0; k < 3; ++k) {
+        r.rotation_gradient[ch][k] = s.rotation_gradient[std::size_t(ch)][k];
+        r.translation_gradient[ch][k] = s.translation_gradient[std::size_t(ch)][k];
+      }
+    }
+    r.harmonic_mean_distance = s.harmonic_mean_distance;
+    r.min_distance = s.min_distance;
+    r.backface_fraction = s.backface_fraction;
+    *out = r;
+    return HEMILIGHT_OK;
+  });
+}
+
+void hemilight_cache_options_init(hemilight_cache_options* options) {
+  if (!options) return;
+  options->resolution = 64;
+  options->error_threshold = 0.2f;
+  options->min_radius = 0.0f;
+  options->max_radius = 0.0f;
+  options->use_gradients = 1;
+  options->thread_count = 0;
+  options->progress = nullptr;
+  options->progress_user = nullptr;
+}
+
+hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions, const float* normals,
+                                            size_t count, const hemilight_cache_options* options, float* irradiance_rgb,
+                                            hemilight_cache_stats* stats) {
+  const char* fn = "hemilight_cache_irradiance";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!options) return invalid(fn, "options is NULL (use hemilight_cache_options_init)");
+    if (!irradiance_rgb) return invalid(fn, "irradiance_rgb is NULL");
+    if (!positions) return invalid(fn, "positions is NULL");
+    if (!normals) return invalid(fn, "normals is NULL");
+    if (count == 0) return invalid(fn, "count is 0: there are no points");
+    if (!hemilight::is_valid_hemicube_resolution(options->resolution))
+      return invalid(fn, "options->resolution " + std::to_string(options->resolution) +
+                             " is invalid: it must be even and in [2, 4096]");
+    if (options->use_gradients != 0 && options->use_gradients != 1)
+      return invalid(fn, "options->use_gradients is " + std::to_string(options->use_gradients) + "; it must be 0 or 1");
+    if (options->thread_count < 0)
+      return invalid(fn, "options->thread_count is " + std::to_string(options->thread_count) + "; it must be >= 0");
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
+    hemilight::cache_options o;
+    o.error_threshold = options->error_threshold;
+    o.min_radius = options->min_radius;
+    o.max_radius = options->max_radius;
+    o.use_gradients = options->use_gradients == 1;
+    o.thread_count = options->thread_count;
+    if (options->progress) {
+      const hemilight_progress_fn progress = options->progress;
+      void* user = options->progress_user;
+      o.progress = [progress, user](float f) { return progress(user, f) != 0; };
+    }
+    hemilight::hemicube_sampler_options so;
+    so.resolution = options->resolution;
+    const hemilight::irradiance_sampler sampler =
+        hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
+    hemilight::cache_result r;
+    try {
+      r = hemilight::cache_irradiance(reinterpret_cast<const glm::vec3*>(positions), reinterpret_cast<const glm::vec3*>(normals),
+                                      count, sampler, o);
+    } catch (const hemilight::error& e) {
+      // "cache_irradiance: normals[3] ..." -> "hemilight_cache_irradiance: normals[3] ..."
+      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
+    }
+    for (size_t i = 0; i < count; ++i)
+      for (int c = 0; c < 3; ++c) irradiance_rgb[3 * i + size_t(c)] = r.irradiance[i][c];
+    if (stats) {
+      stats->hemicubes = r.stats.hemicubes;
+      stats->records = r.stats.records;
+      stats->seconds = r.stats.seconds;
+      stats->invalid_samples = r.stats.invalid_samples;
+    }
+    return HEMILIGHT_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,75 @@
+// The C ABI's scene entry points: hemilight_scene_create / hemilight_scene_release.
+#include "capi_internal.hpp"
+
+#include "hemilight/scene.hpp"
+
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+namespace {
+
+using hemilight::capi::all_finite;
+using hemilight::capi::guarded;
+using hemilight::capi::invalid;
+
+}  // namespace
+
+extern "C" {
+
+hemilight_status hemilight_scene_create(const float* positions, size_t vertex_count, const uint32_t* indices,
+                                        size_t triangle_count, const float* triangle_radiance,
+                                        const float sky_radiance[3], hemilight_scene** out) {
+  const char* fn = "hemilight_scene_create";
+  return guarded(fn, [&] {
+    if (!out) return invalid(fn, "out is NULL");
+    if (!sky_radiance) return invalid(fn, "sky_radiance is NULL");
+    if (vertex_count > hemilight::max_scene_elements)
+      return invalid(fn, "vertex_count " + std::to_string(vertex_count) + " is over the limit of " +
+                             std::to_string(hemilight::max_scene_elements));
+    if (triangle_count > hemilight::max_scene_elements)
+      return invalid(fn, "triangle_count " + std::to_string(triangle_count) + " is over the limit of " +
+                             std::to_string(hemilight::max_scene_elements));
+    if (vertex_count > 0 && !positions) return invalid(fn, "positions is NULL but vertex_count is " + std::to_string(vertex_count));
+    if (triangle_count > 0 && !indices) return invalid(fn, "indices is NULL but triangle_count is " + std::to_string(triangle_count));
+    if (triangle_count > 0 && !triangle_radiance)
+      return invalid(fn, "triangle_radiance is NULL but triangle_count is " + std::to_string(triangle_count));
+    if (!all_finite(sky_radiance, 3) || sky_radiance[0] < 0 || sky_radiance[1] < 0 || sky_radiance[2] < 0)
+      return invalid(fn, "sky_radiance (" + std::to_string(sky_radiance[0]) + ", " + std::to_string(sky_radiance[1]) + ", " +
+                             std::to_string(sky_radiance[2]) + ") must be finite and >= 0");
+    for (size_t i = 0; i < 3 * triangle_count; ++i)
+      if (!(triangle_radiance[i] >= 0.0f) || !std::isfinite(triangle_radiance[i]))
+        return invalid(fn, "triangle_radiance[" + std::to_string(i) + "] = " + std::to_string(triangle_radiance[i]) +
+                               " (triangle " + std::to_string(i / 3) + "); radiance must be finite and >= 0");
+    // glm::vec3 is three packed floats: the caller's arrays are read in place by scene::create,
+    // which validates positions and indices with messages naming them.
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
+    std::vector<hemilight::material> materials(triangle_count);
+    for (size_t i = 0; i < triangle_count; ++i)
+      materials[i].emission = {triangle_radiance[3 * i], triangle_radiance[3 * i + 1], triangle_radiance[3 * i + 2]};
+    hemilight::scene_desc desc;
+    desc.positions = reinterpret_cast<const glm::vec3*>(positions);
+    desc.vertex_count = vertex_count;
+    desc.indices = indices;
+    desc.triangle_count = triangle_count;
+    desc.materials = materials.data();
+    desc.sky_radiance = {sky_radiance[0], sky_radiance[1], sky_radiance[2]};
+    auto handle = std::make_unique<hemilight_scene>();
+    try {
+      handle->scene = hemilight::scene::create(desc);
+    } catch (const hemilight::error& e) {
+      // Same message, under this function's name ("scene::create: indices[17] = ...").
+      std::string what = e.what();
+      const std::string prefix = "scene::create: ";
+      if (what.compare(0, prefix.size(), prefix) == 0) what.erase(0, prefix.size());
+      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string(fn) + ": " + what);
+    }
+    *out = handle.release();
+    return HEMILIGHT_OK;
+  });
+}
+
+void hemilight_scene_release(hemilight_scene* scene) { delete scene; }
+
+}  // extern "C"

@@ -1,0 +1,188 @@
+// hemilight/bake.hpp — the lightmap baker: from triangles with lightmap UVs to an irradiance
+// lightmap, through the irradiance cache, with bounces.
+//
+// Pipeline (docs/bake.md):
+//   1. Samples. Every triangle is rasterized in UV space over the W x H texel grid with exact
+//      coverage: the triangle (in texel units) is clipped against each texel square
+//      (Sutherland-Hodgman), giving the covered area and its centroid. Per texel:
+//        - coverage = the summed covered fraction of all triangles, clamped to 1;
+//        - owner = the triangle with the largest covered area (ties: lower triangle index)
+//          — the overlap rule: where triangles overlap in UV space the owner's material is the
+//          texel's material and the owner is preferred for the sample;
+//        - sample point = the area-weighted centroid of all covered parts; it is mapped to 3D
+//          through the owner if it lies inside the owner's UV triangle, else through another
+//          covering triangle that contains it (largest area first), else the owner's own centroid
+//          is used. (So a texel on the diagonal of a quad gets its centre, a texel on a chart
+//          border the centroid of the covered part: never a point outside the surface.)
+//        - normal = the triangle's interpolated vertex normal there (normalised), or its face
+//          normal when no vertex normals are given (or they interpolate to ~0).
+//      Texels with coverage < min_coverage get no sample.
+//   2. Offset. Each sample moves along its normal by
+//          max(2 x default_near_distance(scene), offset_texels x texel world size),
+//      texel world size = sqrt(3D area / UV area in texels) of the sample's triangle: the point
+//      leaves its own surface by a fraction of a texel, and always by more than the near plane.
+//   3. Irradiance. cache_irradiance() with make_hemicube_sampler() (cache.hpp), each hemicube
+//      rolled about its normal by an angle hashed from the sample position (deterministic per
+//      texel): hemicube aliasing shows as fine noise, not bands. Samples inside geometry (seeing
+//      back faces) are filled by the cache from valid neighbours in object space.
+//   4. Bounces. Pass 1 sees emission and sky. Pass k > 1 renders with a radiance texture (same
+//      size as the lightmap) holding, per texel, emission + albedo E_{k-1} / pi of the texel's
+//      owner, dilated like the lightmap. The result of pass `bounces` is the lightmap; with
+//      indirect_only it is E_bounces - E_1, clamped at 0 (everything but the first bounce).
+//   5. Dilation. Every chart grows into the empty texels around it, one ring per step (each
+//      empty texel with a filled 8-neighbour gets the mean of its filled 8-neighbours), so
+//      bilinear lookups at chart borders do not pull in black.
+//
+// UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
+// its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
+// Row 0 (v near 0) is the first row in memory and the first (top) scanline of the EXR files.
+// Upload the rows in memory order and sample with the same uv in Direct3D or OpenGL.
+//
+// Determinism: the same input gives bitwise the same lightmap for any thread count.
+#pragma once
+
+#include "hemilight/cache.hpp"
+#include "hemilight/image_io.hpp"
+#include "hemilight/scene.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace hemilight {
+
+/// Largest lightmap width or height bake_lightmap accepts. Memory is about 100 bytes per texel
+/// (8192^2: 6.7 GB), so larger maps are refused with error(invalid_argument).
+inline constexpr int max_lightmap_size = 8192;
+
+/// Options of bake_lightmap.
+struct bake_options {
+  int width = 256, height = 256;  ///< lightmap size in texels, each in [1, max_lightmap_size]
+  int resolution = 64;            ///< hemicube N (even, 2..4096)
+  /// Number of light bounces, >= 1: 1 = direct light only (emission and sky); each more bounce
+  /// is one more pass of the whole cache. At most 64.
+  int bounces = 1;
+  /// Store only the indirect part: E_bounces - E_1 (clamped at 0), for engines that add direct
+  /// light at run time. Needs bounces >= 2 to be nonzero.
+  bool indirect_only = false;
+  /// Texels whose covered fraction is below this get no sample (they are filled by dilation).
+  /// Range [0, 1]; 0 samples every texel touched by a triangle.
+  float min_coverage = 0.01f;
+  /// Sample offset along the normal in texel world sizes (see the top of this header), >= 0.
+  float offset_texels = 0.05f;
+  /// Rings of dilation around every chart, >= 0; -1 fills every empty texel of the lightmap.
+  int dilation = 16;
+  /// Cache settings (error_threshold, radii, weights, ...). Its thread_count and progress are
+  /// ignored: the fields below are used instead.
+  cache_options cache;
+  /// false: a hemicube at every sampled texel (no interpolation); the reference the cache's
+  /// error is measured against.
+  bool use_cache = true;
+  int thread_count = 0;  ///< 0 = all cores
+  /// Called from the calling thread with the fraction of the whole bake done, in [0, 1] and never
+  /// decreasing; return
+  /// false to cancel (error(status::cancelled) is thrown, nothing is returned). May be empty.
+  std::function<bool(float fraction)> progress;
+};
+
+/// Statistics of one bake.
+struct bake_stats {
+  std::size_t texels = 0;             ///< W x H
+  std::size_t covered_texels = 0;     ///< texels with coverage > 0
+  std::size_t sampled_texels = 0;     ///< texels with coverage >= min_coverage (one sample each)
+  std::size_t invalid_texels = 0;     ///< sampled texels filled by the cache (inside geometry), any pass
+  std::size_t overlapping_texels = 0; ///< texels whose covering triangles sum to more than 1.001 texel (UV overlap)
+  std::size_t dilated_texels = 0;     ///< empty texels filled by dilation
+  std::size_t hemicubes = 0;          ///< hemicubes rendered, all passes
+  std::size_t records = 0;            ///< cache records, all passes
+  std::vector<cache_stats> passes;    ///< the cache's statistics per pass
+  double coverage_seconds = 0.0;      ///< step 1
+  double seconds = 0.0;               ///< the whole bake (wall time)
+};
+
+/// What bake_lightmap returns.
+struct bake_result {
+  image irradiance;                  ///< W x H RGB irradiance E (integral of L cos theta d omega), dilated
+  std::vector<float> coverage;       ///< per texel (row-major), covered fraction in [0, 1]
+  /// Per texel: 1 if it was sampled (coverage >= min_coverage) and its sample was valid in every
+  /// pass (not inside geometry), else 0. Dilated texels are 0.
+  std::vector<std::uint8_t> valid;
+  std::vector<std::uint8_t> sampled;  ///< per texel: 1 if a sample was placed (coverage >= min_coverage)
+  bake_stats stats;
+};
+
+/// What the baker needs besides a scene_desc: optional per-vertex normals (vertex_count unit
+/// or non-unit vectors; null: face normals).
+struct bake_input {
+  scene_desc scene;                       ///< geometry, materials, sky; lightmap_uvs required
+  const glm::vec3* normals = nullptr;     ///< per-vertex shading normals, or null
+};
+
+/// Bakes the irradiance lightmap of a scene (all meshes share one lightmap UV space).
+///
+/// Errors (hemilight::error naming the problem; nothing returned):
+///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces < 1 or > 64,
+///     bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN, dilation < -1, cache
+///     options out of range); no lightmap UVs; a UV outside [0, 1] ("lightmap_uvs[7].u = 1.2 is
+///     outside [0, 1]"); a triangle with nonzero 3D area but zero UV area; a non-finite normal; an
+///     albedo outside [0, 1];
+///     everything scene::create rejects; no texel sampled (nothing to bake);
+///   cancelled: the progress callback returned false.
+/// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): about
+/// hemicubes x (20-100 us at N = 64) / threads.
+bake_result bake_lightmap(const bake_input& input, const bake_options& options);
+
+/// The samples of a lightmap (step 1 of the pipeline, before the offset), per texel, row-major.
+struct lightmap_samples {
+  int width = 0, height = 0;
+  std::vector<float> coverage;              ///< covered fraction, clamped to [0, 1]
+  /// Owner triangle (scene_desc numbering) by the overlap rule, or no_triangle if nothing covers the texel.
+  std::vector<std::uint32_t> owner;
+  /// Triangle the sample lies on (the owner or another covering triangle), or no_triangle.
+  std::vector<std::uint32_t> sample_triangle;
+  std::vector<glm::vec2> centroid;          ///< sample point in UV (not texel) units
+  std::vector<glm::vec3> position;          ///< sample point in 3D, on sample_triangle
+  std::vector<glm::vec3> normal;            ///< unit normal at the sample
+  std::vector<float> texel_world_size;      ///< sqrt(3D area / UV area in texels) of sample_triangle
+  std::size_t overlapping_texels = 0;       ///< texels whose covered areas sum to more than 1.001
+
+  static constexpr std::uint32_t no_triangle = 0xffffffffu;
+};
+
+/// Exact coverage and sample points of every texel (step 1). Validates like bake_lightmap
+/// (size, UVs, normals, zero-area UV triangles); positions and indices must be valid (as
+/// scene::create checks). Cost: O(sum over triangles of the texels in their UV bounding box).
+lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height);
+
+/// Area (in texel units, [0, 1]) and centroid (texel units) of the part of the triangle a, b, c
+/// (texel units, any winding) inside the texel square [x, x+1] x [y, y+1]. Area 0 (centroid =
+/// the texel centre) if they do not overlap. Cost: clipping against 4 half-planes.
+struct texel_clip {
+  float area = 0.0f;
+  glm::vec2 centroid{0.0f};
+};
+texel_clip clip_triangle_to_texel(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c, int x, int y) noexcept;
+
+/// Grows the filled texels of `img` into the empty ones, `rings` times (-1: until every texel
+/// is filled or nothing changes): an empty texel with at least one filled 8-neighbour gets the
+/// mean of them and becomes filled. `filled` (width x height, 0/1) is updated. Returns the number
+/// of texels filled. Throws error(invalid_argument) if filled's size is not width x height or
+/// rings < -1. Cost: O(texels x rings).
+std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings);
+
+/// Gives `mesh` lightmap UVs for the baker: planar groups of edge-connected triangles (same
+/// plane, shared edge by position) become charts, each projected onto its plane at one common
+/// texel density and packed in shelves into a size x size lightmap with `padding` empty texels
+/// between charts (and at the border). Vertices shared by several charts are duplicated, so the
+/// mesh's vertex count may grow; triangles keep their order and materials. Meant for the
+/// built-in scenes (boxes, rooms), not as a general unwrapper. Throws error(invalid_argument)
+/// for size < 8, padding < 0 or 4 padding >= size. Cost: O(T log T) plus a few packings.
+void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding = 2);
+
+/// Mask image of a bake: R = coverage, G = valid, B = 1 where a sample was placed (covered
+/// >= min_coverage), for writing with write_exr.
+image bake_mask_image(const bake_result& result);
+
+}  // namespace hemilight

@@ -1,0 +1,152 @@
+// hemilight/cache.hpp — irradiance caching: render hemicubes at few of the points where
+// irradiance is needed, interpolate the rest with gradients.
+//
+// Records (Ward 1988, Ward & Heckbert 1992): position x_i, normal n_i, irradiance E_i, gradients
+// g_r,i and g_t,i (convention of integrate.hpp), validity radius R_i. Interpolation at (x, n):
+//
+//     E(x, n) = sum_i w_i (E_i + (n_i x n) . g_r,i + (x - x_i) . g_t,i) / sum_i w_i,  clamped >= 0
+//
+// over the records with w_i > 1/a (Ward: w_i = 1 / (|x - x_i| / R_i + sqrt(1 - n . n_i))) that pass
+// the "behind" test (a record is skipped when x lies behind it: (x - x_i) . (n_i + n) / 2 < -eps).
+//
+// Radii: R_i = the hemicube's harmonic mean distance (split sphere), then, each switchable so its
+// effect can be measured: clamped to [min_radius, max_radius]; limited by the translation
+// gradient, R_i <= E_i / |g_t,i| (on luminance); neighbour clamping R_i <= R_j + |x_i - x_j|;
+// and shrinking of neighbours whose gradients disagree (each predicts the other's irradiance
+// worse than a allows), so that a record is placed between them.
+//
+// Placement is deterministic: the same input gives bitwise the same output for any thread count.
+// It runs in rounds. Each round finds the points no record covers, picks among them, in a fixed
+// pseudo-random order, seeds at least `spacing` apart (spacing halves every round, from
+// a x max_radius down to a x min_radius), renders the seeds' hemicubes in parallel, and appends
+// the new records in seed order. A point counts as covered when a record's weight passes 1/a
+// and (refine_disagreement) the covering records' predictions agree within a. Samples that see more than invalid_backface_fraction back faces
+// (the point is inside geometry) never become records; their points, and points within 0.9 x the
+// invalid sample's min distance, are filled at the end from the nearest valid records.
+#pragma once
+
+#include "hemilight/integrate.hpp"
+#include "hemilight/raster.hpp"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace hemilight {
+
+/// One cache record (all vectors world space).
+struct cache_record {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};
+  glm::vec3 irradiance{0.0f};
+  std::array<glm::vec3, 3> rotation_gradient{};
+  std::array<glm::vec3, 3> translation_gradient{};
+  float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
+  float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
+};
+
+/// Weighting of records.
+enum class cache_weight {
+  ward,                  ///< w = 1 / (d / R + sqrt(1 - n.n_i)), used where w > 1/a
+  /// w = 1 - k max(d / (R/2), sqrt(1 - n.n_i) / 0.12326) with k = 1 / (2a), used where w > 0.
+  /// k is tied to a so that both weights reach as far in space (d < a R); 0.12326 = sqrt(1 - cos 10 deg).
+  tabellion_lamorlette,
+};
+
+/// Options of the irradiance cache. Lengths are in scene units.
+struct cache_options {
+  /// Ward's a: larger means fewer records and more error. Radiance's defaults are 0.1 (rtrace),
+  /// 0.2 (rpict), 0.3 (rvu). Range (0, 1].
+  float error_threshold = 0.2f;
+  /// Smallest and largest radius. 0 = automatic: min_radius = (median spacing of the points) / a,
+  /// so that a record covers at least its neighbouring points; max_radius = 0.2 x the diagonal of
+  /// the points' bounding box (as Radiance's 0.2 S). After automatic values are derived,
+  /// max_radius is raised to min_radius if smaller.
+  float min_radius = 0.0f, max_radius = 0.0f;
+  bool use_gradients = true;               ///< interpolate with g_r and g_t
+  bool gradient_radius_limit = true;       ///< R_i <= E_i / |g_t,i|
+  bool neighbour_clamp = true;             ///< R_i <= R_j + |x_i - x_j|
+  bool shrink_disagreeing = true;          ///< shrink records whose gradients disagree
+  /// A point also counts as uncovered while the records covering it disagree: their first-order
+  /// predictions at the point span more than a x max(E, 5% of the mean record E) in luminance.
+  /// This places records along shadow edges and other discontinuities the split-sphere radius
+  /// cannot see, down to min_radius.
+  bool refine_disagreement = true;
+  cache_weight weight = cache_weight::ward;
+  float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
+  int thread_count = 0;                    ///< 0 = all cores
+  /// Called from the calling thread between rounds and during rendering with the fraction of
+  /// points covered so far, in [0, 1]; return false to cancel (error(status::cancelled) is thrown
+  /// and nothing is written). May be empty.
+  std::function<bool(float fraction)> progress;
+};
+
+/// Statistics of one cache run.
+struct cache_stats {
+  std::size_t hemicubes = 0;        ///< hemicubes rendered (records + invalid samples)
+  std::size_t records = 0;          ///< records kept
+  std::size_t invalid_samples = 0;  ///< samples rejected for seeing back faces
+  std::size_t invalid_points = 0;   ///< points filled from records around them
+  std::size_t rounds = 0;           ///< placement rounds
+  double seconds = 0.0;             ///< wall time
+  float min_radius = 0.0f, max_radius = 0.0f;  ///< the radii used (after automatic defaults)
+};
+
+/// Renders and integrates one hemicube at (position, unit normal). `worker` is in
+/// [0, thread count): use it to pick a per-thread rasterizer/integrator. Must be deterministic
+/// in its arguments (apart from worker) and thread-safe across different workers.
+using irradiance_sampler = std::function<irradiance_sample(int worker, const glm::vec3& position, const glm::vec3& normal)>;
+
+/// How make_hemicube_sampler renders and integrates.
+struct hemicube_sampler_options {
+  int resolution = 64;            ///< hemicube N (even, 2..4096)
+  raster_options raster;          ///< near plane etc.
+  integrate_options integrate;    ///< estimator etc. (the defaults are the cache's)
+  /// Turn each hemicube about its normal by an angle hashed from the position's bits:
+  /// deterministic, and it turns the texel grid's aliasing into fine noise instead of bands.
+  bool roll = true;
+  const radiance_texture* texture = nullptr;  ///< optional radiance texture (bounce passes); must outlive the sampler
+};
+
+/// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
+/// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache). Throws
+/// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
+/// options. The sampler throws error(invalid_argument) for a worker index out of range.
+irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
+                                         int workers);
+
+/// What cache_irradiance returns.
+struct cache_result {
+  std::vector<glm::vec3> irradiance;  ///< per point, RGB, >= 0
+  std::vector<std::uint8_t> valid;    ///< per point: 1 = interpolated from covering records, 0 = filled (inside geometry or uncovered)
+  std::vector<cache_record> records;
+  cache_stats stats;
+};
+
+/// Irradiance at `count` points (positions and unit normals, world space) through the cache.
+/// Throws error(invalid_argument) naming the first bad input: count == 0, NULL arrays, a NaN/Inf
+/// position, a normal whose length is not 1 within 1e-3 (zero normals included), options out of
+/// range (error_threshold not in (0, 1], negative or NaN radii, min_radius > max_radius when both
+/// are given, invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned
+/// false. Exceptions thrown by the sampler propagate unchanged. Cost: one sampler call per
+/// record and invalid sample, plus O(count x log records) for coverage and interpolation.
+cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
+                              const irradiance_sampler& sampler, const cache_options& options);
+
+/// Interpolates the cache at one point from `records` (the formula at the top of this header),
+/// brute force over all records: for tests and tools. Returns the weight sum through
+/// *weight_sum if given (0 when no record covers the point: the result is then 0).
+glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& position,
+                              const glm::vec3& normal, const cache_options& options, float* weight_sum = nullptr);
+
+/// The weight of one record at (position, normal) under options.weight and error_threshold,
+/// before the behind test: Ward's w when w > 1/a, the Tabellion-Lamorlette w when w > 0, else 0.
+/// A record at exactly the point and normal gets +inf (Ward) or 1 (T-L).
+float record_weight(const cache_record& record, const glm::vec3& position, const glm::vec3& normal,
+                    const cache_options& options);
+
+/// True when the behind test rejects the record at (position, normal).
+bool record_is_behind(const cache_record& record, const glm::vec3& position, const glm::vec3& normal);
+
+}  // namespace hemilight

@@ -1,0 +1,162 @@
+// hemilight/scene.hpp — the triangles a hemicube sees, with no more than the lighting needs.
+//
+// A scene is built once by scene::create() from a scene_desc (pointers + counts the caller owns;
+// everything is copied) and is immutable afterwards: share it between threads through
+// std::shared_ptr<const scene>, no locks needed. Everything per hemicube lives in a
+// hemicube_rasterizer (raster.hpp), one per thread.
+//
+// Triangles: positions (vec3, scene units) and uint32 indices, three per triangle. The front face
+// winds counter-clockwise: its normal is (v1 - v0) x (v2 - v0). Per triangle a material: emitted
+// radiance (RGB, >= 0), albedo (RGB, kept for the bounce passes; the rasterizer does not use it)
+// and whether it is two-sided. A one-sided triangle seen from behind still occludes, but the
+// hemicube texel gets radiance 0 and the texel_back_face flag (hemicube.hpp).
+// Optionally per-vertex lightmap UVs: then a radiance texture passed to the render call
+// (raster.hpp) replaces the triangles' emission (it holds emission + albedo E / pi of a bounce).
+// Sky: a constant radiance seen where nothing is hit.
+//
+// Zero-area triangles are accepted and never drawn (they keep their index). An empty scene is
+// valid: every texel sees the sky.
+#pragma once
+
+#include "hemilight/error.hpp"
+
+#include <glm/glm.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace hemilight {
+
+/// Per-triangle material: what the hemicube sees of a triangle and what a bounce needs.
+struct material {
+  glm::vec3 emission{0.0f};  ///< emitted radiance (W m^-2 sr^-1 or any unit), each channel >= 0
+  glm::vec3 albedo{0.0f};    ///< diffuse reflectance, each channel in [0, 1] (not used to render)
+  bool two_sided = false;    ///< seen from behind, a two-sided triangle looks like its front
+};
+
+/// Largest vertex and triangle counts scene::create accepts (2^31 - 1): indices are uint32 and
+/// the rasterizer keeps triangle numbers in 32 bits. Larger counts get error(out_of_memory).
+inline constexpr std::size_t max_scene_elements = (std::size_t(1) << 31) - 1;
+
+/// What scene::create reads (nothing is kept: the scene copies what it needs).
+struct scene_desc {
+  const glm::vec3* positions = nullptr;    ///< vertex_count positions (finite)
+  std::size_t vertex_count = 0;
+  const std::uint32_t* indices = nullptr;  ///< 3 * triangle_count vertex indices (< vertex_count)
+  std::size_t triangle_count = 0;
+  const material* materials = nullptr;     ///< triangle_count materials, or null: all black, one-sided
+  const glm::vec2* lightmap_uvs = nullptr; ///< vertex_count lightmap UVs (finite), or null: none
+  glm::vec3 sky_radiance{0.0f};            ///< radiance seen where nothing is hit, each channel >= 0
+};
+
+/// A mesh that owns its arrays, with helpers to build one; desc() views it as a scene_desc.
+/// The reference scenes (reference_scenes.hpp) and the tests build their geometry with it.
+struct scene_mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices;
+  std::vector<material> materials;       ///< one per triangle
+  std::vector<glm::vec2> lightmap_uvs;   ///< empty, or one per vertex
+  glm::vec3 sky_radiance{0.0f};
+
+  std::size_t triangle_count() const noexcept { return indices.size() / 3; }
+
+  /// A view of the arrays (valid while the mesh lives and is not modified).
+  scene_desc desc() const noexcept;
+
+  /// Appends the triangle (a, b, c) with its own three vertices; front face counter-clockwise.
+  void add_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const material& m);
+
+  /// Appends the planar quad a, b, c, d (counter-clockwise seen from its front) as the two
+  /// triangles (a, b, c) and (a, c, d), sharing vertices a and c.
+  void add_quad(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d, const material& m);
+
+  /// Appends the quad a, b, c, d split into an nu x nv grid of quads (2 nu nv triangles, shared
+  /// vertices, front face as add_quad). Grid points are bilinear in the corners and computed as
+  /// (1 - s) p + s q, so the corners and edge points are bit-identical to what another grid
+  /// with the same corners and edge divisions computes: meshes built from such grids are closed.
+  /// `flip` reverses the winding (front face on the other side) without changing any vertex.
+  /// Precondition: nu, nv >= 1.
+  void add_grid(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d, int nu, int nv,
+                const material& m, bool flip = false);
+
+  /// Appends a box (12 triangles) with corners lo and hi, faces pointing outwards (inwards when
+  /// `inward` is set: a closed room).
+  void add_box(const glm::vec3& lo, const glm::vec3& hi, const material& m, bool inward = false);
+};
+
+/// A node of the scene's bounding-volume hierarchy (binary, over triangle bounding boxes).
+struct bvh_node {
+  glm::vec3 lo, hi;     ///< bounding box of everything below
+  std::uint32_t first;  ///< leaf: first triangle (in scene::triangles() order); inner: left child (right = first + 1)
+  std::uint32_t count;  ///< leaf: number of triangles (> 0); inner: 0
+};
+
+/// An immutable, validated set of triangles with materials, an optional lightmap UV set, a sky
+/// radiance and a bounding-volume hierarchy, shared by every thread that renders hemicubes.
+class scene {
+ public:
+  /// A drawable (non-degenerate) triangle as the rasterizer reads it, in BVH order.
+  struct triangle {
+    glm::vec3 v0, v1, v2;  ///< world positions, front face counter-clockwise
+    std::uint32_t index;   ///< the triangle's number in the scene_desc
+  };
+
+  /// Validates `desc`, copies what lighting needs and builds the BVH.
+  ///
+  /// Errors (hemilight::error, the message names the argument and the index):
+  ///   invalid_argument: a null array with a nonzero count; a NaN/Inf position or UV
+  ///     ("positions[4].y is nan"); an index >= vertex_count ("indices[17] = 900 is out of range:
+  ///     12 vertices"); a negative or non-finite emission, albedo or sky radiance.
+  ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
+  /// Zero-area triangles (repeated indices, collinear or coincident positions) are accepted and
+  /// never drawn. Cost: O(T log^2 T) for T triangles (1M triangles: about a second on one core);
+  /// memory about 100 bytes per triangle.
+  static std::shared_ptr<const scene> create(const scene_desc& desc);
+
+  std::size_t vertex_count() const noexcept { return positions_.size(); }
+  /// Number of triangles in the scene_desc (drawable or not).
+  std::size_t triangle_count() const noexcept { return materials_.size(); }
+  /// Number of triangles with nonzero area (the ones the rasterizer draws).
+  std::size_t drawable_triangle_count() const noexcept { return triangles_.size(); }
+
+  const std::vector<glm::vec3>& positions() const noexcept { return positions_; }
+  const std::vector<std::uint32_t>& indices() const noexcept { return indices_; }
+  /// Material of triangle i (scene_desc numbering). Precondition: i < triangle_count().
+  const material& triangle_material(std::size_t i) const noexcept { return materials_[i]; }
+  bool has_lightmap_uvs() const noexcept { return !uvs_.empty(); }
+  /// Per-vertex lightmap UVs (empty if the scene has none).
+  const std::vector<glm::vec2>& lightmap_uvs() const noexcept { return uvs_; }
+  const glm::vec3& sky_radiance() const noexcept { return sky_; }
+
+  /// Bounding box of all vertices (lo > hi, i.e. (+inf, -inf), for a scene without vertices).
+  const glm::vec3& bounds_lo() const noexcept { return lo_; }
+  const glm::vec3& bounds_hi() const noexcept { return hi_; }
+  /// Length of the bounding box diagonal (scene units); 0 for an empty or single-point scene.
+  /// The near-plane default of the rasterizer and the cache's radius defaults derive from it.
+  float size() const noexcept { return size_; }
+
+  /// Drawable triangles in BVH order, and the BVH (node 0 is the root; empty if no triangle).
+  const std::vector<triangle>& triangles() const noexcept { return triangles_; }
+  const std::vector<bvh_node>& bvh() const noexcept { return nodes_; }
+
+  /// Largest number of triangles in a BVH leaf.
+  static constexpr std::uint32_t max_leaf_triangles = 4;
+
+ private:
+  scene() = default;
+  void build_bvh();
+
+  std::vector<glm::vec3> positions_;
+  std::vector<std::uint32_t> indices_;
+  std::vector<material> materials_;
+  std::vector<glm::vec2> uvs_;
+  glm::vec3 sky_{0.0f};
+  glm::vec3 lo_{0.0f}, hi_{0.0f};
+  float size_ = 0.0f;
+  std::vector<triangle> triangles_;
+  std::vector<bvh_node> nodes_;
+};
+
+}  // namespace hemilight

@@ -1,0 +1,520 @@
+// The lightmap baker (bake.hpp): exact UV coverage, sample placement, cache passes with bounces,
+// dilation.
+#include "hemilight/bake.hpp"
+
+#include "hemilight/geometry.hpp"
+#include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace hemilight {
+
+namespace {
+
+constexpr float pi_f = 3.14159265358979323846f;
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Twice the signed area of (a, b, c) in double.
+double cross2(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+void check_size(const char* who, int width, int height) {
+  if (width < 1 || width > max_lightmap_size || height < 1 || height > max_lightmap_size)
+    throw_invalid_argument(std::string(who) + ": lightmap size " + std::to_string(width) + " x " + std::to_string(height) +
+                           " is invalid: width and height must be in [1, " + std::to_string(max_lightmap_size) + "]");
+}
+
+// Validates what compute_lightmap_samples reads (scene::create checks the rest later).
+void check_input(const char* who, const bake_input& in) {
+  const scene_desc& d = in.scene;
+  if (d.triangle_count > 0 && !d.indices) throw_invalid_argument(std::string(who) + ": indices is null");
+  if (d.vertex_count > 0 && !d.positions) throw_invalid_argument(std::string(who) + ": positions is null");
+  if (!d.lightmap_uvs)
+    throw_invalid_argument(std::string(who) + ": the scene has no lightmap UVs (scene_desc::lightmap_uvs is null)");
+  // Albedo above 1 would make the bounces diverge (scene::create only rejects negative values).
+  if (d.materials)
+    for (std::size_t i = 0; i < d.triangle_count; ++i)
+      for (int c = 0; c < 3; ++c)
+        if (!(d.materials[i].albedo[c] >= 0.0f && d.materials[i].albedo[c] <= 1.0f))
+          throw_invalid_argument(std::string(who) + ": materials[" + std::to_string(i) + "].albedo = " +
+                                 num(d.materials[i].albedo[c]) + " is outside [0, 1]");
+  for (std::size_t i = 0; i < 3 * d.triangle_count; ++i)
+    if (d.indices[i] >= d.vertex_count)
+      throw_invalid_argument(std::string(who) + ": indices[" + std::to_string(i) + "] = " + std::to_string(d.indices[i]) +
+                             " is out of range: " + std::to_string(d.vertex_count) + " vertices");
+  for (std::size_t i = 0; i < d.vertex_count; ++i) {
+    const glm::vec2 uv = d.lightmap_uvs[i];
+    for (int c = 0; c < 2; ++c)
+      if (!(uv[c] >= 0.0f && uv[c] <= 1.0f))
+        throw_invalid_argument(std::string(who) + ": lightmap_uvs[" + std::to_string(i) + "]." + (c ? "v" : "u") + " = " +
+                               num(uv[c]) + " is outside [0, 1]");
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(d.positions[i][c]))
+        throw_invalid_argument(std::string(who) + ": positions[" + std::to_string(i) + "] is not finite");
+    if (in.normals)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(in.normals[i][c]))
+          throw_invalid_argument(std::string(who) + ": normals[" + std::to_string(i) + "] is not finite");
+  }
+}
+
+// Per-triangle data in double: UVs in texel units, 3D vertices, areas.
+struct tri_data {
+  glm::dvec2 t[3];      // texel units
+  double uv_area = 0;   // texel units, absolute
+  double area3 = 0;     // scene units^2
+  bool drawn = false;   // nonzero 3D area
+};
+
+tri_data make_tri(const scene_desc& d, std::size_t i, int w, int h) {
+  tri_data r;
+  const std::uint32_t* idx = d.indices + 3 * i;
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec2 uv = d.lightmap_uvs[idx[k]];
+    r.t[k] = glm::dvec2(double(uv.x) * w, double(uv.y) * h);
+  }
+  r.uv_area = 0.5 * std::fabs(cross2(r.t[0], r.t[1], r.t[2]));
+  const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
+  r.area3 = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+  r.drawn = r.area3 > 0.0;
+  return r;
+}
+
+// Barycentrics of q in the 2D triangle t (b1, b2 of vertices 1 and 2); false if degenerate.
+bool barycentric(const glm::dvec2 (&t)[3], const glm::dvec2& q, double& b1, double& b2) {
+  const double det = cross2(t[0], t[1], t[2]);
+  if (det == 0.0) return false;
+  b1 = cross2(t[0], q, t[2]) / det;
+  b2 = cross2(t[0], t[1], q) / det;
+  return true;
+}
+
+struct clip_d {
+  double area = 0;
+  glm::dvec2 centroid{0.0};
+};
+
+// Sutherland-Hodgman of a triangle against the texel square, area and centroid (double).
+clip_d clip_texel(const glm::dvec2 (&tri)[3], int x, int y) {
+  glm::dvec2 a[9], b[9];
+  int n = 3;
+  for (int k = 0; k < 3; ++k) a[k] = tri[k];
+  const double lo[2] = {double(x), double(y)}, hi[2] = {double(x) + 1.0, double(y) + 1.0};
+  for (int plane = 0; plane < 4 && n > 0; ++plane) {
+    const int axis = plane & 1;
+    const bool upper = plane >= 2;
+    const double bound = upper ? hi[axis] : lo[axis];
+    // Signed distance inside the half-plane (>= 0 inside).
+    const auto inside = [&](const glm::dvec2& p) { return upper ? bound - p[axis] : p[axis] - bound; };
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const glm::dvec2& p = a[i];
+      const glm::dvec2& q = a[(i + 1) % n];
+      const double dp = inside(p), dq = inside(q);
+      if (dp >= 0.0) b[m++] = p;
+      if ((dp >= 0.0) != (dq >= 0.0)) {
+        const double s = dp / (dp - dq);
+        glm::dvec2 r = p + s * (q - p);
+        r[axis] = bound;  // exactly on the boundary
+        b[m++] = r;
+      }
+    }
+    n = m;
+    std::copy(b, b + m, a);
+  }
+  clip_d r;
+  if (n < 3) return r;
+  double area2 = 0.0;
+  glm::dvec2 c(0.0);
+  const glm::dvec2 o = a[0];  // relative to the first vertex: better conditioned
+  for (int i = 1; i + 1 < n; ++i) {
+    const double w = cross2(o, a[i], a[i + 1]);
+    area2 += w;
+    c += w * (o + a[i] + a[i + 1]) / 3.0;
+  }
+  if (area2 == 0.0) return r;
+  r.area = std::fabs(area2) * 0.5;
+  r.centroid = c / area2;
+  return r;
+}
+
+// Texel bounding box of a triangle in texel units, clamped to the lightmap.
+void texel_bounds(const tri_data& t, int w, int h, int& x0, int& y0, int& x1, int& y1) {
+  const double minx = std::min({t.t[0].x, t.t[1].x, t.t[2].x}), maxx = std::max({t.t[0].x, t.t[1].x, t.t[2].x});
+  const double miny = std::min({t.t[0].y, t.t[1].y, t.t[2].y}), maxy = std::max({t.t[0].y, t.t[1].y, t.t[2].y});
+  x0 = std::clamp(int(std::floor(minx)), 0, w - 1);
+  y0 = std::clamp(int(std::floor(miny)), 0, h - 1);
+  x1 = std::clamp(int(std::ceil(maxx)) - 1, 0, w - 1);
+  y1 = std::clamp(int(std::ceil(maxy)) - 1, 0, h - 1);
+}
+
+// Calls f(x, y, k) for every texel of the lightmap in the bounding box of a drawn triangle.
+template <class F>
+void for_each_texel_in_bounds(const tri_data& t, int w, int h, F&& f) {
+  if (!t.drawn) return;
+  int x0, y0, x1, y1;
+  texel_bounds(t, w, h, x0, y0, x1, y1);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) f(x, y, std::size_t(y) * std::size_t(w) + std::size_t(x));
+}
+
+void check_options(const bake_options& o) {
+  const char* who = "bake_lightmap";
+  check_size(who, o.width, o.height);
+  if (!is_valid_hemicube_resolution(o.resolution))
+    throw_invalid_argument(std::string(who) + ": resolution " + std::to_string(o.resolution) +
+                           " is invalid: it must be even and in [2, 4096]");
+  if (o.bounces < 1 || o.bounces > 64)
+    throw_invalid_argument(std::string(who) + ": bounces " + std::to_string(o.bounces) + " is not in [1, 64]");
+  if (!(o.min_coverage >= 0.0f && o.min_coverage <= 1.0f))
+    throw_invalid_argument(std::string(who) + ": min_coverage " + num(o.min_coverage) + " is not in [0, 1]");
+  if (!(o.offset_texels >= 0.0f) || !std::isfinite(o.offset_texels))
+    throw_invalid_argument(std::string(who) + ": offset_texels " + num(o.offset_texels) + " must be finite and >= 0");
+  if (o.dilation < -1)
+    throw_invalid_argument(std::string(who) + ": dilation " + std::to_string(o.dilation) + " must be >= -1");
+  if (o.thread_count < 0)
+    throw_invalid_argument(std::string(who) + ": thread_count " + std::to_string(o.thread_count) + " must be >= 0");
+}
+
+}  // namespace
+
+texel_clip clip_triangle_to_texel(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c, int x, int y) noexcept {
+  const glm::dvec2 t[3] = {glm::dvec2(a), glm::dvec2(b), glm::dvec2(c)};
+  const clip_d r = clip_texel(t, x, y);
+  texel_clip out;
+  out.area = float(r.area);
+  out.centroid = r.area > 0.0 ? glm::vec2(r.centroid) : glm::vec2(float(x) + 0.5f, float(y) + 0.5f);
+  return out;
+}
+
+lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height) {
+  const char* who = "compute_lightmap_samples";
+  check_size(who, width, height);
+  check_input(who, input);
+  const scene_desc& d = input.scene;
+  const std::size_t texels = std::size_t(width) * std::size_t(height);
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+
+  std::vector<tri_data> tris(d.triangle_count);
+  for (std::size_t i = 0; i < d.triangle_count; ++i) {
+    tris[i] = make_tri(d, i, width, height);
+    // A triangle with 3D area but (next to) no UV area would get no texels: a broken unwrap.
+    if (tris[i].drawn && !(tris[i].uv_area > 1e-12 * double(width) * double(height)))
+      throw_invalid_argument(std::string(who) + ": triangle " + std::to_string(i) +
+                             " has zero area in lightmap UV space (but not in 3D): it would get no texels");
+  }
+
+  // Pass A: coverage sum, area-weighted centroid, owner (largest area, ties to the lower index:
+  // triangles are visited in index order and only a strictly larger area replaces the owner).
+  std::vector<double> sum_area(texels, 0.0), owner_area(texels, 0.0);
+  std::vector<glm::dvec2> sum_centroid(texels, glm::dvec2(0.0)), owner_centroid(texels, glm::dvec2(0.0));
+  std::vector<std::uint32_t> owner(texels, none);
+  for (std::size_t i = 0; i < d.triangle_count; ++i)
+    for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
+      const clip_d c = clip_texel(tris[i].t, x, y);
+      if (!(c.area > 0.0)) return;
+      sum_area[k] += c.area;
+      sum_centroid[k] += c.area * c.centroid;
+      if (c.area > owner_area[k]) {
+        owner_area[k] = c.area;
+        owner[k] = std::uint32_t(i);
+        owner_centroid[k] = c.centroid;
+      }
+    });
+  std::vector<glm::dvec2> centroid(texels);
+  for (std::size_t k = 0; k < texels; ++k)
+    centroid[k] = sum_area[k] > 0.0 ? sum_centroid[k] / sum_area[k] : glm::dvec2(0.0);
+
+  // Pass B: the triangle the combined centroid is mapped through: the owner if it contains it,
+  // else the covering triangle with the largest area that contains it (ties: lower index).
+  const double eps = 1e-9;
+  std::vector<std::uint32_t> through(texels, none);
+  std::vector<double> through_area(texels, 0.0);
+  for (std::size_t i = 0; i < d.triangle_count; ++i)
+    for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
+      if (owner[k] == none || through[k] == owner[k]) return;
+      double b1, b2;
+      if (!barycentric(tris[i].t, centroid[k], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) return;
+      const clip_d c = clip_texel(tris[i].t, x, y);
+      if (!(c.area > 0.0)) return;
+      if (std::uint32_t(i) == owner[k] || through[k] == none || c.area > through_area[k]) {
+        through[k] = std::uint32_t(i);
+        through_area[k] = c.area;
+      }
+    });
+
+  lightmap_samples s;
+  s.width = width;
+  s.height = height;
+  s.coverage.assign(texels, 0.0f);
+  s.owner = owner;
+  s.sample_triangle.assign(texels, none);
+  s.centroid.assign(texels, glm::vec2(0.0f));
+  s.position.assign(texels, glm::vec3(0.0f));
+  s.normal.assign(texels, glm::vec3(0.0f, 0.0f, 1.0f));
+  s.texel_world_size.assign(texels, 0.0f);
+  for (std::size_t k = 0; k < texels; ++k) {
+    if (owner[k] == none) continue;
+    s.coverage[k] = float(std::min(1.0, sum_area[k]));
+    if (sum_area[k] > 1.001) ++s.overlapping_texels;
+    std::uint32_t ti = through[k];
+    glm::dvec2 q = centroid[k];
+    if (ti == none) {  // the combined centroid lies on no covering triangle: the owner's own centroid
+      ti = owner[k];
+      q = owner_centroid[k];
+    }
+    const tri_data& t = tris[ti];
+    double b1 = 0, b2 = 0;
+    barycentric(t.t, q, b1, b2);
+    // Clamp to the triangle (the point is inside up to rounding).
+    b1 = std::clamp(b1, 0.0, 1.0);
+    b2 = std::clamp(b2, 0.0, 1.0 - b1);
+    const double b0 = 1.0 - b1 - b2;
+    const std::uint32_t* idx = d.indices + 3 * std::size_t(ti);
+    const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
+    const glm::dvec3 face = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    glm::dvec3 n = face;
+    if (input.normals) {
+      const glm::dvec3 ni =
+          b0 * glm::dvec3(input.normals[idx[0]]) + b1 * glm::dvec3(input.normals[idx[1]]) + b2 * glm::dvec3(input.normals[idx[2]]);
+      const double len = glm::length(ni);
+      if (len > 1e-6) n = ni / len;
+    }
+    s.sample_triangle[k] = ti;
+    s.centroid[k] = glm::vec2(float(q.x / width), float(q.y / height));
+    s.position[k] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
+    s.normal[k] = glm::vec3(n);
+    s.texel_world_size[k] = float(std::sqrt(t.area3 / t.uv_area));
+  }
+  return s;
+}
+
+std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings) {
+  const std::size_t texels = std::size_t(img.width) * std::size_t(img.height);
+  if (filled.size() != texels)
+    throw_invalid_argument("dilate: filled has " + std::to_string(filled.size()) + " entries, the image " +
+                           std::to_string(texels));
+  if (rings < -1) throw_invalid_argument("dilate: rings " + std::to_string(rings) + " must be >= -1");
+  const int w = img.width, h = img.height, ch = img.channels;
+  std::size_t total = 0;
+  std::vector<std::size_t> fresh;
+  for (int ring = 0; rings < 0 || ring < rings; ++ring) {
+    fresh.clear();
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t k = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        if (filled[k]) continue;
+        float acc[4] = {0, 0, 0, 0};
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            if (!filled[std::size_t(ny) * std::size_t(w) + std::size_t(nx)]) continue;
+            const float* p = img.at(nx, ny);
+            for (int c = 0; c < ch; ++c) acc[c] += p[c];
+            ++n;
+          }
+        if (n == 0) continue;
+        float* p = img.at(x, y);
+        for (int c = 0; c < ch; ++c) p[c] = acc[c] / float(n);
+        fresh.push_back(k);
+      }
+    if (fresh.empty()) break;
+    // Marked after the ring: a ring reads only texels filled before it (order independent).
+    for (std::size_t k : fresh) filled[k] = 1;
+    total += fresh.size();
+  }
+  return total;
+}
+
+bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_options(o);
+  check_input("bake_lightmap", input);
+  const std::shared_ptr<const scene> sc = scene::create(input.scene);
+
+  bake_result r;
+  r.stats.texels = std::size_t(o.width) * std::size_t(o.height);
+  const lightmap_samples s = compute_lightmap_samples(input, o.width, o.height);
+  r.stats.coverage_seconds = seconds_since(t0);
+  r.stats.overlapping_texels = s.overlapping_texels;
+  const std::size_t texels = r.stats.texels;
+
+  // Sampled texels, offset along their normals (bake.hpp, step 2).
+  const float min_offset = 2.0f * default_near_distance(*sc);
+  std::vector<std::size_t> texel_of;
+  std::vector<glm::vec3> positions, normals;
+  r.coverage = s.coverage;
+  r.sampled.assign(texels, 0);
+  for (std::size_t k = 0; k < texels; ++k) {
+    if (s.coverage[k] > 0.0f) ++r.stats.covered_texels;
+    if (s.sample_triangle[k] == lightmap_samples::no_triangle || !(s.coverage[k] >= o.min_coverage) || !(s.coverage[k] > 0.0f))
+      continue;
+    r.sampled[k] = 1;
+    texel_of.push_back(k);
+    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[k]);
+    positions.push_back(s.position[k] + offset * s.normal[k]);
+    normals.push_back(s.normal[k]);
+  }
+  const std::size_t count = texel_of.size();
+  r.stats.sampled_texels = count;
+  if (count == 0)
+    throw_invalid_argument("bake_lightmap: no texel is covered by a triangle (coverage >= min_coverage): nothing to bake");
+
+  const int workers = resolve_thread_count(o.thread_count);
+  cache_options co = o.cache;
+  co.thread_count = o.thread_count;
+  std::vector<glm::vec3> e(count), e_first;
+  std::vector<std::uint8_t> valid(count, 1);
+  image texture;
+  radiance_texture texture_view;
+  const int tex_rings = o.dilation < 0 ? -1 : std::max(o.dilation, 2);
+
+  // The cache's fraction can step back between rounds; the bake reports the running maximum.
+  float reported = 0.0f;
+  const auto report = [&](float f) {
+    reported = std::max(reported, std::min(f, 1.0f));
+    return o.progress(reported);
+  };
+  for (int pass = 0; pass < o.bounces; ++pass) {
+    if (o.progress && !report(float(pass) / float(o.bounces)))
+      throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+    hemicube_sampler_options so;
+    so.resolution = o.resolution;
+    so.roll = true;
+    if (pass > 0) {
+      // Radiance texture of this pass: emission + albedo E_{k-1} / pi of each texel's owner.
+      texture = image::make(o.width, o.height, 3);
+      std::vector<std::uint8_t> filled(texels, 0);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t k = texel_of[i];
+        const material& m = sc->triangle_material(s.owner[k]);
+        const glm::vec3 l = m.emission + m.albedo * e[i] / pi_f;
+        float* p = texture.pixels.data() + 3 * k;
+        p[0] = l.x;
+        p[1] = l.y;
+        p[2] = l.z;
+        filled[k] = 1;
+      }
+      dilate(texture, filled, tex_rings);
+      texture_view = radiance_texture(texture);
+      so.texture = &texture_view;
+    }
+    const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
+    const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
+    if (o.use_cache) {
+      if (o.progress) co.progress = [&](float f) { return report(base + span * f); };
+      cache_result cr = cache_irradiance(positions.data(), normals.data(), count, sampler, co);
+      for (std::size_t i = 0; i < count; ++i) {
+        e[i] = cr.irradiance[i];
+        valid[i] = std::uint8_t(valid[i] & cr.valid[i]);
+      }
+      r.stats.hemicubes += cr.stats.hemicubes;
+      r.stats.records += cr.stats.records;
+      r.stats.passes.push_back(cr.stats);
+    } else {
+      // Reference mode: a hemicube at every sample, in blocks so progress and cancel stay live.
+      const auto tp = std::chrono::steady_clock::now();
+      std::vector<float> backface(count, 0.0f);
+      const std::size_t block = 2048;
+      for (std::size_t b = 0; b < count; b += block) {
+        if (o.progress && !report(base + span * float(b) / float(count)))
+          throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+        const std::size_t end = std::min(count, b + block);
+        parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
+          for (std::size_t i = b + lo; i < b + hi; ++i) {
+            const irradiance_sample smp = sampler(worker, positions[i], normals[i]);
+            e[i] = smp.irradiance;
+            backface[i] = smp.backface_fraction;
+          }
+        });
+      }
+      // Invalid samples (inside geometry) are filled from valid texel neighbours by dilation.
+      image tmp = image::make(o.width, o.height, 3);
+      std::vector<std::uint8_t> filled(texels, 0);
+      std::size_t invalid = 0;
+      for (std::size_t i = 0; i < count; ++i) {
+        float* p = tmp.pixels.data() + 3 * texel_of[i];
+        p[0] = e[i].x;
+        p[1] = e[i].y;
+        p[2] = e[i].z;
+        if (backface[i] > co.invalid_backface_fraction) {
+          valid[i] = 0;
+          ++invalid;
+        } else {
+          filled[texel_of[i]] = 1;
+        }
+      }
+      if (invalid > 0) {
+        dilate(tmp, filled, -1);
+        for (std::size_t i = 0; i < count; ++i)
+          if (backface[i] > co.invalid_backface_fraction) {
+            const float* p = tmp.pixels.data() + 3 * texel_of[i];
+            e[i] = glm::vec3(p[0], p[1], p[2]);
+          }
+      }
+      cache_stats cs;
+      cs.hemicubes = count;
+      cs.records = count;
+      cs.invalid_samples = invalid;
+      cs.invalid_points = invalid;
+      cs.seconds = seconds_since(tp);
+      r.stats.hemicubes += count;
+      r.stats.records += count;
+      r.stats.passes.push_back(cs);
+    }
+    if (pass == 0 && o.indirect_only) e_first = e;
+  }
+  if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+
+  r.irradiance = image::make(o.width, o.height, 3);
+  r.valid.assign(texels, 0);
+  std::vector<std::uint8_t> filled(texels, 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t k = texel_of[i];
+    glm::vec3 v = e[i];
+    if (o.indirect_only) v = glm::max(v - e_first[i], glm::vec3(0.0f));
+    float* p = r.irradiance.pixels.data() + 3 * k;
+    p[0] = v.x;
+    p[1] = v.y;
+    p[2] = v.z;
+    filled[k] = 1;
+    r.valid[k] = valid[i];
+    if (!valid[i]) ++r.stats.invalid_texels;
+  }
+  r.stats.dilated_texels = dilate(r.irradiance, filled, o.dilation);
+  r.stats.seconds = seconds_since(t0);
+  return r;
+}
+
+image bake_mask_image(const bake_result& result) {
+  const image& e = result.irradiance;
+  const std::size_t texels = std::size_t(e.width) * std::size_t(e.height);
+  if (result.coverage.size() != texels || result.valid.size() != texels || result.sampled.size() != texels)
+    throw_invalid_argument("bake_mask_image: the result's per-texel arrays do not match its irradiance image");
+  image m = image::make(e.width, e.height, 3);
+  for (std::size_t k = 0; k < texels; ++k) {
+    m.pixels[3 * k] = result.coverage[k];
+    m.pixels[3 * k + 1] = float(result.valid[k]);
+    m.pixels[3 * k + 2] = float(result.sampled[k]);
+  }
+  return m;
+}
+
+}  // namespace hemilight

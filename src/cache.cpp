@@ -1,0 +1,565 @@
+// The irradiance cache: record weights, a bounding-volume hierarchy over records, deterministic
+// round-based placement, radius limits, interpolation. See cache.hpp.
+#include "hemilight/cache.hpp"
+
+#include "hemilight/parallel.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <memory>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+
+namespace hemilight {
+
+namespace {
+
+constexpr float max_weight = 1e12f;  // caps Ward's 1/0 at a record's own position and normal
+constexpr float behind_epsilon = 1e-6f;
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+std::string vec_str(const glm::vec3& v) {
+  return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+}
+
+// The largest distance at which a record can have a positive weight: a R for both weightings.
+float coverage_radius(const cache_record& r, const cache_options& o) { return o.error_threshold * r.radius; }
+
+glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3& n, bool gradients) {
+  glm::vec3 e = r.irradiance;
+  if (gradients) {
+    const glm::vec3 rot = glm::cross(r.normal, n);
+    const glm::vec3 dx = x - r.position;
+    for (int c = 0; c < 3; ++c)
+      e[c] += glm::dot(rot, r.rotation_gradient[std::size_t(c)]) + glm::dot(dx, r.translation_gradient[std::size_t(c)]);
+  }
+  return e;
+}
+
+// A bounding-volume hierarchy over the records' coverage spheres, rebuilt after every round
+// (records are only added between rounds, so queries never race with insertion). Query cost
+// O(log n + k) for k records whose box holds the point.
+class record_bvh {
+ public:
+  void build(const std::vector<cache_record>& records, const cache_options& o) {
+    records_ = &records;
+    nodes_.clear();
+    index_.resize(records.size());
+    std::iota(index_.begin(), index_.end(), 0u);
+    lo_.resize(records.size());
+    hi_.resize(records.size());
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      const float r = coverage_radius(records[i], o);
+      lo_[i] = records[i].position - glm::vec3(r);
+      hi_[i] = records[i].position + glm::vec3(r);
+    }
+    if (!records.empty()) build_node(0, static_cast<std::uint32_t>(records.size()));
+  }
+
+  template <class F>
+  void query(const glm::vec3& x, F&& f) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const node& nd = nodes_[stack[--top]];
+      if (x.x < nd.lo.x || x.y < nd.lo.y || x.z < nd.lo.z || x.x > nd.hi.x || x.y > nd.hi.y || x.z > nd.hi.z) continue;
+      if (nd.count > 0) {
+        for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) f(index_[k]);
+      } else {
+        stack[top++] = nd.first;
+        stack[top++] = nd.first + 1;
+      }
+    }
+  }
+
+ private:
+  struct node {
+    glm::vec3 lo, hi;
+    std::uint32_t first, count;  // leaf: records [first, first + count); inner: children first, first + 1
+  };
+
+  // Builds the node for index_[begin, end) at nodes_[slot]; median split on the longest axis of
+  // the centres. Depth stays below 64 because every split halves the range.
+  void build_node(std::uint32_t begin, std::uint32_t end) {
+    nodes_.push_back({});
+    build_into(static_cast<std::uint32_t>(nodes_.size() - 1), begin, end);
+  }
+  void build_into(std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    glm::vec3 clo = lo, chi = hi;
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const std::uint32_t i = index_[k];
+      lo = glm::min(lo, lo_[i]);
+      hi = glm::max(hi, hi_[i]);
+      clo = glm::min(clo, (*records_)[i].position);
+      chi = glm::max(chi, (*records_)[i].position);
+    }
+    nodes_[slot].lo = lo;
+    nodes_[slot].hi = hi;
+    if (end - begin <= 4) {
+      nodes_[slot].first = begin;
+      nodes_[slot].count = end - begin;
+      return;
+    }
+    const glm::vec3 ext = chi - clo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(index_.begin() + begin, index_.begin() + mid, index_.begin() + end,
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       const float pa = (*records_)[a].position[axis], pb = (*records_)[b].position[axis];
+                       return pa < pb || (pa == pb && a < b);  // total order: deterministic
+                     });
+    const std::uint32_t child = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    nodes_.push_back({});
+    nodes_[slot].first = child;
+    nodes_[slot].count = 0;
+    build_into(child, begin, mid);
+    build_into(child + 1, mid, end);
+  }
+
+  const std::vector<cache_record>* records_ = nullptr;
+  std::vector<node> nodes_;
+  std::vector<std::uint32_t> index_;
+  std::vector<glm::vec3> lo_, hi_;
+};
+
+// Interpolation at one point through the BVH; returns the weight sum (0: not covered).
+// `spread` (optional) receives the range (max - min) of the luminance the covering records
+// predict for the point, and `own` whether one of them sits at the point itself.
+float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
+                  const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
+                  bool* own = nullptr) {
+  glm::vec3 sum(0.0f);
+  float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  bool at_record = false;
+  bvh.query(x, [&](std::uint32_t i) {
+    const cache_record& r = records[i];
+    const float w = record_weight(r, x, n, o);
+    if (w <= 0.0f || record_is_behind(r, x, n)) return;
+    const glm::vec3 e = extrapolate(r, x, n, o.use_gradients);
+    sum += w * e;
+    wsum += w;
+    const float l = luminance(e);
+    lo = std::min(lo, l);
+    hi = std::max(hi, l);
+    at_record = at_record || r.position == x;
+  });
+  out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+  if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
+  if (own) *own = at_record;
+  return wsum;
+}
+
+// Median distance from a point to its nearest neighbour, over up to 1024 evenly strided points,
+// found with a hash grid (cell = bounding-box diagonal / sqrt(count): points on surfaces).
+float median_spacing(const glm::vec3* p, std::size_t count, float diagonal) {
+  if (count < 2 || !(diagonal > 0.0f)) return 0.0f;
+  const float cell = diagonal / std::sqrt(float(count));
+  auto key = [&](const glm::vec3& v) {
+    const auto q = glm::ivec3(glm::floor(v / cell));
+    return (std::uint64_t(std::uint32_t(q.x)) * 73856093u) ^ (std::uint64_t(std::uint32_t(q.y)) * 19349663u) ^
+           (std::uint64_t(std::uint32_t(q.z)) * 83492791u);
+  };
+  std::unordered_multimap<std::uint64_t, std::size_t> grid;
+  grid.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) grid.emplace(key(p[i]), i);
+  std::vector<float> nn;
+  const std::size_t stride = std::max<std::size_t>(1, count / 1024);
+  for (std::size_t i = 0; i < count; i += stride) {
+    float best = std::numeric_limits<float>::infinity();
+    for (int ring = 1; ring <= 4 && !std::isfinite(best); ring *= 2) {
+      const glm::ivec3 q = glm::ivec3(glm::floor(p[i] / cell));
+      for (int dz = -ring; dz <= ring; ++dz)
+        for (int dy = -ring; dy <= ring; ++dy)
+          for (int dx = -ring; dx <= ring; ++dx) {
+            const glm::vec3 c = (glm::vec3(q + glm::ivec3(dx, dy, dz)) + 0.5f) * cell;
+            auto range = grid.equal_range(key(c));
+            for (auto it = range.first; it != range.second; ++it) {
+              if (it->second == i) continue;
+              const float d = glm::length(p[it->second] - p[i]);
+              if (d > 0.0f) best = std::min(best, d);
+            }
+          }
+    }
+    if (std::isfinite(best)) nn.push_back(best);
+  }
+  if (nn.empty()) return 0.0f;
+  std::nth_element(nn.begin(), nn.begin() + std::ptrdiff_t(nn.size() / 2), nn.end());
+  return nn[nn.size() / 2];
+}
+
+void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const cache_options& o) {
+  const std::string fn = "cache_irradiance: ";
+  if (count == 0) throw_invalid_argument(fn + "count is 0: there are no points");
+  if (!positions) throw_invalid_argument(fn + "positions is NULL");
+  if (!normals) throw_invalid_argument(fn + "normals is NULL");
+  for (std::size_t i = 0; i < count; ++i) {
+    const glm::vec3 &p = positions[i], &n = normals[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite");
+    const float len = glm::length(n);
+    if (!(std::fabs(len - 1.0f) <= 1e-3f))
+      throw_invalid_argument(fn + "normals[" + std::to_string(i) + "] = " + vec_str(n) + " has length " +
+                             std::to_string(len) + "; it must be a unit vector");
+  }
+  if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
+    throw_invalid_argument(fn + "error_threshold is " + std::to_string(o.error_threshold) + "; it must be in (0, 1]");
+  if (!(o.min_radius >= 0.0f) || !std::isfinite(o.min_radius))
+    throw_invalid_argument(fn + "min_radius is " + std::to_string(o.min_radius) + "; it must be finite and >= 0 (0 = automatic)");
+  if (!(o.max_radius >= 0.0f) || !std::isfinite(o.max_radius))
+    throw_invalid_argument(fn + "max_radius is " + std::to_string(o.max_radius) + "; it must be finite and >= 0 (0 = automatic)");
+  if (o.min_radius > 0.0f && o.max_radius > 0.0f && o.min_radius > o.max_radius)
+    throw_invalid_argument(fn + "min_radius " + std::to_string(o.min_radius) + " is larger than max_radius " +
+                           std::to_string(o.max_radius));
+  if (!(o.invalid_backface_fraction >= 0.0f && o.invalid_backface_fraction <= 1.0f))
+    throw_invalid_argument(fn + "invalid_backface_fraction is " + std::to_string(o.invalid_backface_fraction) +
+                           "; it must be in [0, 1]");
+}
+
+// 64-bit mix (splitmix64 finaliser): a fixed pseudo-random order of the points.
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+float record_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+  const float d = glm::length(x - r.position);
+  const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
+  if (o.weight == cache_weight::ward) {
+    const float denom = d / r.radius + ndot;
+    const float w = denom > 1.0f / max_weight ? 1.0f / denom : max_weight;
+    return w > 1.0f / o.error_threshold ? w : 0.0f;
+  }
+  const float k = 1.0f / (2.0f * o.error_threshold);
+  const float w = 1.0f - k * std::max(d / (0.5f * r.radius), ndot / 0.12326f);
+  return w > 0.0f ? w : 0.0f;
+}
+
+bool record_is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) {
+  return 0.5f * glm::dot(x - r.position, r.normal + n) < -behind_epsilon;
+}
+
+glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& x, const glm::vec3& n,
+                              const cache_options& o, float* weight_sum) {
+  glm::vec3 sum(0.0f);
+  float wsum = 0.0f;
+  for (const cache_record& r : records) {
+    const float w = record_weight(r, x, n, o);
+    if (w <= 0.0f || record_is_behind(r, x, n)) continue;
+    sum += w * extrapolate(r, x, n, o.use_gradients);
+    wsum += w;
+  }
+  if (weight_sum) *weight_sum = wsum;
+  return wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+}
+
+cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
+                              const irradiance_sampler& sampler, const cache_options& options_in) {
+  validate(positions, normals, count, options_in);
+  if (!sampler) throw_invalid_argument("cache_irradiance: sampler is empty");
+  const auto start = std::chrono::steady_clock::now();
+  cache_options o = options_in;
+  const int threads = resolve_thread_count(o.thread_count);
+  const float a = o.error_threshold;
+
+  // Automatic radii from the points' extent and spacing.
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (std::size_t i = 0; i < count; ++i) {
+    lo = glm::min(lo, positions[i]);
+    hi = glm::max(hi, positions[i]);
+  }
+  const float diagonal = glm::length(hi - lo);
+  if (o.min_radius == 0.0f) {
+    const float spacing = median_spacing(positions, count, diagonal);
+    o.min_radius = spacing > 0.0f ? spacing / a : std::max(diagonal, 1e-3f) * 1e-3f;
+  }
+  if (o.max_radius == 0.0f) o.max_radius = 0.2f * diagonal;
+  o.max_radius = std::max(o.max_radius, o.min_radius);
+
+  // Coverage can drop between rounds (radii shrink), so the reported fraction is the running
+  // maximum: progress never goes backwards.
+  float reported = 0.0f;
+  auto report = [&](float fraction) {
+    reported = std::max(reported, fraction);
+    if (o.progress && !o.progress(reported)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
+  };
+
+  std::vector<cache_record> records;
+  record_bvh bvh;
+  bvh.build(records, o);
+  // Per point: 0 = open, 1 = inside geometry (an invalid sample there or near one).
+  std::vector<std::uint8_t> inside(count, 0);
+  std::vector<std::uint8_t> covered(count, 0);
+  std::vector<std::uint64_t> order_key(count);
+  for (std::size_t i = 0; i < count; ++i) order_key[i] = mix(i);
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return order_key[x] < order_key[y]; });
+
+  cache_stats stats;
+  float spacing = a * o.max_radius;
+  const float finest = a * o.min_radius;
+  // Invalid samples: position and exclusion radius (0.9 x their min distance).
+  std::vector<std::pair<glm::vec3, float>> invalid_balls;
+
+  for (;;) {
+    // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
+    // when a record's weight passes the threshold and, with refine_disagreement, the covering
+    // records agree on it: their predictions span at most a x max(E, floor) (luminance).
+    float floor_e = 0.0f;
+    if (!records.empty()) {
+      double mean = 0.0;
+      for (const cache_record& r : records) mean += luminance(r.irradiance);
+      floor_e = 0.05f * float(mean / double(records.size()));
+    }
+    parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        if (inside[i]) continue;
+        glm::vec3 value;
+        float spread = 0.0f;
+        bool own = false;
+        const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own);
+        bool ok = w > 0.0f;
+        if (ok && o.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e);
+        covered[i] = ok ? 1 : 0;
+      }
+    });
+    std::size_t open = 0;
+    for (std::size_t i = 0; i < count; ++i) open += (!covered[i] && !inside[i]) ? 1u : 0u;
+    report(1.0f - float(open) / float(count));
+    if (open == 0) break;
+
+    // 2. Seeds: open points in the fixed order, at least `spacing` from this round's other seeds
+    // of a similar normal (a hash grid with cells of `spacing`).
+    std::vector<std::size_t> seeds;
+    const float cell = std::max(spacing, 1e-30f);
+    std::unordered_multimap<std::uint64_t, std::size_t> grid;
+    auto key = [&](const glm::ivec3& q) {
+      return (std::uint64_t(std::uint32_t(q.x)) * 73856093u) ^ (std::uint64_t(std::uint32_t(q.y)) * 19349663u) ^
+             (std::uint64_t(std::uint32_t(q.z)) * 83492791u);
+    };
+    for (std::size_t i : order) {
+      if (covered[i] || inside[i]) continue;
+      bool blocked = false;
+      if (spacing > finest) {  // at the finest spacing every open point is a seed
+        const glm::ivec3 q = glm::ivec3(glm::floor(positions[i] / cell));
+        for (int dz = -1; dz <= 1 && !blocked; ++dz)
+          for (int dy = -1; dy <= 1 && !blocked; ++dy)
+            for (int dx = -1; dx <= 1 && !blocked; ++dx) {
+              auto range = grid.equal_range(key(q + glm::ivec3(dx, dy, dz)));
+              for (auto it = range.first; it != range.second && !blocked; ++it) {
+                const std::size_t j = it->second;
+                blocked = glm::length(positions[j] - positions[i]) < spacing && glm::dot(normals[j], normals[i]) > 0.9f;
+              }
+            }
+        if (!blocked) grid.emplace(key(q), i);
+      }
+      if (!blocked) seeds.push_back(i);
+    }
+
+    // 3. Render the seeds in parallel; results land in per-seed slots (deterministic).
+    std::vector<irradiance_sample> samples(seeds.size());
+    std::atomic<bool> cancel{false};
+    std::atomic<std::size_t> done{0};
+    const float covered_fraction = 1.0f - float(open) / float(count);
+    parallel_for(seeds.size(), threads, 1, [&](int worker, std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e && !cancel; ++k) {
+        samples[k] = sampler(worker, positions[seeds[k]], normals[seeds[k]]);
+        const std::size_t finished = ++done;
+        // Worker 0 is the calling thread: the only one that calls progress.
+        if (worker == 0 && o.progress) {
+          reported = std::max(reported, covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f);
+          if (!o.progress(reported)) cancel = true;
+        }
+      }
+    });
+    if (cancel) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
+    stats.hemicubes += seeds.size();
+
+    // 4. New records in seed order, with their radius limits.
+    const std::size_t first_new = records.size();
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      const std::size_t i = seeds[k];
+      const irradiance_sample& s = samples[k];
+      if (s.backface_fraction > o.invalid_backface_fraction) {
+        ++stats.invalid_samples;
+        inside[i] = 1;
+        // Nothing lies nearer than min_distance in the visible half-space: points within most
+        // of that distance are inside the same closed region.
+        const float ball = std::isfinite(s.min_distance) ? 0.9f * s.min_distance : 0.0f;
+        invalid_balls.emplace_back(positions[i], ball);
+        continue;
+      }
+      cache_record r;
+      r.position = positions[i];
+      r.normal = normals[i];
+      r.irradiance = s.irradiance;
+      r.rotation_gradient = s.rotation_gradient;
+      r.translation_gradient = s.translation_gradient;
+      r.harmonic_distance = s.harmonic_mean_distance;
+      float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o.max_radius;
+      if (o.gradient_radius_limit) {
+        const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
+                                     0.0722f * s.translation_gradient[2]);
+        const float e = luminance(s.irradiance);
+        if (gt > 0.0f && e > 0.0f) radius = std::min(radius, e / gt);
+      }
+      r.radius = std::clamp(radius, o.min_radius, o.max_radius);
+      records.push_back(r);
+    }
+    // Points within an invalid sample's exclusion ball are inside geometry too.
+    if (!invalid_balls.empty()) {
+      parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          if (inside[i]) continue;
+          for (const auto& ball : invalid_balls)
+            if (glm::length(positions[i] - ball.first) < ball.second) {
+              inside[i] = 1;
+              break;
+            }
+        }
+      });
+      invalid_balls.clear();  // applied; later rounds only add new ones
+    }
+
+    // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
+    // over pairs (new record, any record) within reach (deterministic).
+    if (records.size() > first_new && (o.neighbour_clamp || o.shrink_disagreeing)) {
+      bvh.build(records, o);
+      for (std::size_t i = first_new; i < records.size(); ++i) {
+        // Candidates: records whose coverage box holds x_i, plus those x_i's own sphere reaches.
+        std::vector<std::uint32_t> near;
+        bvh.query(records[i].position, [&](std::uint32_t j) { near.push_back(j); });
+        std::sort(near.begin(), near.end());
+        for (std::uint32_t j : near) {
+          if (std::size_t(j) == i) continue;
+          cache_record& ri = records[i];
+          cache_record& rj = records[j];
+          const float d = glm::length(ri.position - rj.position);
+          if (o.neighbour_clamp) {
+            ri.radius = std::max(o.min_radius, std::min(ri.radius, rj.radius + d));
+            rj.radius = std::max(o.min_radius, std::min(rj.radius, ri.radius + d));
+          }
+          if (o.shrink_disagreeing && glm::dot(ri.normal, rj.normal) > 0.9f && d > 0.0f) {
+            // Each record's first-order prediction of the other's irradiance (luminance).
+            const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
+            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, true));
+            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, true));
+            const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
+            if (err > a) {
+              // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
+              const float r_gap = std::max(o.min_radius, 0.4f * d / a);
+              ri.radius = std::min(ri.radius, r_gap);
+              rj.radius = std::min(rj.radius, r_gap);
+            }
+          }
+        }
+      }
+    }
+    bvh.build(records, o);
+    ++stats.rounds;
+    if (spacing > finest) spacing = std::max(finest, 0.5f * spacing);
+    else if (seeds.empty()) break;  // defensive: nothing could be placed
+  }
+
+  // Final interpolation (parallel); points inside geometry or left uncovered are filled from the
+  // nearest valid records (weights without the threshold: 1 / (d / R + sqrt(1 - n.n_i))).
+  cache_result result;
+  result.irradiance.assign(count, glm::vec3(0.0f));
+  result.valid.assign(count, 0);
+  parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      glm::vec3 v;
+      if (!inside[i] && interpolate(records, bvh, positions[i], normals[i], o, v) > 0.0f) {
+        result.irradiance[i] = v;
+        result.valid[i] = 1;
+      }
+    }
+  });
+  std::vector<std::size_t> fill;
+  for (std::size_t i = 0; i < count; ++i)
+    if (!result.valid[i]) fill.push_back(i);
+  stats.invalid_points = fill.size();
+  if (!records.empty() && !fill.empty()) {
+    parallel_for(fill.size(), threads, 256, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t i = fill[k];
+        // The 8 records of largest relaxed weight (brute force: only filled points pay this).
+        std::array<std::pair<float, std::uint32_t>, 8> best;
+        best.fill({0.0f, 0u});
+        for (std::size_t j = 0; j < records.size(); ++j) {
+          const cache_record& r = records[j];
+          const float denom = glm::length(positions[i] - r.position) / r.radius +
+                              std::sqrt(std::max(0.0f, 1.0f - glm::dot(normals[i], r.normal)));
+          const float w = 1.0f / std::max(denom, 1e-12f);
+          if (w > best.back().first) {
+            best.back() = {w, static_cast<std::uint32_t>(j)};
+            std::sort(best.begin(), best.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+          }
+        }
+        glm::vec3 sum(0.0f);
+        float wsum = 0.0f;
+        for (const auto& bw : best)
+          if (bw.first > 0.0f) {
+            sum += bw.first * records[bw.second].irradiance;
+            wsum += bw.first;
+          }
+        result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+      }
+    });
+  }
+  stats.records = records.size();
+  stats.min_radius = o.min_radius;
+  stats.max_radius = o.max_radius;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report(1.0f);
+  result.records = std::move(records);
+  result.stats = stats;
+  return result;
+}
+
+irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
+  if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");
+  if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
+  struct context {
+    hemicube_rasterizer raster;
+    hemicube_integrator integrator;
+    hemicube_buffer buffer;
+  };
+  auto contexts = std::make_shared<std::vector<std::unique_ptr<context>>>();
+  for (int w = 0; w < workers; ++w)
+    contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
+                                                          hemicube_integrator(o.resolution, o.integrate), {}}));
+  return [contexts, o](int worker, const glm::vec3& x, const glm::vec3& n) {
+    if (worker < 0 || std::size_t(worker) >= contexts->size())
+      throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
+    context& c = *(*contexts)[std::size_t(worker)];
+    frame f = make_frame(n);
+    if (o.roll) {
+      std::uint32_t bits[3];
+      std::memcpy(bits, &x, sizeof bits);
+      const std::uint64_t h = mix((std::uint64_t(bits[0]) << 32 | bits[1]) ^ mix(bits[2]));
+      const float angle = float(h >> 40) * (6.2831853f / float(1u << 24));
+      const glm::vec3 t = std::cos(angle) * f.t + std::sin(angle) * f.b;
+      f.b = glm::cross(f.n, t);
+      f.t = t;
+    }
+    c.raster.render(x, f, o.resolution, c.buffer, o.texture);
+    return c.integrator.integrate(c.buffer);
+  };
+}
+
+}  // namespace hemilight

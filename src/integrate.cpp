@@ -1,0 +1,475 @@
+// Hemicube integration: exact per-texel weights, per-wall gradient coefficients, and the two
+// passes (texels, walls) that reduce a hemicube buffer. See integrate.hpp and docs/integration.md.
+#include "hemilight/integrate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <string>
+#include <type_traits>
+
+namespace hemilight {
+
+namespace {
+
+using dvec3 = glm::dvec3;
+
+// Vector solid angle of a spherical polygon, integral of w dw: 1/2 sum beta_k gamma_k (Lambert).
+// With hemicube corner order (c x r = a) it points out of the cube through the texel.
+dvec3 vector_solid_angle(const std::array<dvec3, 4>& c) {
+  dvec3 sum(0.0);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const dvec3 x = glm::cross(c[k], c[(k + 1) % 4]);
+    const double len = glm::length(x);
+    if (len > 0.0) sum += std::atan2(len, glm::dot(c[k], c[(k + 1) % 4])) * x / len;
+  }
+  return 0.5 * sum;
+}
+
+dvec3 texel_centre(int n, std::size_t i) { return dvec3(hemicube_texel_direction(n, i)); }
+
+struct wall_coefficients {
+  glm::dvec2 great_arc{0.0};
+  glm::dvec2 classified{0.0};
+};
+
+// Coefficients of the wall with unit end directions d0, d1 between texels with centres ca, cb.
+wall_coefficients wall_between(const dvec3& d0, const dvec3& d1, const dvec3& ca, const dvec3& cb) {
+  wall_coefficients out;
+  const dvec3 x = glm::cross(d0, d1);
+  const double sin_beta = glm::length(x);
+  if (sin_beta == 0.0) return out;
+  dvec3 m = x / sin_beta;
+  if (glm::dot(m, cb - ca) < 0.0) m = -m;  // m points from texel a into texel b
+  const double beta = std::atan2(sin_beta, glm::dot(d0, d1));  // arc length
+  // Integral of cos(theta) = w.z along the great arc d(s) = d0 cos s + w sin s, s in [0, beta].
+  const dvec3 w = glm::normalize(d1 - glm::dot(d0, d1) * d0);
+  const double cos_integral = d0.z * std::sin(beta) + w.z * (1.0 - std::cos(beta));
+  out.great_arc = glm::dvec2(m.x, m.y) * cos_integral;
+
+  // Classified walls (Ward & Heckbert adapted): rate from the wall's latitude/longitude class
+  // at its midpoint, direction normalize(m_t).
+  const double mt = std::hypot(m.x, m.y);
+  if (mt == 0.0) return out;
+  const dvec3 mid = glm::normalize(d0 + d1);
+  const double sin_theta = std::hypot(mid.x, mid.y);
+  const double cos_theta = mid.z;
+  bool longitude = false;  // the wall runs along a meridian (constant longitude)
+  if (sin_theta > 1e-12) {
+    const double cphi = mid.x / sin_theta, sphi = mid.y / sin_theta;
+    const dvec3 theta_hat(cos_theta * cphi, cos_theta * sphi, -sin_theta);
+    const dvec3 phi_hat(-sphi, cphi, 0.0);
+    const dvec3 along = glm::normalize(d1 - d0);
+    longitude = std::fabs(glm::dot(along, theta_hat)) > std::fabs(glm::dot(along, phi_hat));
+  }
+  const double rate = longitude ? 1.0 / sin_theta : cos_theta;
+  out.classified = glm::dvec2(m.x, m.y) / mt * cos_integral * rate;
+  return out;
+}
+
+constexpr double hl2_basis[3][3] = {
+    {-0.40824829046386301637, 0.70710678118654752440, 0.57735026918962576451},
+    {-0.40824829046386301637, -0.70710678118654752440, 0.57735026918962576451},
+    {0.81649658092772603273, 0.0, 0.57735026918962576451},
+};
+
+constexpr float sh_y00 = 0.282094791773878143f;  // 1 / (2 sqrt(pi))
+constexpr float sh_y1 = 0.488602511902919921f;   // sqrt(3) / (2 sqrt(pi))
+
+}  // namespace
+
+integration_table::integration_table(int n) : n_(n) {
+  if (!is_valid_hemicube_resolution(n))
+    throw_invalid_argument("integration_table: resolution " + std::to_string(n) +
+                           " is invalid: it must be even and in [2, 4096]");
+  const std::size_t count = hemicube_texel_count(n);
+  const std::size_t un = static_cast<std::size_t>(n);
+  for (std::vector<float>* v : {&vx, &vy, &vz, &simple_x, &simple_y, &hl2[0], &hl2[1], &hl2[2], &solid_angle,
+                                &right_great_arc_x, &right_great_arc_y, &up_great_arc_x, &up_great_arc_y,
+                                &right_classified_x, &right_classified_y, &up_classified_x, &up_classified_y})
+    v->assign(count, 0.0f);
+
+  const double s = 2.0 / n;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::array<dvec3, 4> corners = hemicube_texel_corners(n, i);
+    const dvec3 v = vector_solid_angle(corners);
+    vx[i] = static_cast<float>(v.x);
+    vy[i] = static_cast<float>(v.y);
+    vz[i] = static_cast<float>(v.z);
+    const dvec3 c = texel_centre(n, i);
+    simple_x[i] = static_cast<float>(3.0 * v.z * c.x);
+    simple_y[i] = static_cast<float>(3.0 * v.z * c.y);
+    for (int k = 0; k < 3; ++k) {
+      const dvec3 b(hl2_basis[k][0], hl2_basis[k][1], hl2_basis[k][2]);
+      hl2[k][i] = static_cast<float>(std::max(0.0, glm::dot(v, b)));
+    }
+    solid_angle[i] = static_cast<float>(hemicube_texel_solid_angle(n, i));
+
+    // Walls inside the face: to the right (x + 1) and up (y + 1) neighbours.
+    const hemicube_texel t = hemicube_texel_from_index(n, i);
+    const glm::dvec2 lo = hemicube_texel_min_corner(n, t);
+    auto point = [&](double u, double w) { return glm::normalize(hemicube_face_point(t.face, u, w)); };
+    if (t.x + 1 < n) {
+      const wall_coefficients w = wall_between(point(lo.x + s, lo.y), point(lo.x + s, lo.y + s), c, texel_centre(n, i + 1));
+      right_great_arc_x[i] = static_cast<float>(w.great_arc.x);
+      right_great_arc_y[i] = static_cast<float>(w.great_arc.y);
+      right_classified_x[i] = static_cast<float>(w.classified.x);
+      right_classified_y[i] = static_cast<float>(w.classified.y);
+    }
+    if (t.y + 1 < hemicube_face_height(n, t.face)) {
+      const wall_coefficients w = wall_between(point(lo.x, lo.y + s), point(lo.x + s, lo.y + s), c, texel_centre(n, i + un));
+      up_great_arc_x[i] = static_cast<float>(w.great_arc.x);
+      up_great_arc_y[i] = static_cast<float>(w.great_arc.y);
+      up_classified_x[i] = static_cast<float>(w.classified.x);
+      up_classified_y[i] = static_cast<float>(w.classified.y);
+    }
+  }
+
+  // Walls across face borders. (1) Each side face's top row meets the top face along z = 1.
+  auto add_border = [&](std::size_t a, std::size_t b, const dvec3& p0, const dvec3& p1) {
+    const wall_coefficients w = wall_between(glm::normalize(p0), glm::normalize(p1), texel_centre(n, a), texel_centre(n, b));
+    border_walls.push_back({static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                            {static_cast<float>(w.great_arc.x), static_cast<float>(w.great_arc.y)},
+                            {static_cast<float>(w.classified.x), static_cast<float>(w.classified.y)}});
+  };
+  auto top_index = [&](double x, double y) {  // top-face texel containing (x, y, 1); edges clamp inward
+    auto cell = [&](double c) { return std::clamp(static_cast<int>(std::floor((c + 1.0) / s)), 0, n - 1); };
+    return hemicube_texel_index(n, {hemicube_face::top, cell(x), cell(y)});
+  };
+  const hemicube_face sides[4] = {hemicube_face::pos_x, hemicube_face::pos_y, hemicube_face::neg_x, hemicube_face::neg_y};
+  for (hemicube_face f : sides) {
+    for (int x = 0; x < n; ++x) {
+      const double u0 = -1.0 + s * x, u1 = u0 + s;
+      const dvec3 p0 = hemicube_face_point(f, u0, 1.0), p1 = hemicube_face_point(f, u1, 1.0);
+      const dvec3 mid = 0.5 * (p0 + p1);
+      add_border(hemicube_texel_index(n, {f, x, n / 2 - 1}), top_index(mid.x, mid.y), p0, p1);
+    }
+  }
+  // (2) Neighbouring side faces (in the rotation order pos_x -> pos_y -> neg_x -> neg_y) meet
+  // along a vertical cube edge: column N-1 of one face and column 0 of the next.
+  for (int k = 0; k < 4; ++k) {
+    const hemicube_face f = sides[k], g = sides[(k + 1) % 4];
+    for (int y = 0; y < n / 2; ++y) {
+      const double v0 = s * y, v1 = v0 + s;
+      add_border(hemicube_texel_index(n, {f, n - 1, y}), hemicube_texel_index(n, {g, 0, y}), hemicube_face_point(f, 1.0, v0),
+                 hemicube_face_point(f, 1.0, v1));
+    }
+  }
+}
+
+std::shared_ptr<const integration_table> integration_table::get(int n) {
+  if (!is_valid_hemicube_resolution(n)) return std::make_shared<const integration_table>(n);  // throws
+  struct slot {
+    std::shared_ptr<const integration_table> strong;
+    std::weak_ptr<const integration_table> weak;
+  };
+  static std::mutex mutex;
+  static std::map<int, slot> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  slot& entry = cache[n];
+  if (auto alive = entry.weak.lock()) return alive;
+  auto table = std::make_shared<const integration_table>(n);
+  entry.weak = table;
+  if (n <= 512) entry.strong = table;
+  return table;
+}
+
+hemicube_integrator::hemicube_integrator(int resolution, const integrate_options& options)
+    : n_(resolution), options_(options) {
+  if (!(options.min_wall_distance >= 0.0f) || !std::isfinite(options.min_wall_distance))
+    throw_invalid_argument("hemicube_integrator: min_wall_distance is " + std::to_string(options.min_wall_distance) +
+                           "; it must be finite and >= 0 (0 = automatic)");
+  table_ = integration_table::get(resolution);  // validates the resolution
+  const std::size_t count = hemicube_texel_count(resolution);
+  r_.resize(count);
+  g_.resize(count);
+  b_.resize(count);
+  inv_r_.resize(count);
+}
+
+namespace {
+
+// Every sum below runs over blocks of at most `block` texels; inside a block it is one SIMD
+// reduction in Inner ("#pragma omp simd reduction" lets the compiler split it into vector lanes;
+// built with -fopenmp-simd, no OpenMP runtime), and block totals are added in double. With
+// Inner = float each result is accurate to about the float rounding of one block, whatever N.
+constexpr std::size_t block = 1024;
+
+// Sum over the walls between texel i and i + step of (L_b - L_a) * coefficient * 1 / r_wall, per
+// channel and coefficient component, into acc[6]. Hot loop of the integrator.
+template <class Inner>
+inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const float* g, const float* b, const float* inv,
+                                                          const float* cx, const float* cy, std::size_t step,
+                                                          std::size_t end, float cap, double* acc) {
+  for (std::size_t b0 = 0; b0 < end; b0 += block) {
+    const std::size_t b1 = std::min(end, b0 + block);
+    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const float near_inv = inv[i] > inv[i + step] ? inv[i] : inv[i + step];
+      const Inner w = Inner(near_inv < cap ? near_inv : cap);
+      const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
+      const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
+                  db = Inner(b[i + step]) - Inner(b[i]);
+      a0 += dr * wx;
+      a1 += dr * wy;
+      a2 += dg * wx;
+      a3 += dg * wy;
+      a4 += db * wx;
+      a5 += db * wy;
+    }
+    acc[0] += double(a0);
+    acc[1] += double(a1);
+    acc[2] += double(a2);
+    acc[3] += double(a3);
+    acc[4] += double(a4);
+    acc[5] += double(a5);
+  }
+}
+
+// Deinterleaves the radiance, inverts the distances, and sums pass 1 (E per channel, total
+// projected solid angle, harmonic sum, back faces) into s1[6]; returns the min distance.
+template <class Inner>
+inline __attribute__((always_inline)) float texel_sums_impl(const float* rad, const float* dist, const std::uint8_t* flags,
+                                                            const float* vz, float* r, float* g, float* b, float* inv,
+                                                            std::size_t count, double* s1) {
+  for (std::size_t i = 0; i < count; ++i) {
+    r[i] = rad[3 * i];
+    g[i] = rad[3 * i + 1];
+    b[i] = rad[3 * i + 2];
+  }
+  float min_d = std::numeric_limits<float>::infinity();
+#pragma omp simd reduction(min : min_d)
+  for (std::size_t i = 0; i < count; ++i) {
+    inv[i] = 1.0f / dist[i];
+    min_d = dist[i] < min_d ? dist[i] : min_d;
+  }
+  for (std::size_t b0 = 0; b0 < count; b0 += block) {
+    const std::size_t b1 = std::min(count, b0 + block);
+    Inner e0 = 0, e1 = 0, e2 = 0, pt = 0, hs = 0, bk = 0;
+#pragma omp simd reduction(+ : e0, e1, e2, pt, hs, bk)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner p = Inner(vz[i]);
+      e0 += Inner(r[i]) * p;
+      e1 += Inner(g[i]) * p;
+      e2 += Inner(b[i]) * p;
+      pt += p;
+      hs += p * Inner(inv[i]);
+      bk += p * Inner((flags[i] >> 1) & 1u);  // texel_back_face is bit 1
+    }
+    s1[0] += double(e0);
+    s1[1] += double(e1);
+    s1[2] += double(e2);
+    s1[3] += double(pt);
+    s1[4] += double(hs);
+    s1[5] += double(bk);
+  }
+  return min_d;
+}
+
+// Sums L_i (x, y) of the texels' vector solid angles per channel into phi[6] (for g_r).
+template <class Inner>
+inline __attribute__((always_inline)) void vector_sums_impl(const float* r, const float* g, const float* b, const float* vx,
+                                                            const float* vy, std::size_t count, double* phi) {
+  for (std::size_t b0 = 0; b0 < count; b0 += block) {
+    const std::size_t b1 = std::min(count, b0 + block);
+    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner x = Inner(vx[i]), y = Inner(vy[i]);
+      a0 += Inner(r[i]) * x;
+      a1 += Inner(r[i]) * y;
+      a2 += Inner(g[i]) * x;
+      a3 += Inner(g[i]) * y;
+      a4 += Inner(b[i]) * x;
+      a5 += Inner(b[i]) * y;
+    }
+    phi[0] += double(a0);
+    phi[1] += double(a1);
+    phi[2] += double(a2);
+    phi[3] += double(a3);
+    phi[4] += double(a4);
+    phi[5] += double(a5);
+  }
+}
+
+// The float kernel is compiled twice where the compiler can dispatch at load time (GCC/Clang on
+// x86-64 Linux: an AVX2 clone and the portable SSE2 default, picked by the CPU); the two give the
+// same sums up to the order of float additions inside a block.
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void wall_sums_float(const float* r, const float* g, const float* b, const float* inv, const float* cx, const float* cy,
+                     std::size_t step, std::size_t end, float cap, double* acc) {
+  wall_sums_impl<float>(r, g, b, inv, cx, cy, step, end, cap, acc);
+}
+
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void vector_sums_float(const float* r, const float* g, const float* b, const float* vx, const float* vy, std::size_t count,
+                       double* phi) {
+  vector_sums_impl<float>(r, g, b, vx, vy, count, phi);
+}
+
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+float texel_sums_float(const float* rad, const float* dist, const std::uint8_t* flags, const float* vz, float* r, float* g,
+                       float* b, float* inv, std::size_t count, double* s1) {
+  return texel_sums_impl<float>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+}
+
+}  // namespace
+
+template <class Acc>
+irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
+  // Sums inside a block in Acc's precision (float, or double when asked for).
+  using Inner = Acc;
+  const integration_table& t = *table_;
+  const std::size_t count = hemicube_texel_count(n_);
+  const std::size_t row = static_cast<std::size_t>(n_);
+  const float* rad = buffer.radiance.data();
+  const float* dist = buffer.distance.data();
+  const std::uint8_t* flags = buffer.flags.data();
+  float* r = r_.data();
+  float* g = g_.data();
+  float* b = b_.data();
+  float* inv = inv_r_.data();
+  const float* vx = t.vx.data();
+  const float* vy = t.vy.data();
+  const float* vz = t.vz.data();
+  // Planar copies of the radiance and 1/distance (0 for misses), min distance, and pass 1:
+  // E, total projected solid angle, harmonic sum, back faces.
+  double s1[6] = {};
+  float min_d;
+  if constexpr (std::is_same<Inner, float>::value)
+    min_d = texel_sums_float(rad, dist, flags, vz, r, g, b, inv, count, s1);
+  else
+    min_d = texel_sums_impl<Inner>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+  assert(min_d > 0.0f);
+  irradiance_sample out;
+  out.irradiance = glm::vec3(float(s1[0]), float(s1[1]), float(s1[2]));
+  const double total = s1[3], harmonic = s1[4];
+  out.harmonic_mean_distance = harmonic > 0 ? float(total / harmonic) : std::numeric_limits<float>::infinity();
+  out.min_distance = min_d;
+  out.backface_fraction = float(s1[5] / total);
+  const frame& f = buffer.basis;
+
+  if (options_.rotation_gradient) {
+    double phi[6] = {};  // (x, y) of the vector irradiance per channel
+    if constexpr (std::is_same<Inner, float>::value)
+      vector_sums_float(r, g, b, vx, vy, count, phi);
+    else
+      vector_sums_impl<Inner>(r, g, b, vx, vy, count, phi);
+    // g_r = n x Phi; in the local frame z x (x, y, z) = (-y, x, 0).
+    for (std::size_t c = 0; c < 3; ++c)
+      out.rotation_gradient[c] = f.to_world(glm::vec3(-float(phi[2 * c + 1]), float(phi[2 * c]), 0.0f));
+  }
+
+  if (options_.translation == translation_estimator::simple) {
+    const float* sx = t.simple_x.data();
+    const float* sy = t.simple_y.data();
+    double acc[6] = {};
+    for (std::size_t b0 = 0; b0 < count; b0 += block) {
+      const std::size_t b1 = std::min(count, b0 + block);
+      Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+      for (std::size_t i = b0; i < b1; ++i) {
+        const Inner wx = Inner(sx[i]) * Inner(inv[i]), wy = Inner(sy[i]) * Inner(inv[i]);
+        a0 += Inner(r[i]) * wx;
+        a1 += Inner(r[i]) * wy;
+        a2 += Inner(g[i]) * wx;
+        a3 += Inner(g[i]) * wy;
+        a4 += Inner(b[i]) * wx;
+        a5 += Inner(b[i]) * wy;
+      }
+      acc[0] += double(a0);
+      acc[1] += double(a1);
+      acc[2] += double(a2);
+      acc[3] += double(a3);
+      acc[4] += double(a4);
+      acc[5] += double(a5);
+    }
+    for (std::size_t c = 0; c < 3; ++c)
+      out.translation_gradient[c] = f.to_world(glm::vec3(float(acc[2 * c]), float(acc[2 * c + 1]), 0.0f));
+  } else if (options_.translation != translation_estimator::none) {
+    // Pass 2: walls. A wall moves with its nearer texel: 1/r_min = the larger inverse distance,
+    // capped at 1/min_wall_distance (automatic: 10 / harmonic mean distance).
+    float cap;
+    if (options_.min_wall_distance > 0.0f) cap = 1.0f / options_.min_wall_distance;
+    else cap = harmonic > 0 ? float(10.0 * harmonic / total) : 0.0f;  // nothing hit: sky-sky walls only
+    const bool arc = options_.translation == translation_estimator::great_arc;
+    double acc[6] = {};
+    // Walls inside faces: texel i with i + step (step 1: right neighbour, step N: the row above).
+    // The tables hold zero coefficients where i + step is not a neighbour (row and face ends),
+    // so both passes run over one contiguous range.
+    auto walls = [&](std::size_t step, const float* cx, const float* cy) {
+      if constexpr (std::is_same<Inner, float>::value)
+        wall_sums_float(r, g, b, inv, cx, cy, step, count - step, cap, acc);
+      else
+        wall_sums_impl<Inner>(r, g, b, inv, cx, cy, step, count - step, cap, acc);
+    };
+    walls(1, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
+          arc ? t.right_great_arc_y.data() : t.right_classified_y.data());
+    walls(row, arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
+          arc ? t.up_great_arc_y.data() : t.up_classified_y.data());
+    for (const integration_table::wall& w : t.border_walls) {  // 6 N walls across face borders
+      const double iw = std::min(std::max(inv[w.a], inv[w.b]), cap);
+      const float* c = arc ? w.great_arc : w.classified;
+      const double wx = c[0] * iw, wy = c[1] * iw;
+      acc[0] += (double(r[w.b]) - r[w.a]) * wx;
+      acc[1] += (double(r[w.b]) - r[w.a]) * wy;
+      acc[2] += (double(g[w.b]) - g[w.a]) * wx;
+      acc[3] += (double(g[w.b]) - g[w.a]) * wy;
+      acc[4] += (double(b[w.b]) - b[w.a]) * wx;
+      acc[5] += (double(b[w.b]) - b[w.a]) * wy;
+    }
+    for (std::size_t c = 0; c < 3; ++c)
+      out.translation_gradient[c] = f.to_world(glm::vec3(float(acc[2 * c]), float(acc[2 * c + 1]), 0.0f));
+  }
+
+  if (options_.directional) {
+    // Rarely asked for; plain double sums. 15 quantities: SH band 0, the vector (x, y, z) and
+    // the three HL2 weights, each for R, G, B.
+    double sh0[3] = {}, sv[3][3] = {}, h[3][3] = {};
+    for (std::size_t i = 0; i < count; ++i) {
+      const double l[3] = {r[i], g[i], b[i]};
+      for (std::size_t c = 0; c < 3; ++c) {
+        sh0[c] += l[c] * t.solid_angle[i];
+        sv[c][0] += l[c] * vx[i];
+        sv[c][1] += l[c] * vy[i];
+        sv[c][2] += l[c] * vz[i];
+        for (std::size_t k = 0; k < 3; ++k) h[k][c] += l[c] * t.hl2[k][i];
+      }
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      const glm::vec3 w = f.to_world(glm::vec3(float(sv[c][0]), float(sv[c][1]), float(sv[c][2])));
+      out.sh_l1[0][int(c)] = sh_y00 * float(sh0[c]);
+      out.sh_l1[1][int(c)] = sh_y1 * w.y;
+      out.sh_l1[2][int(c)] = sh_y1 * w.z;
+      out.sh_l1[3][int(c)] = sh_y1 * w.x;
+      for (std::size_t k = 0; k < 3; ++k) out.hl2[k][int(c)] = float(h[k][c]);
+    }
+  }
+  return out;
+}
+
+irradiance_sample hemicube_integrator::integrate(const hemicube_buffer& buffer) {
+  const std::size_t count = hemicube_texel_count(n_);
+  if (buffer.resolution != n_ || buffer.distance.size() != count || buffer.flags.size() != count ||
+      buffer.radiance.size() != 3 * count)
+    throw_invalid_argument("hemicube_integrator::integrate: buffer has resolution " + std::to_string(buffer.resolution) +
+                           " and " + std::to_string(buffer.distance.size()) + " texels; the integrator expects " +
+                           std::to_string(n_) + " and " + std::to_string(count));
+  return options_.double_precision ? run<double>(buffer) : run<float>(buffer);
+}
+
+irradiance_sample integrate(const hemicube_buffer& buffer, const integrate_options& options) {
+  hemicube_integrator integrator(buffer.resolution, options);
+  return integrator.integrate(buffer);
+}
+
+}  // namespace hemilight

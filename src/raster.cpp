@@ -1,0 +1,837 @@
+#include "hemilight/raster.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <cstring>
+#include <string>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#define HEMILIGHT_RASTER_SSE2 1
+#else
+#define HEMILIGHT_RASTER_SSE2 0
+#endif
+
+namespace hemilight {
+
+namespace {
+
+constexpr int sub_bits = 8;                   // sub-texel bits of the fixed-point grid
+constexpr std::int64_t sub_one = 1 << sub_bits;
+constexpr std::int64_t sub_half = sub_one / 2;
+// Guard band: clip |u|, |v| <= 1000 w. Wide, so that big triangles crossing a face's edges are
+// rarely clipped (clipping multiplies the rows to walk), narrow enough that snapped coordinates
+// stay below 1001 * 2048 * 256 < 2^29 for N <= 4096 (edge-function terms below 2^60 in int64).
+constexpr float guard_band = 1000.0f;
+constexpr int max_clip_vertices = 3 + 5;      // each of the 5 clip planes adds at most one
+
+// A vertex in a face's clip space: u = c.p, v = r.p, w = a.p (geometry.hpp face axes).
+struct clip_vertex {
+  float u, v, w;
+};
+
+// The local-frame point p seen on face f, as (c.p, r.p, a.p). Exact (sign changes, permutation).
+inline clip_vertex to_clip(int face, const glm::vec3& p) noexcept {
+  switch (face) {
+    case 0: return {p.x, p.y, p.z};
+    case 1: return {p.y, p.z, p.x};
+    case 2: return {-p.y, p.z, -p.x};
+    case 3: return {-p.x, p.z, p.y};
+    default: return {p.x, p.z, -p.y};
+  }
+}
+
+// Signed distance to clip plane k (inside when >= 0).
+inline float clip_distance(int k, const clip_vertex& c, float near) noexcept {
+  switch (k) {
+    case 0: return c.w - near;
+    case 1: return guard_band * c.w - c.u;
+    case 2: return guard_band * c.w + c.u;
+    case 3: return guard_band * c.w - c.v;
+    default: return guard_band * c.w + c.v;
+  }
+}
+
+inline bool lex_less(const clip_vertex& a, const clip_vertex& b) noexcept {
+  if (a.u != b.u) return a.u < b.u;
+  if (a.v != b.v) return a.v < b.v;
+  return a.w < b.w;
+}
+
+// The point where segment (a, b) crosses plane k. Computed from the endpoints in a canonical order
+// so that two triangles sharing the edge get the same bits.
+inline clip_vertex intersect(int k, clip_vertex a, clip_vertex b, float near) noexcept {
+  if (lex_less(b, a)) std::swap(a, b);
+  const float da = clip_distance(k, a, near), db = clip_distance(k, b, near);
+  const float t = da / (da - db);
+  return {a.u + t * (b.u - a.u), a.v + t * (b.v - a.v), a.w + t * (b.w - a.w)};
+}
+
+// Outcode bits of a local-frame point: bit 0 = below the tangent plane (z < 0), bits 1..12 the
+// face-frustum side planes (a point outside bit k's plane sets it). Face f is rejected for a
+// triangle when all three vertices share a bit of face_planes[f].
+enum : unsigned {
+  below = 1u << 0,
+  x_lt_y = 1u << 1, x_lt_my = 1u << 2,  // x - y < 0,  x + y < 0
+  mx_lt_y = 1u << 3, mx_lt_my = 1u << 4,  // -x - y < 0 (x + y > 0), -x + y < 0
+  x_lt_z = 1u << 5, mx_lt_z = 1u << 6,    // x - z < 0, -x - z < 0
+  y_lt_z = 1u << 7, my_lt_z = 1u << 8,    // y - z < 0, -y - z < 0
+  z_lt_x = 1u << 9, z_lt_mx = 1u << 10,   // z - x < 0, z + x < 0
+  z_lt_y = 1u << 11, z_lt_my = 1u << 12,  // z - y < 0, z + y < 0
+};
+
+// A face's frustum (with v >= 0 for side faces) is the set where none of its bits is set.
+constexpr unsigned face_planes[5] = {
+    z_lt_x | z_lt_mx | z_lt_y | z_lt_my,            // top: z >= |x|, z >= |y|
+    below | x_lt_y | x_lt_my | x_lt_z,              // +x: x >= |y|, x >= z >= 0
+    below | mx_lt_y | mx_lt_my | mx_lt_z,           // -x: -x >= |y|, -x >= z >= 0
+    below | mx_lt_my | x_lt_my | y_lt_z,            // +y: y >= |x| (y - x >= 0 is -x + y; y + x >= 0), y >= z
+    below | x_lt_y | mx_lt_y | my_lt_z,             // -y: -y >= |x|, -y >= z
+};
+
+inline unsigned outcode(const glm::vec3& p) noexcept {
+#if HEMILIGHT_RASTER_SSE2
+  // The same twelve differences as below, four per register (x + (-y) is x - y exactly; the sign
+  // of a zero cannot change a "< 0" test), so both versions give the same bits.
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 a = _mm_add_ps(_mm_setr_ps(p.x, p.x, -p.x, -p.x), _mm_setr_ps(-p.y, p.y, -p.y, p.y));
+  const __m128 b = _mm_sub_ps(_mm_setr_ps(p.x, -p.x, p.y, -p.y), _mm_set1_ps(p.z));
+  const __m128 c = _mm_add_ps(_mm_set1_ps(p.z), _mm_setr_ps(-p.x, p.x, -p.y, p.y));
+  return static_cast<unsigned>(p.z < 0) | static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(a, zero))) << 1 |
+         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(b, zero))) << 5 |
+         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(c, zero))) << 9;
+#else
+  unsigned c = 0;
+  if (p.z < 0) c |= below;
+  if (p.x - p.y < 0) c |= x_lt_y;
+  if (p.x + p.y < 0) c |= x_lt_my;
+  if (-p.x - p.y < 0) c |= mx_lt_y;
+  if (-p.x + p.y < 0) c |= mx_lt_my;
+  if (p.x - p.z < 0) c |= x_lt_z;
+  if (-p.x - p.z < 0) c |= mx_lt_z;
+  if (p.y - p.z < 0) c |= y_lt_z;
+  if (-p.y - p.z < 0) c |= my_lt_z;
+  if (p.z - p.x < 0) c |= z_lt_x;
+  if (p.z + p.x < 0) c |= z_lt_mx;
+  if (p.z - p.y < 0) c |= z_lt_y;
+  if (p.z + p.y < 0) c |= z_lt_my;
+  return c;
+#endif
+}
+
+// Faces whose frustum a world-space box may touch, given the local frame. Each local linear
+// function f = d . (p - x) is bounded over the box by its value at the centre +- d_abs . half;
+// the box is dropped from a face when one of the face's functions stays below -margin on it.
+// The margin absorbs the rounding difference between this test and the per-vertex outcodes.
+inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, const frame& f) noexcept {
+  const glm::vec3 c = 0.5f * (node.lo + node.hi) - position;
+  const glm::vec3 h = 0.5f * (node.hi - node.lo);
+  const float lx = glm::dot(f.t, c), ly = glm::dot(f.b, c), lz = glm::dot(f.n, c);
+  const float rx = glm::dot(glm::abs(f.t), h), ry = glm::dot(glm::abs(f.b), h), rz = glm::dot(glm::abs(f.n), h);
+  const float margin = 1e-5f * (std::fabs(lx) + std::fabs(ly) + std::fabs(lz) + rx + ry + rz);
+  // Upper bounds of +-x +- y etc. over the box (a sum of radii bounds the radius of a sum).
+  const auto out = [&](float centre, float radius) { return centre + radius < -margin; };
+  if (out(lz, rz)) return 0;  // entirely below the tangent plane
+  unsigned faces = 0;
+  if (!(out(lz - lx, rz + rx) || out(lz + lx, rz + rx) || out(lz - ly, rz + ry) || out(lz + ly, rz + ry))) faces |= 1u;
+  if (!(out(lx - ly, rx + ry) || out(lx + ly, rx + ry) || out(lx - lz, rx + rz))) faces |= 2u;
+  if (!(out(-lx - ly, rx + ry) || out(-lx + ly, rx + ry) || out(-lx - lz, rx + rz))) faces |= 4u;
+  if (!(out(ly - lx, rx + ry) || out(ly + lx, rx + ry) || out(ly - lz, ry + rz))) faces |= 8u;
+  if (!(out(-ly - lx, rx + ry) || out(-ly + lx, rx + ry) || out(-ly - lz, ry + rz))) faces |= 16u;
+  return faces;
+}
+
+// floor(a / 2^sub_bits) and ceil(a / 2^sub_bits) for any sign.
+// (Arithmetic right shift: floor for negative values too; every supported compiler does this,
+// and C++20 requires it.)
+inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >> sub_bits; }
+inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
+
+// floor(a / m) for m > 0 and |a|, m < 2^52: a double estimate (off by at most one, both are
+// exact doubles) made exact with integer checks; cheaper than a 64-bit division.
+inline std::int64_t floor_div(std::int64_t a, std::int64_t m) noexcept {
+  auto q = static_cast<std::int64_t>(static_cast<double>(a) / static_cast<double>(m));
+  while (q * m > a) --q;
+  while ((q + 1) * m <= a) ++q;
+  return q;
+}
+
+// Nearest integer, halves away from zero (deterministic, no libm call). |x| < 2^30 here.
+inline std::int64_t round_to_int(double x) noexcept {
+  return static_cast<std::int64_t>(x >= 0.0 ? x + 0.5 : x - 0.5);
+}
+
+struct fixed_point {
+  std::int64_t x, y;
+};
+
+#if HEMILIGHT_RASTER_SSE2
+// Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
+constexpr std::int64_t simd_extent = 32 * sub_one;
+
+// See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
+// E = ex x + ey y + e0; covered iff all three are >= 0.
+template <bool count_mode>
+void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3], const std::int64_t (&e0)[3],
+                              std::int64_t x_begin, std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
+                              float* depth, std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
+                              float dzdx, std::uint32_t draw) noexcept {
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+  __m128i step[3], row[3];
+  for (int k = 0; k < 3; ++k) {
+    // Values at (x_begin + lane, y_begin): exact in int64, small enough for int32 here.
+    const std::int64_t base = ex[k] * x_begin + ey[k] * y_begin + e0[k];
+    row[k] = _mm_setr_epi32(static_cast<std::int32_t>(base), static_cast<std::int32_t>(base + ex[k]),
+                            static_cast<std::int32_t>(base + 2 * ex[k]), static_cast<std::int32_t>(base + 3 * ex[k]));
+    step[k] = _mm_set1_epi32(static_cast<std::int32_t>(4 * ex[k]));
+  }
+  const __m128i dy0 = _mm_set1_epi32(static_cast<std::int32_t>(ey[0])), dy1 = _mm_set1_epi32(static_cast<std::int32_t>(ey[1])),
+                dy2 = _mm_set1_epi32(static_cast<std::int32_t>(ey[2]));
+  const __m128 dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
+  const __m128i id = _mm_set1_epi32(static_cast<std::int32_t>(draw));
+  const int xb = static_cast<int>(x_begin), xe = static_cast<int>(x_end);
+  for (std::int64_t y = y_begin; y <= y_end; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
+    const __m128 zr = _mm_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
+    __m128i a = row[0], b = row[1], c = row[2];
+    for (int x = xb; x <= xe; x += 4) {
+      // Covered lanes: the OR of the three values has a clear sign bit.
+      const __m128i in = _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(a, b), c), _mm_set1_epi32(-1));
+      a = _mm_add_epi32(a, step[0]);
+      b = _mm_add_epi32(b, step[1]);
+      c = _mm_add_epi32(c, step[2]);
+      if (_mm_movemask_epi8(in) == 0) continue;
+      if (x + 3 >= n) {
+        // Last group of the row would pass the row's end: scalar, lane by lane.
+        alignas(16) std::int32_t m[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(m), in);
+        for (int k = 0; k < 4 && x + k < n; ++k) {
+          if (!m[k]) continue;
+          const std::size_t i = r + static_cast<std::size_t>(x + k);
+          if (count_mode) {
+            ++counts[i];
+            continue;
+          }
+          float z = _mm_cvtss_f32(zr) + dzdx * static_cast<float>(x + k);
+          z = z > FLT_MIN ? z : FLT_MIN;
+          if (z > depth[i]) {
+            depth[i] = z;
+            ids[i] = draw;
+          }
+        }
+        continue;
+      }
+      const std::size_t i = r + static_cast<std::size_t>(x);
+      if (count_mode) {
+        __m128i* cp = reinterpret_cast<__m128i*>(counts + i);
+        _mm_storeu_si128(cp, _mm_sub_epi32(_mm_loadu_si128(cp), in));  // in = -1 where covered
+        continue;
+      }
+      const __m128 xf = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x), lane));
+      const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
+      const __m128 old = _mm_loadu_ps(depth + i);
+      const __m128 closer = _mm_and_ps(_mm_cmpgt_ps(z, old), _mm_castsi128_ps(in));
+      _mm_storeu_ps(depth + i, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
+      __m128i* ip = reinterpret_cast<__m128i*>(ids + i);
+      const __m128i mask = _mm_castps_si128(closer);
+      _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
+    }
+    row[0] = _mm_add_epi32(row[0], dy0);
+    row[1] = _mm_add_epi32(row[1], dy1);
+    row[2] = _mm_add_epi32(row[2], dy2);
+  }
+}
+#endif
+
+// The resolve loops, with restrict pointers so that the byte stores of the flags do not force
+// reloads (char stores may alias anything). Texels never written have depth 0 (their id is
+// stale): they are set to record 0, the sky. Stores are the bottleneck: one 16-byte store per texel
+// writes its RGB plus one float that the next texel overwrites (the last texel is written
+// exactly), and the flags go out eight at a time.
+void resolve_texels(std::size_t count, const float* __restrict depth, const float* __restrict lengths,
+                    std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
+                    float* __restrict distance, float* __restrict radiance, std::uint8_t* __restrict flags,
+                    bool simd) noexcept {
+  std::size_t i = 0;
+#if HEMILIGHT_RASTER_SSE2
+  if (simd) {
+    // One pass, four texels at a time: distance, id of unwritten texels -> 0, radiance, flags.
+    const __m128 zero = _mm_setzero_ps();
+    for (; i + 4 < count; i += 4) {  // '<': the 16-byte radiance stores never pass the end
+      const __m128 d = _mm_loadu_ps(depth + i);
+      _mm_storeu_ps(distance + i, _mm_div_ps(_mm_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
+      const __m128i id = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)),
+                                       _mm_castps_si128(_mm_cmpgt_ps(d, zero)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(ids + i), id);
+      std::uint32_t lane[4];
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
+      std::uint8_t packed[4];
+      for (std::size_t k = 0; k < 4; ++k) {
+        const hemicube_rasterizer::shade& sh = shades[lane[k]];
+        _mm_storeu_ps(radiance + 3 * (i + k), _mm_loadu_ps(&sh.r));
+        packed[k] = static_cast<std::uint8_t>(sh.flags);
+      }
+      std::memcpy(flags + i, packed, 4);
+    }
+  }
+#endif
+  // Scalar reference (and tail): the same values.
+  for (; i < count; ++i) {
+    distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
+    ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
+    const hemicube_rasterizer::shade& sh = shades[ids[i]];
+    radiance[3 * i] = sh.r;
+    radiance[3 * i + 1] = sh.g;
+    radiance[3 * i + 2] = sh.b;
+    flags[i] = static_cast<std::uint8_t>(sh.flags);
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// radiance_texture
+// ---------------------------------------------------------------------------------------------
+
+void radiance_texture::validate(const char* who) const {
+  if (!pixels) throw_invalid_argument(std::string(who) + ": texture pixels is null");
+  if (width <= 0 || height <= 0)
+    throw_invalid_argument(std::string(who) + ": texture size " + std::to_string(width) + " x " +
+                           std::to_string(height) + " is invalid; both must be positive");
+  if (channels != 3 && channels != 4)
+    throw_invalid_argument(std::string(who) + ": texture channels is " + std::to_string(channels) + "; it must be 3 or 4");
+}
+
+glm::vec3 radiance_texture::sample(const glm::vec2& uv) const noexcept {
+  // Continuous texel coordinates (centres at integers), clamped to the edge centres: the same as
+  // clamp-to-edge bilinear filtering; NaN fails both comparisons and lands on 0.
+  float px = uv.x * static_cast<float>(width) - 0.5f, py = uv.y * static_cast<float>(height) - 0.5f;
+  const float wmax = static_cast<float>(width - 1), hmax = static_cast<float>(height - 1);
+  px = px > 0.0f ? (px < wmax ? px : wmax) : 0.0f;
+  py = py > 0.0f ? (py < hmax ? py : hmax) : 0.0f;
+  const int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const float fx = px - static_cast<float>(x0), fy = py - static_cast<float>(y0);
+  const auto at = [&](int x, int y) {
+    const float* p = pixels + (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) *
+                                  static_cast<std::size_t>(channels);
+    return glm::vec3(p[0], p[1], p[2]);
+  };
+  const glm::vec3 top = (1.0f - fx) * at(x0, y0) + fx * at(x1, y0);
+  const glm::vec3 bottom = (1.0f - fx) * at(x0, y1) + fx * at(x1, y1);
+  return (1.0f - fy) * top + fy * bottom;
+}
+
+float default_near_distance(const scene& s) noexcept {
+  const float d = 1e-4f * s.size();
+  return d > 0.0f ? d : 1e-4f;
+}
+
+// ---------------------------------------------------------------------------------------------
+// hemicube_rasterizer
+// ---------------------------------------------------------------------------------------------
+
+hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options) : scene_(std::move(s)) {
+  if (!scene_) throw_invalid_argument("hemicube_rasterizer: scene is null");
+  if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
+    throw_invalid_argument("hemicube_rasterizer: near_distance is " + std::to_string(options.near_distance) +
+                           "; it must be finite and >= 0 (0 = default)");
+  near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
+  simd_ = options.simd;
+}
+
+void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
+                                          int resolution) const {
+  const std::string w(who);
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(position[c]))
+      throw_invalid_argument(w + ": position." + "xyz"[c] + " is " + std::to_string(position[c]) + "; it must be finite");
+  const glm::vec3* axes[3] = {&basis.t, &basis.b, &basis.n};
+  const char* names[3] = {"t", "b", "n"};
+  for (int a = 0; a < 3; ++a) {
+    const float len = glm::length(*axes[a]);
+    if (!(std::fabs(len - 1.0f) <= 1e-3f))
+      throw_invalid_argument(w + ": basis." + names[a] + " has length " + std::to_string(len) +
+                             "; the frame must be orthonormal (tolerance 1e-3)");
+  }
+  const float dots[3] = {glm::dot(basis.t, basis.b), glm::dot(basis.t, basis.n), glm::dot(basis.b, basis.n)};
+  const char* pairs[3] = {"t . b", "t . n", "b . n"};
+  for (int k = 0; k < 3; ++k)
+    if (!(std::fabs(dots[k]) <= 1e-3f))
+      throw_invalid_argument(w + ": basis " + pairs[k] + " = " + std::to_string(dots[k]) +
+                             "; the frame must be orthonormal (tolerance 1e-3)");
+  if (!(glm::dot(glm::cross(basis.t, basis.b), basis.n) > 0.0f))
+    throw_invalid_argument(w + ": basis is left-handed ((t x b) . n < 0); it must be right-handed");
+  if (!is_valid_hemicube_resolution(resolution))
+    throw_invalid_argument(w + ": resolution " + std::to_string(resolution) +
+                           " is invalid: it must be even and in [2, 4096]");
+}
+
+void hemicube_rasterizer::prepare(int resolution) {
+  const std::size_t count = hemicube_texel_count(resolution);
+  if (n_ != resolution) {
+    directions_.resize(count);
+    lengths_.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const hemicube_texel t = hemicube_texel_from_index(resolution, i);
+      const glm::dvec2 c = hemicube_texel_min_corner(resolution, t) + glm::dvec2(1.0 / resolution);
+      const glm::dvec3 d = hemicube_face_point(t.face, c.x, c.y);
+      lengths_[i] = static_cast<float>(glm::length(d));
+      directions_[i] = glm::vec3(glm::normalize(d));
+    }
+    n_ = resolution;
+  }
+  depth_.assign(count, 0.0f);
+  ids_.resize(count);  // stale ids are masked by depth 0 (never written)
+  // Record 0 stands for "nothing hit" (the sky): texels start there.
+  draws_.clear();
+  draws_.push_back(draw_record{});
+  draws_.front().index = no_triangle;
+  shades_.clear();
+  shades_.push_back({0.0f, 0.0f, 0.0f, texel_miss});
+  stats_ = {};
+}
+
+std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
+  assert(texel < ids_.size());
+  return draws_[ids_[texel]].index;  // the resolve set unwritten texels to record 0
+}
+
+unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
+                                                               const glm::vec3& position, const frame& basis) const {
+  // A node far away compared with its size may fall between texel centres on every face it
+  // touches: then none of its triangles can cover a centre. Bound the node by its bounding
+  // sphere (centre c, radius R, local frame); on a face where it lies in front of the near plane,
+  // u = c.p / a.p over the sphere is bounded by the corners of (c.c +- R) / (a.c -+ R) (a ratio
+  // over a box with positive denominators takes its extremes at the corners). The margin (1/50
+  // texel) exceeds the rasterizer's snapping (1/512 texel) and the float error of this test, so
+  // the culling never changes a rendered texel.
+  const glm::vec3 centre = 0.5f * (node.lo + node.hi);
+  const glm::vec3 c = basis.to_local(centre - position);
+  // Grown by the float error of moving points to the local frame (the triangles' vertices carry
+  // the same kind of error, ~1 ulp of the world coordinates): far from the origin it matters.
+  const glm::vec3 scale = glm::max(glm::abs(centre), glm::abs(position));
+  const float radius = 0.5f * glm::length(node.hi - node.lo) + 1e-6f * (scale.x + scale.y + scale.z);
+  const float n = static_cast<float>(n_);
+  const float margin = 0.02f;
+  for (int f = 0; f < 5; ++f) {
+    if (!(mask >> f & 1u)) continue;
+    const clip_vertex cc = to_clip(f, c);
+    // Only nodes that span a few texels at most (and are in front of the near plane).
+    if (!(cc.w - radius >= near_) || radius * n > 4.0f * cc.w) continue;
+    const float inv_near = 1.0f / (cc.w - radius), inv_far = 1.0f / (cc.w + radius);
+    const float u0 = std::min((cc.u - radius) * inv_near, (cc.u - radius) * inv_far);
+    const float u1 = std::max((cc.u + radius) * inv_near, (cc.u + radius) * inv_far);
+    const float v0 = std::min((cc.v - radius) * inv_near, (cc.v - radius) * inv_far);
+    const float v1 = std::max((cc.v + radius) * inv_near, (cc.v + radius) * inv_far);
+    // Texel coordinates; centres at k + 1/2. Relative float error of the bounds is ~1e-6.
+    const float half = 0.5f * n, v_offset = f == 0 ? 1.0f : 0.0f;
+    const float x0 = (u0 + 1.0f) * half, x1 = (u1 + 1.0f) * half;
+    const float y0 = (v0 + v_offset) * half, y1 = (v1 + v_offset) * half;
+    const float m = margin + 1e-5f * (std::fabs(x0) + std::fabs(x1) + std::fabs(y0) + std::fabs(y1));
+    // Is there an integer k in the face with x0 - m <= k + 1/2 <= x1 + m? The range is a few
+    // texels wide; clamped to the face (a little beyond it), floor is a truncation of a positive
+    // value (no libm call).
+    const float rows = f == 0 ? n : half;
+    const auto has_centre = [](float lo, float hi, float count) {
+      // Integers K = k + 2 in [a, b] with K in [2, count + 1]; a, b shifted to be >= 1.
+      const float a = std::max(lo - 0.5f, -1.0f) + 2.0f, b = std::min(hi - 0.5f, count) + 2.0f;
+      if (!(b >= 2.0f) || !(a <= b)) return false;  // also false for NaN
+      const int floor_b = static_cast<int>(b);      // truncation = floor (b > 0)
+      const int ceil_a = static_cast<int>(a) + (static_cast<float>(static_cast<int>(a)) < a ? 1 : 0);
+      return std::max(ceil_a, 2) <= std::min(floor_b, static_cast<int>(count) + 1);
+    };
+    if (!has_centre(x0 - m, x1 + m, n) || !has_centre(y0 - m, y1 + m, rows)) mask &= ~(1u << f);
+  }
+  return mask;
+}
+
+template <hemicube_rasterizer::mode M>
+void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture) {
+  const std::vector<bvh_node>& nodes = scene_->bvh();
+  if (nodes.empty()) return;
+  const std::vector<scene::triangle>& tris = scene_->triangles();
+  // Stack entries: node index (low 27 bits are plenty: 2^31 triangles need < 2^29 nodes, so the
+  // face mask travels in a second word).
+  stack_.clear();
+  stack_.push_back(0);
+  stack_.push_back(31);
+  while (!stack_.empty()) {
+    const unsigned parent_mask = stack_.back();
+    stack_.pop_back();
+    const std::uint32_t ni = stack_.back();
+    stack_.pop_back();
+    const bvh_node& node = nodes[ni];
+    ++stats_.nodes_visited;
+    unsigned mask = parent_mask & node_faces(node, position, basis);
+    if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis);
+    if (!mask) continue;
+    if (node.count == 0) {
+      stack_.push_back(node.first + 1);
+      stack_.push_back(mask);
+      stack_.push_back(node.first);
+      stack_.push_back(mask);
+      continue;
+    }
+    for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis, texture);
+  }
+}
+
+template <hemicube_rasterizer::mode M>
+void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
+                                        const frame& basis, const radiance_texture* texture) {
+  ++stats_.triangles_tested;
+  const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
+                              basis.to_local(tri.v2 - position)};
+  const unsigned common = outcode(local[0]) & outcode(local[1]) & outcode(local[2]);
+  unsigned faces = 0;
+  for (int f = 0; f < 5; ++f)
+    if ((face_mask >> f & 1u) && !(common & face_planes[f])) faces |= 1u << f;
+  if (!faces) return;
+
+  draw_record rec;
+  // Edges and normal in world space (differences of the stored positions), then rotated.
+  const glm::vec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+  rec.normal = basis.to_local(glm::cross(e1, e2));
+  rec.v0 = local[0];
+  rec.plane = glm::dot(rec.normal, rec.v0);
+  // A plane through the point is seen edge-on: it covers no texel centre.
+  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
+  rec.index = tri.index;
+  // The rest of the record (material, texture gradients) is filled in when the triangle first
+  // covers a texel centre: most triangles of big scenes cover none.
+  std::uint32_t draw = 0;
+  for (int f = 0; f < 5; ++f)
+    if (faces >> f & 1u) {
+      ++stats_.face_triangles;
+      raster_face<M>(f, local, rec, draw, basis, tri, texture);
+    }
+}
+
+std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
+                                                 const radiance_texture* texture) {
+  const material& m = scene_->triangle_material(tri.index);
+  const bool back = rec.plane > 0.0f && !m.two_sided;
+  rec.flags = back ? texel_back_face : texel_hit_front;
+  rec.radiance = back ? glm::vec3(0.0f) : m.emission;
+  rec.textured = !back && texture && scene_->has_lightmap_uvs();
+  if (rec.textured) {
+    const glm::vec3 le1 = basis.to_local(tri.v1 - tri.v0), le2 = basis.to_local(tri.v2 - tri.v0);
+    const float nn = glm::dot(rec.normal, rec.normal);
+    rec.grad_b1 = glm::cross(le2, rec.normal) / nn;
+    rec.grad_b2 = glm::cross(rec.normal, le1) / nn;
+  }
+  const auto draw = static_cast<std::uint32_t>(draws_.size());
+  draws_.push_back(rec);
+  shades_.push_back({rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags});
+  return draw;
+}
+
+template <hemicube_rasterizer::mode M>
+void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
+                                      const frame& basis, const scene::triangle& tri,
+                                      const radiance_texture* texture) {
+  const int n = n_;
+  const int rows = face == 0 ? n : n / 2;
+  const float near = near_;
+
+  // Clip in homogeneous coordinates.
+  clip_vertex poly[max_clip_vertices + 1], tmp[max_clip_vertices + 1];
+  int count = 3;
+  unsigned all_out = 31, any_out = 0;
+  for (int i = 0; i < 3; ++i) {
+    poly[i] = to_clip(face, local[i]);
+    // The five plane tests of clip_distance, written out (no switch in the loop).
+    const clip_vertex& c = poly[i];
+    const float gw = guard_band * c.w;
+#if HEMILIGHT_RASTER_SSE2
+    // gw + (-u) is gw - u exactly: the same bits as the scalar expressions.
+    const __m128 d = _mm_add_ps(_mm_set1_ps(gw), _mm_setr_ps(-c.u, c.u, -c.v, c.v));
+    const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) |
+                          static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps()))) << 1;
+#else
+    const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) | static_cast<unsigned>(gw - c.u < 0.0f) << 1 |
+                          static_cast<unsigned>(gw + c.u < 0.0f) << 2 | static_cast<unsigned>(gw - c.v < 0.0f) << 3 |
+                          static_cast<unsigned>(gw + c.v < 0.0f) << 4;
+#endif
+    all_out &= code;
+    any_out |= code;
+  }
+  if (all_out) return;
+  if (any_out) ++stats_.clipped;
+  for (int k = 0; k < 5 && count >= 3; ++k) {
+    if (!(any_out >> k & 1u)) continue;
+    int out = 0;
+    for (int i = 0; i < count; ++i) {
+      const clip_vertex& a = poly[i];
+      const clip_vertex& b = poly[(i + 1) % count];
+      const bool ina = clip_distance(k, a, near) >= 0.0f, inb = clip_distance(k, b, near) >= 0.0f;
+      if (ina) tmp[out++] = a;
+      if (ina != inb) tmp[out++] = intersect(k, a, b, near);
+    }
+    std::copy(tmp, tmp + out, poly);
+    count = out;
+  }
+  if (count < 3) return;
+
+  // Project and snap. Side faces: v in [0, 1] maps to rows [0, N/2).
+  // In double: coordinates up to 2^29 keep their 1/256-texel precision.
+  const double scale = 0.5 * n * static_cast<double>(sub_one);
+  const double v_offset = face == 0 ? 1.0 : 0.0;
+  fixed_point fx[max_clip_vertices + 1];
+  for (int i = 0; i < count; ++i) {
+    const double iw = 1.0 / static_cast<double>(poly[i].w);
+    fx[i] = {round_to_int((poly[i].u * iw + 1.0) * scale), round_to_int((poly[i].v * iw + v_offset) * scale)};
+  }
+
+  // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
+  // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
+  // Evaluated per row in double, then per texel in float.
+  const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
+  const double inv_k = 1.0 / static_cast<double>(rec.plane);
+  const double step = 2.0 / n;
+  const double u0 = 1.0 / n - 1.0, v0 = face == 0 ? 1.0 / n - 1.0 : 1.0 / n;
+  const auto dzdx = static_cast<float>(nm.u * step * inv_k);
+  const double dzdy = nm.v * step * inv_k;
+  const double z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
+
+  const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+  float* depth = depth_.data() + face_offset;
+  std::uint32_t* ids = ids_.data() + face_offset;
+  std::uint32_t* counts = M == mode::count ? counts_->data() + face_offset : nullptr;
+
+  // Writes the texels [lo, hi] of row y.
+  const auto span = [&](int y, int lo, int hi) {
+    ++stats_.spans;
+    stats_.fragments += static_cast<std::size_t>(hi - lo + 1);
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
+    if (M == mode::count) {
+      for (int x = lo; x <= hi; ++x) ++counts[row + static_cast<std::size_t>(x)];
+      return;
+    }
+    const auto zrow = static_cast<float>(z00 + dzdy * y);
+    float* drow = depth + row;
+    std::uint32_t* irow = ids + row;
+    int x = lo;
+#if HEMILIGHT_RASTER_SSE2
+    if (simd_ && hi - lo >= 3) {
+      // Four texels at a time; the same operations in the same order as the scalar loop below,
+      // so the results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like
+      // the scalar select.
+      const __m128 zr = _mm_set1_ps(zrow), dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
+      const __m128i id = _mm_set1_epi32(static_cast<int>(draw)), lane = _mm_setr_epi32(0, 1, 2, 3);
+      for (; x + 3 <= hi; x += 4) {
+        const __m128 xf = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x), lane));
+        const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
+        const __m128 old = _mm_loadu_ps(drow + x);
+        const __m128 closer = _mm_cmpgt_ps(z, old);
+        _mm_storeu_ps(drow + x, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
+        __m128i* ip = reinterpret_cast<__m128i*>(irow + x);
+        const __m128i mask = _mm_castps_si128(closer);
+        _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
+      }
+    }
+#endif
+    // The scalar reference path (and the tail of the SIMD one).
+    for (; x <= hi; ++x) {
+      float z = zrow + dzdx * static_cast<float>(x);
+      // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and a
+      // covered texel must stay covered: clamp to the smallest positive depth (the farthest).
+      z = z > FLT_MIN ? z : FLT_MIN;
+      // Selects, not a branch: short spans would mispredict on every texel.
+      const float old = drow[x];
+      const bool closer = z > old;
+      drow[x] = closer ? z : old;
+      irow[x] = closer ? draw : irow[x];
+    }
+  };
+
+  // Fan of the clipped polygon.
+  for (int i = 1; i + 1 < count; ++i) {
+    fixed_point p[3] = {fx[0], fx[i], fx[i + 1]};
+    std::int64_t area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+    if (area == 0) continue;
+    if (area < 0) std::swap(p[1], p[2]);
+    const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
+    const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
+    // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
+    const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
+    const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
+    const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
+    const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
+    if (x_begin > x_end || y_begin > y_end) continue;
+    if (draw == 0) draw = commit_record(rec, basis, tri, texture);
+
+    // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
+    // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
+    // d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
+    // texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
+    std::int64_t ex[3], ey[3], e0[3];
+    for (int k = 0; k < 3; ++k) {
+      const fixed_point& a = p[k];
+      const fixed_point& b = p[(k + 1) % 3];
+      const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
+      const bool owned = dy > 0 || (dy == 0 && dx < 0);
+      ex[k] = -dy * sub_one;
+      ey[k] = dx * sub_one;
+      e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
+    }
+
+#if HEMILIGHT_RASTER_SSE2
+    if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
+      // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
+      // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
+      // additions, and the coverage mask goes straight into the depth test: no span search,
+      // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
+      small_triangle_sse2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                                 dzdy, dzdx, draw);
+      continue;
+    }
+#endif
+    if (x_end - x_begin < 24 && (x_end - x_begin + 1) * (y_end - y_begin + 1) <= 96) {
+      // Small box (most triangles of big scenes): step the edge functions texel by texel
+      // (additions only; a texel is in iff the OR of the three values is not negative) and
+      // write each row's run at once (the triangle is convex: the run is contiguous).
+      std::int64_t row0 = ex[0] * x_begin + ey[0] * y_begin + e0[0];
+      std::int64_t row1 = ex[1] * x_begin + ey[1] * y_begin + e0[1];
+      std::int64_t row2 = ex[2] * x_begin + ey[2] * y_begin + e0[2];
+      for (std::int64_t y = y_begin; y <= y_end; ++y, row0 += ey[0], row1 += ey[1], row2 += ey[2]) {
+        std::int64_t a = row0, b = row1, c = row2;
+        std::int64_t x = x_begin;
+        while (x <= x_end && (a | b | c) < 0) {
+          a += ex[0];
+          b += ex[1];
+          c += ex[2];
+          ++x;
+        }
+        if (x > x_end) continue;
+        const std::int64_t first = x;
+        while (x <= x_end && (a | b | c) >= 0) {
+          a += ex[0];
+          b += ex[1];
+          c += ex[2];
+          ++x;
+        }
+        span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
+      }
+      continue;
+    }
+
+    // Exact incremental spans. Edge k bounds x from the left when ex > 0:
+    // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
+    // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
+    // per row with additions only (a Bresenham-style exact walk).
+    struct walk {
+      int kind;  // +1 left bound, -1 right bound, 0 constant in x
+      std::int64_t bound, rem, m, q_step, r_step, value, value_step;
+    } w[3] = {};
+    for (int k = 0; k < 3; ++k) {
+      walk& e = w[k];
+      const std::int64_t r = ey[k] * y_begin + e0[k];
+      if (ex[k] > 0) {
+        e.kind = 1;
+        e.m = ex[k];
+        const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
+        e.bound = -floor_div(-num, e.m);
+        e.rem = e.bound * e.m - num;
+        const std::int64_t d = -ey[k];                     // num steps by d per row
+        e.q_step = floor_div(d, e.m);
+        e.r_step = d - e.q_step * e.m;
+      } else if (ex[k] < 0) {
+        e.kind = -1;
+        e.m = -ex[k];
+        e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
+        e.rem = r - e.bound * e.m;
+        e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
+        e.r_step = ey[k] - e.q_step * e.m;
+      } else {
+        e.kind = 0;
+        e.value = r;
+        e.value_step = ey[k];
+      }
+    }
+    for (std::int64_t y = y_begin; y <= y_end; ++y) {
+      std::int64_t lo = x_begin, hi = x_end;
+      for (walk& e : w) {
+        // The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
+        if (e.kind > 0) {
+          lo = std::max(lo, e.bound);
+          e.rem -= e.r_step;
+          const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
+          e.bound += e.q_step - carry;
+          e.rem += carry & e.m;
+        } else if (e.kind < 0) {
+          hi = std::min(hi, e.bound);
+          e.rem += e.r_step - e.m;
+          const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
+          e.bound += e.q_step + 1 + keep;
+          e.rem += keep & e.m;
+        } else {
+          if (e.value < 0) hi = lo - 1;
+          e.value += e.value_step;
+        }
+      }
+      if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
+    }
+  }
+}
+
+void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+                                 const radiance_texture* texture) {
+  const char* who = "hemicube_rasterizer::render";
+  check_arguments(who, position, basis, resolution);
+  if (texture) texture->validate(who);
+  prepare(resolution);
+  const glm::vec3 sky = scene_->sky_radiance();
+  shades_.front() = {sky.x, sky.y, sky.z, texel_miss};
+  draw_all<mode::depth>(position, basis, texture);
+
+  // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
+  // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
+  // triangle's exact plane evaluated at the texel centre, so this is the ray-plane intersection.
+  out.resize(resolution);
+  out.position = position;
+  out.basis = basis;
+  const std::size_t count = hemicube_texel_count(resolution);
+  const float* depth = depth_.data();
+  const float* lengths = lengths_.data();
+  std::uint32_t* ids = ids_.data();
+  const shade* shades = shades_.data();
+  float* distance = out.distance.data();
+  float* radiance = out.radiance.data();
+  std::uint8_t* flags = out.flags.data();
+  resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags, simd_);
+  if (!texture || !scene_->has_lightmap_uvs()) return;
+  // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
+  const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
+  const std::vector<std::uint32_t>& indices = scene_->indices();
+  for (std::size_t i = 0; i < count; ++i) {
+    const draw_record& rec = draws_[ids[i]];
+    if (!rec.textured) continue;
+    const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
+    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
+    const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
+    const glm::vec2& uv0 = uvs[indices[tri]];
+    const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+    const glm::vec3 l = texture->sample(uv);
+    radiance[3 * i] = l.x;
+    radiance[3 * i + 1] = l.y;
+    radiance[3 * i + 2] = l.z;
+  }
+}
+
+void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+                                          std::vector<std::uint32_t>& counts) {
+  check_arguments("hemicube_rasterizer::render_coverage", position, basis, resolution);
+  prepare(resolution);
+  counts.assign(hemicube_texel_count(resolution), 0u);
+  counts_ = &counts;
+  draw_all<mode::count>(position, basis, nullptr);
+  counts_ = nullptr;
+  std::fill(ids_.begin(), ids_.end(), 0u);  // seen_triangle() after this: no_triangle everywhere
+}
+
+}  // namespace hemilight

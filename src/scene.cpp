@@ -1,0 +1,218 @@
+#include "hemilight/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace hemilight {
+
+namespace {
+
+const char* const axis_name[3] = {"x", "y", "z"};
+
+void check_non_negative(const std::string& name, const glm::vec3& v) {
+  for (int c = 0; c < 3; ++c)
+    if (!(v[c] >= 0.0f) || !std::isfinite(v[c]))
+      throw_invalid_argument("scene::create: " + name + "." + "rgb"[c] + " is " + std::to_string(v[c]) +
+                             "; it must be finite and >= 0");
+}
+
+}  // namespace
+
+scene_desc scene_mesh::desc() const noexcept {
+  scene_desc d;
+  d.positions = positions.data();
+  d.vertex_count = positions.size();
+  d.indices = indices.data();
+  d.triangle_count = indices.size() / 3;
+  d.materials = materials.data();
+  d.lightmap_uvs = lightmap_uvs.empty() ? nullptr : lightmap_uvs.data();
+  d.sky_radiance = sky_radiance;
+  return d;
+}
+
+void scene_mesh::add_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const material& m) {
+  const auto base = static_cast<std::uint32_t>(positions.size());
+  positions.insert(positions.end(), {a, b, c});
+  indices.insert(indices.end(), {base, base + 1, base + 2});
+  materials.push_back(m);
+}
+
+void scene_mesh::add_quad(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
+                          const material& m) {
+  add_grid(a, b, c, d, 1, 1, m);
+}
+
+void scene_mesh::add_grid(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d, int nu,
+                          int nv, const material& m, bool flip) {
+  const auto base = static_cast<std::uint32_t>(positions.size());
+  const auto lerp = [](const glm::vec3& p, const glm::vec3& q, float s) { return (1.0f - s) * p + s * q; };
+  for (int j = 0; j <= nv; ++j) {
+    const float t = static_cast<float>(j) / static_cast<float>(nv);
+    // Edge points first (a-d and b-c), then across: grids sharing an edge agree bit for bit.
+    const glm::vec3 left = lerp(a, d, t), right = lerp(b, c, t);
+    for (int i = 0; i <= nu; ++i) positions.push_back(lerp(left, right, static_cast<float>(i) / static_cast<float>(nu)));
+  }
+  const auto row = static_cast<std::uint32_t>(nu + 1);
+  for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(nv); ++j)
+    for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(nu); ++i) {
+      const std::uint32_t p00 = base + j * row + i, p10 = p00 + 1, p01 = p00 + row, p11 = p01 + 1;
+      if (flip)
+        indices.insert(indices.end(), {p00, p11, p10, p00, p01, p11});
+      else
+        indices.insert(indices.end(), {p00, p10, p11, p00, p11, p01});
+      materials.push_back(m);
+      materials.push_back(m);
+    }
+}
+
+void scene_mesh::add_box(const glm::vec3& lo, const glm::vec3& hi, const material& m, bool inward) {
+  const glm::vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+  // Counter-clockwise seen from outside.
+  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+  for (const auto& f : faces) {
+    if (inward)
+      add_quad(p[f[3]], p[f[2]], p[f[1]], p[f[0]], m);
+    else
+      add_quad(p[f[0]], p[f[1]], p[f[2]], p[f[3]], m);
+  }
+}
+
+std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
+  if (desc.vertex_count > max_scene_elements)
+    throw error(status::out_of_memory, "scene::create: vertex_count " + std::to_string(desc.vertex_count) +
+                                           " is over the limit of " + std::to_string(max_scene_elements));
+  if (desc.triangle_count > max_scene_elements)
+    throw error(status::out_of_memory, "scene::create: triangle_count " + std::to_string(desc.triangle_count) +
+                                           " is over the limit of " + std::to_string(max_scene_elements));
+  if (desc.vertex_count > 0 && !desc.positions)
+    throw_invalid_argument("scene::create: positions is null but vertex_count is " + std::to_string(desc.vertex_count));
+  if (desc.triangle_count > 0 && !desc.indices)
+    throw_invalid_argument("scene::create: indices is null but triangle_count is " +
+                           std::to_string(desc.triangle_count));
+  check_non_negative("sky_radiance", desc.sky_radiance);
+
+  std::shared_ptr<scene> s(new scene());
+  s->sky_ = desc.sky_radiance;
+  s->positions_.assign(desc.positions, desc.positions + desc.vertex_count);
+  s->lo_ = glm::vec3(std::numeric_limits<float>::infinity());
+  s->hi_ = -s->lo_;
+  for (std::size_t i = 0; i < desc.vertex_count; ++i) {
+    const glm::vec3& p = s->positions_[i];
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(p[c]))
+        throw_invalid_argument("scene::create: positions[" + std::to_string(i) + "]." + axis_name[c] + " is " +
+                               std::to_string(p[c]) + "; positions must be finite");
+    s->lo_ = glm::min(s->lo_, p);
+    s->hi_ = glm::max(s->hi_, p);
+  }
+  // Diagonal in double: a float could overflow for coordinates near FLT_MAX.
+  if (desc.vertex_count > 0) {
+    const glm::dvec3 diag = glm::dvec3(s->hi_) - glm::dvec3(s->lo_);
+    s->size_ = static_cast<float>(std::min(glm::length(diag), double(std::numeric_limits<float>::max())));
+  }
+  if (desc.lightmap_uvs) {
+    s->uvs_.assign(desc.lightmap_uvs, desc.lightmap_uvs + desc.vertex_count);
+    for (std::size_t i = 0; i < s->uvs_.size(); ++i)
+      for (int c = 0; c < 2; ++c)
+        if (!std::isfinite(s->uvs_[i][c]))
+          throw_invalid_argument("scene::create: lightmap_uvs[" + std::to_string(i) + "]." + "uv"[c] + " is " +
+                                 std::to_string(s->uvs_[i][c]) + "; UVs must be finite");
+  }
+  s->indices_.assign(desc.indices, desc.indices + 3 * desc.triangle_count);
+  for (std::size_t i = 0; i < s->indices_.size(); ++i)
+    if (s->indices_[i] >= desc.vertex_count)
+      throw_invalid_argument("scene::create: indices[" + std::to_string(i) + "] = " + std::to_string(s->indices_[i]) +
+                             " is out of range: " + std::to_string(desc.vertex_count) + " vertices");
+  if (desc.materials) {
+    s->materials_.assign(desc.materials, desc.materials + desc.triangle_count);
+    for (std::size_t i = 0; i < s->materials_.size(); ++i) {
+      check_non_negative("materials[" + std::to_string(i) + "].emission", s->materials_[i].emission);
+      check_non_negative("materials[" + std::to_string(i) + "].albedo", s->materials_[i].albedo);
+    }
+  } else {
+    s->materials_.assign(desc.triangle_count, material{});
+  }
+
+  s->triangles_.reserve(desc.triangle_count);
+  for (std::size_t i = 0; i < desc.triangle_count; ++i) {
+    const glm::vec3& a = s->positions_[s->indices_[3 * i]];
+    const glm::vec3& b = s->positions_[s->indices_[3 * i + 1]];
+    const glm::vec3& c = s->positions_[s->indices_[3 * i + 2]];
+    // Zero area in double (exact for float inputs up to rounding of the products): never drawn.
+    const glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+    if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) continue;
+    s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
+  }
+  s->build_bvh();
+  return s;
+}
+
+void scene::build_bvh() {
+  nodes_.clear();
+  if (triangles_.empty()) return;
+  const std::size_t count = triangles_.size();
+  std::vector<glm::vec3> centroid(count), tlo(count), thi(count);
+  std::vector<std::uint32_t> order(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const triangle& t = triangles_[i];
+    tlo[i] = glm::min(t.v0, glm::min(t.v1, t.v2));
+    thi[i] = glm::max(t.v0, glm::max(t.v1, t.v2));
+    centroid[i] = 0.5f * tlo[i] + 0.5f * thi[i];
+    order[i] = static_cast<std::uint32_t>(i);
+  }
+  nodes_.reserve(2 * (count / max_leaf_triangles + 1));
+  // Median split on the longest axis of the centroids' box. Explicit stack of (node, begin, end).
+  struct task {
+    std::size_t node, begin, end;
+  };
+  std::vector<task> stack;
+  nodes_.push_back({});
+  stack.push_back({0, 0, count});
+  while (!stack.empty()) {
+    const task tk = stack.back();
+    stack.pop_back();
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+    glm::vec3 clo = lo, chi = hi;
+    for (std::size_t i = tk.begin; i < tk.end; ++i) {
+      lo = glm::min(lo, tlo[order[i]]);
+      hi = glm::max(hi, thi[order[i]]);
+      clo = glm::min(clo, centroid[order[i]]);
+      chi = glm::max(chi, centroid[order[i]]);
+    }
+    nodes_[tk.node].lo = lo;
+    nodes_[tk.node].hi = hi;
+    const std::size_t n = tk.end - tk.begin;
+    if (n <= max_leaf_triangles) {
+      nodes_[tk.node].first = static_cast<std::uint32_t>(tk.begin);
+      nodes_[tk.node].count = static_cast<std::uint32_t>(n);
+      continue;
+    }
+    const glm::vec3 ext = chi - clo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const std::size_t mid = tk.begin + n / 2;
+    const auto first = order.begin() + static_cast<std::ptrdiff_t>(tk.begin);
+    std::nth_element(first, order.begin() + static_cast<std::ptrdiff_t>(mid),
+                     order.begin() + static_cast<std::ptrdiff_t>(tk.end),
+                     [&](std::uint32_t x, std::uint32_t y) {
+                       const float cx = centroid[x][axis], cy = centroid[y][axis];
+                       return cx < cy || (cx == cy && x < y);  // deterministic order for ties
+                     });
+    // Children are allocated as a pair: left, then right = left + 1.
+    const std::size_t left = nodes_.size();
+    nodes_.push_back({});
+    const std::size_t right = nodes_.size();
+    nodes_.push_back({});
+    nodes_[tk.node].count = 0;
+    nodes_[tk.node].first = static_cast<std::uint32_t>(left);
+    stack.push_back({right, mid, tk.end});
+    stack.push_back({left, tk.begin, mid});
+  }
+  std::vector<triangle> sorted(count);
+  for (std::size_t i = 0; i < count; ++i) sorted[i] = triangles_[order[i]];
+  triangles_.swap(sorted);
+}
+
+}  // namespace hemilight

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The command-line baker on tiny OBJ files this script writes itself: a good quad bakes and
+# writes its outputs; every bad input gets one line on stderr and a non-zero exit.
+# usage: test_bake_cli.sh HEMILIGHT_BAKE TMPDIR
+set -uo pipefail
+bake=$1
+dir=$2/bake_cli
+rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
+fails=0
+
+# A 1 x 1 floor quad facing up (+y) with vt coordinates covering the unit square.
+cat > quad.obj <<'OBJ'
+v 0 0 0
+v 1 0 0
+v 1 0 1
+v 0 0 1
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 1 0
+f 1/1/1 4/4/1 3/3/1 2/2/1
+OBJ
+sed 's/^vt 1 1$/vt 1.5 1/' quad.obj > outside.obj
+grep -v '^vt' quad.obj | sed 's#/[0-9]*/#//#g' > nouv.obj
+sed 's/^vt 1 1$/vt 0 0/' quad.obj > flat.obj
+
+expect_ok() {
+  if ! "$bake" "$@" --quiet > ok.log 2>&1; then echo "FAIL: $* should succeed:"; cat ok.log; fails=$((fails + 1)); fi
+}
+expect_fail() {  # expect_fail WORDS... -- ARGS...
+  local words=() ; while [ "$1" != "--" ]; do words+=("$1"); shift; done; shift
+  "$bake" --quiet "$@" > out.log 2> err.log
+  local rc=$?
+  local lines; lines=$(grep -c . err.log)
+  if [ $rc -eq 0 ] || [ "$lines" -ne 1 ]; then
+    echo "FAIL: $* gave exit $rc and $lines stderr lines:"; cat err.log; fails=$((fails + 1)); return
+  fi
+  for w in "${words[@]}"; do
+    grep -q -- "$w" err.log || { echo "FAIL: $*: '$w' not in: $(cat err.log)"; fails=$((fails + 1)); }
+  done
+}
+
+# The sky (1, 1, 1) over an unoccluded up-facing quad gives E = pi everywhere.
+expect_ok quad.obj --size 16 --resolution 16 --bounces 1 --out res
+for f in res/quad_irradiance.exr res/quad_mask.exr res/quad_irradiance.png; do
+  [ -s "$f" ] || { echo "FAIL: $f not written"; fails=$((fails + 1)); }
+done
+grep -q "256 sampled" ok.log || { echo "FAIL: expected 256 sampled texels:"; cat ok.log; fails=$((fails + 1)); }
+"$bake" --help | grep -q "usage: hemilight_bake" || { echo "FAIL: --help"; fails=$((fails + 1)); }
+
+expect_fail "missing.obj" "no such file" -- missing.obj
+expect_fail "no texture coordinates" -- nouv.obj
+expect_fail "outside \[0, 1\]" -- outside.obj
+expect_fail "zero area in lightmap UV space" -- flat.obj
+expect_fail "--size 0" -- quad.obj --size 0
+expect_fail "--size 1000000" -- quad.obj --size 1000000
+expect_fail "--resolution 7" -- quad.obj --resolution 7
+expect_fail "--bounces 0" -- quad.obj --bounces 0
+expect_fail "--error 2" -- quad.obj --error 2
+expect_fail "unknown option --frobnicate" -- quad.obj --frobnicate
+expect_fail "--size needs a value" -- quad.obj --size
+
+[ $fails -eq 0 ] && echo "all bake CLI checks passed"
+exit $fails

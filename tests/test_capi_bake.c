@@ -1,0 +1,163 @@
+/* C99 test of the C ABI's lightmap baker: hemilight_bake_options_init, hemilight_bake_lightmap.
+ * Reference: a uniform sky of radiance L over unoccluded up-facing quads gives E = pi L at every
+ * texel (closed form). Bad input: every failure leaves the caller's buffers untouched.
+ * Prints failing checks and a closing "N passed, N failed" line. */
+#include "hemilight.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int passed = 0, failed = 0;
+#define CHECK(cond)                                            \
+  do {                                                         \
+    if (cond) {                                                \
+      ++passed;                                                \
+    } else {                                                   \
+      ++failed;                                                \
+      printf("FAILED %s:%d: %s\n", __FILE__, __LINE__, #cond); \
+    }                                                          \
+  } while (0)
+#define CHECK_FAILS(call, expected, needle)                                                      \
+  do {                                                                                           \
+    hemilight_status st_ = (call);                                                               \
+    CHECK(st_ == (expected) && strstr(hemilight_last_error(), (needle)) != NULL);                \
+    if (st_ != (expected) || strstr(hemilight_last_error(), (needle)) == NULL)                   \
+      printf("  call: %s\n  status %d, message: %s\n", #call, (int)st_, hemilight_last_error()); \
+  } while (0)
+
+#define W 8
+#define H 8
+static float out[3 * W * H];
+static uint8_t valid[W * H];
+
+static void fill_sentinel(void) {
+  int i;
+  for (i = 0; i < 3 * W * H; ++i) out[i] = -7.0f;
+  memset(valid, 9, sizeof valid);
+}
+static int untouched(void) {
+  int i;
+  for (i = 0; i < 3 * W * H; ++i)
+    if (out[i] != -7.0f) return 0;
+  for (i = 0; i < W * H; ++i)
+    if (valid[i] != 9) return 0;
+  return 1;
+}
+
+static int cancel_at_once(void* user, float fraction) {
+  (void)fraction;
+  ++*(int*)user;
+  return 0;
+}
+
+int main(void) {
+  /* Two unit floor quads side by side (x in [0, 1] and [1, 2]), facing up, each on half of the map. */
+  static const float pos_a[] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
+  static const float pos_b[] = {1, 0, 0, 2, 0, 0, 2, 0, -1, 1, 0, -1};
+  static const float uv_a[] = {0, 0, 0.5f, 0, 0.5f, 1, 0, 1};
+  static const float uv_b[] = {0.5f, 0, 1, 0, 1, 1, 0.5f, 1};
+  static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  hemilight_bake_mesh meshes[2];
+  hemilight_bake_options o;
+  hemilight_bake_stats stats;
+  int i, ok = 1, calls = 0;
+  float bad_uv[8], bad_pos[12];
+  uint32_t bad_idx[6];
+
+  memset(meshes, 0, sizeof meshes);
+  meshes[0].positions = pos_a;
+  meshes[0].lightmap_uvs = uv_a;
+  meshes[0].vertex_count = 4;
+  meshes[0].indices = idx;
+  meshes[0].triangle_count = 2;
+  meshes[0].material.albedo[0] = meshes[0].material.albedo[1] = meshes[0].material.albedo[2] = 0.5f;
+  meshes[1] = meshes[0];
+  meshes[1].positions = pos_b;
+  meshes[1].lightmap_uvs = uv_b;
+
+  hemilight_bake_options_init(&o);
+  hemilight_bake_options_init(NULL); /* ignored */
+  CHECK(o.width == 256 && o.resolution == 64 && o.bounces == 1 && o.use_cache == 1 && o.progress == NULL);
+  o.width = W;
+  o.height = H;
+  o.resolution = 16;
+  o.bounces = 2;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+
+  /* Good call: E = pi everywhere (the quads see only the sky: nothing bounces onto them). */
+  fill_sentinel();
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, &stats) == HEMILIGHT_OK);
+  for (i = 0; i < 3 * W * H; ++i)
+    if (fabs(out[i] - 3.14159265) > 1e-4) ok = 0; /* float sums of exact weights */
+  CHECK(ok);
+  for (i = 0; i < W * H; ++i)
+    if (valid[i] != 1) ok = 0;
+  CHECK(ok);
+  CHECK(stats.sampled_texels == W * H && stats.hemicubes > 0 && stats.invalid_texels == 0 && stats.seconds >= 0.0);
+  /* valid may be NULL, stats too. */
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL) == HEMILIGHT_OK);
+
+  /* Bad input: a clear message, nothing written. */
+  fill_sentinel();
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, NULL, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "options is NULL");
+  CHECK_FAILS(hemilight_bake_lightmap(NULL, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes is NULL");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 0, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "mesh_count is 0");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, NULL, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "irradiance_rgb is NULL");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H - 1, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "irradiance_capacity");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H - 1, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "valid_capacity");
+  o.width = 0;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "0 x 8 is invalid");
+  o.width = 1000000;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "1000000 x 8 is invalid");
+  o.width = W;
+  o.bounces = 0;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "bounces 0");
+  o.bounces = 1;
+  o.resolution = 15;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "resolution 15");
+  o.resolution = 16;
+  o.error_threshold = 0.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "error_threshold");
+  o.error_threshold = 0.2f;
+  o.use_cache = 2;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "use_cache is 2");
+  o.use_cache = 1;
+  o.sky_radiance[1] = -1.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "sky_radiance");
+  o.sky_radiance[1] = 1.0f;
+
+  memcpy(bad_uv, uv_b, sizeof bad_uv);
+  bad_uv[2] = 1.25f;
+  meshes[1].lightmap_uvs = bad_uv;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "outside [0, 1]");
+  bad_uv[2] = bad_uv[0]; /* vertex 1 = vertex 0 in UV: triangle 0 of mesh 1 (triangle 2 overall) is flat in UV */
+  bad_uv[3] = bad_uv[1];
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "zero area in lightmap UV space");
+  meshes[1].lightmap_uvs = uv_b;
+  memcpy(bad_idx, idx, sizeof bad_idx);
+  bad_idx[4] = 4;
+  meshes[1].indices = bad_idx;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes[1].indices[4] = 4 is out of range");
+  meshes[1].indices = idx;
+  memcpy(bad_pos, pos_b, sizeof bad_pos);
+  bad_pos[4] = (float)NAN;
+  meshes[1].positions = bad_pos;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "not finite");
+  meshes[1].positions = pos_b;
+  meshes[1].lightmap_uvs = NULL;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lightmap_uvs is NULL");
+  meshes[1].lightmap_uvs = uv_b;
+  meshes[0].material.albedo[0] = 2.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "albedo");
+  meshes[0].material.albedo[0] = 0.5f;
+
+  o.progress = cancel_at_once;
+  o.progress_user = &calls;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_CANCELLED, "cancelled");
+  CHECK(calls == 1);
+  CHECK(untouched());
+
+  printf("%d passed, %d failed\n", passed, failed);
+  return failed == 0 ? 0 : 1;
+}

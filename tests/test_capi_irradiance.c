@@ -1,0 +1,178 @@
+/* C99 test of the C ABI's irradiance entry points: hemilight_sample_irradiance,
+ * hemilight_cache_options_init, hemilight_cache_irradiance. References: closed forms (a uniform
+ * sky gives pi L; Lambert's formula for a quad emitter, written here in C).
+ * Prints failing checks and a closing "N passed, N failed" line. */
+#include "hemilight.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int passed = 0, failed = 0;
+#define CHECK(cond)                                            \
+  do {                                                         \
+    if (cond) {                                                \
+      ++passed;                                                \
+    } else {                                                   \
+      ++failed;                                                \
+      printf("FAILED %s:%d: %s\n", __FILE__, __LINE__, #cond); \
+    }                                                          \
+  } while (0)
+#define CHECK_FAILS(call, expected, needle)                                                          \
+  do {                                                                                               \
+    hemilight_status st_ = (call);                                                                   \
+    CHECK(st_ == (expected) && strstr(hemilight_last_error(), (needle)) != NULL);                    \
+    if (st_ != (expected) || strstr(hemilight_last_error(), (needle)) == NULL)                       \
+      printf("  call: %s\n  status %d, message: %s\n", #call, (int)st_, hemilight_last_error());     \
+  } while (0)
+
+static const double pi = 3.14159265358979323846;
+
+/* Lambert: irradiance at p (normal n) from a convex polygon of radiance 1 fully above the horizon. */
+static double lambert(const double (*v)[3], int count, const double p[3], const double n[3]) {
+  double sum = 0.0;
+  int i;
+  for (i = 0; i < count; ++i) {
+    double a[3], b[3], c[3], la = 0, lb = 0, lc = 0, d = 0;
+    int k;
+    for (k = 0; k < 3; ++k) {
+      a[k] = v[i][k] - p[k];
+      b[k] = v[(i + 1) % count][k] - p[k];
+    }
+    for (k = 0; k < 3; ++k) {
+      la += a[k] * a[k];
+      lb += b[k] * b[k];
+    }
+    la = sqrt(la);
+    lb = sqrt(lb);
+    for (k = 0; k < 3; ++k) {
+      a[k] /= la;
+      b[k] /= lb;
+      d += a[k] * b[k];
+    }
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+    lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    sum += atan2(lc, d) * (c[0] * n[0] + c[1] * n[1] + c[2] * n[2]) / lc;
+  }
+  return fabs(0.5 * sum);
+}
+
+static void test_sample(void) {
+  const float sky[3] = {1.0f, 2.0f, 3.0f};
+  const float zero_sky[3] = {0.0f, 0.0f, 0.0f};
+  const float p[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, 0.0f, 2.0f};
+  const float bad_p[3] = {0.0f, NAN, 0.0f}, zero_n[3] = {0.0f, 0.0f, 0.0f};
+  hemilight_scene* empty = NULL;
+  hemilight_scene* quad = NULL;
+  hemilight_irradiance r, untouched;
+  int c;
+  /* A 0.8 x 0.6 emitter (radiance 1, 0.5, 0.25) at height 1, facing down. */
+  const float pos[] = {-0.3f, -0.2f, 1.0f, -0.3f, 0.4f, 1.0f, 0.5f, 0.4f, 1.0f, 0.5f, -0.2f, 1.0f};
+  const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  const float rad[] = {1.0f, 0.5f, 0.25f, 1.0f, 0.5f, 0.25f};
+  const double v[4][3] = {{-0.3, -0.2, 1.0}, {-0.3, 0.4, 1.0}, {0.5, 0.4, 1.0}, {0.5, -0.2, 1.0}};
+  const double pd[3] = {0, 0, 0}, nd[3] = {0, 0, 1};
+  double e_ref;
+
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &empty) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(empty, p, up, 16, &r) == HEMILIGHT_OK);
+  /* Uniform sky: pi L to float rounding (1e-5 relative), zero gradients, nothing hit. */
+  for (c = 0; c < 3; ++c) CHECK(fabs(r.irradiance[c] / (pi * sky[c]) - 1.0) < 1e-5);
+  CHECK(r.translation_gradient[0][0] == 0.0f && r.translation_gradient[2][1] == 0.0f);
+  CHECK(fabs(r.rotation_gradient[1][0]) < 1e-5f);
+  CHECK(isinf(r.harmonic_mean_distance) && isinf(r.min_distance) && r.backface_fraction == 0.0f);
+
+  CHECK(hemilight_scene_create(pos, 4, idx, 2, rad, zero_sky, &quad) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(quad, p, up, 128, &r) == HEMILIGHT_OK);
+  e_ref = lambert(v, 4, pd, nd);
+  /* N = 128: the emitter's outline cuts ~0.5% of its texels' weight; 1% tolerance. */
+  CHECK(fabs(r.irradiance[0] / e_ref - 1.0) < 0.01);
+  CHECK(fabs(r.irradiance[1] / r.irradiance[0] - 0.5) < 1e-5);
+  CHECK(r.harmonic_mean_distance > 1.0f && isfinite(r.harmonic_mean_distance));
+  CHECK(fabs(r.min_distance - 1.0f) < 0.02f);
+
+  memset(&untouched, 0x5a, sizeof untouched);
+  r = untouched;
+  CHECK_FAILS(hemilight_sample_irradiance(NULL, p, up, 16, &r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_sample_irradiance(empty, bad_p, up, 16, &r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "position");
+  CHECK_FAILS(hemilight_sample_irradiance(empty, p, zero_n, 16, &r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "zero length");
+  CHECK_FAILS(hemilight_sample_irradiance(empty, p, up, 15, &r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "resolution 15");
+  CHECK_FAILS(hemilight_sample_irradiance(empty, p, up, 16, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "out is NULL");
+  CHECK(memcmp(&r, &untouched, sizeof r) == 0);
+  hemilight_scene_release(empty);
+  hemilight_scene_release(quad);
+}
+
+static int stop_at_once(void* user, float fraction) {
+  (void)fraction;
+  ++*(int*)user;
+  return 0;
+}
+
+static void test_cache(void) {
+  const float sky[3] = {0.5f, 1.0f, 2.0f};
+  hemilight_scene* empty = NULL;
+  hemilight_cache_options o;
+  hemilight_cache_stats stats;
+  enum { side = 20, count = side * side };
+  float* pos = (float*)malloc(sizeof(float) * 3 * count);
+  float* nrm = (float*)malloc(sizeof(float) * 3 * count);
+  float* out = (float*)malloc(sizeof(float) * 3 * count);
+  int i, ok = 1, calls = 0;
+  if (!pos || !nrm || !out) {
+    CHECK(0);
+    free(pos);
+    free(nrm);
+    free(out);
+    return;
+  }
+  for (i = 0; i < count; ++i) {
+    pos[3 * i] = (float)(i % side) * 0.1f;
+    pos[3 * i + 1] = (float)(i / side) * 0.1f;
+    pos[3 * i + 2] = 0.0f;
+    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
+    nrm[3 * i + 2] = 1.0f;
+  }
+  hemilight_cache_options_init(&o);
+  CHECK(o.resolution == 64 && o.error_threshold == 0.2f && o.use_gradients == 1 && o.thread_count == 0 && o.progress == NULL);
+  hemilight_cache_options_init(NULL); /* ignored */
+  o.resolution = 16;
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &empty) == HEMILIGHT_OK);
+  CHECK(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, &stats) == HEMILIGHT_OK);
+  for (i = 0; i < count; ++i) ok = ok && fabs(out[3 * i + 2] / (pi * sky[2]) - 1.0) < 1e-5;
+  CHECK(ok);
+  CHECK(stats.hemicubes > 0 && stats.hemicubes < count && stats.records == stats.hemicubes && stats.invalid_samples == 0);
+
+  out[0] = -1.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, 0, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "count is 0");
+  CHECK_FAILS(hemilight_cache_irradiance(NULL, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, NULL, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "options is NULL");
+  nrm[5] = 3.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "normals[1]");
+  nrm[5] = 1.0f;
+  o.error_threshold = 0.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "error_threshold");
+  o.error_threshold = 0.2f;
+  o.resolution = 7;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "resolution 7");
+  o.resolution = 16;
+  o.progress = stop_at_once;
+  o.progress_user = &calls;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_CANCELLED, "cancelled");
+  CHECK(calls == 1);
+  CHECK(out[0] == -1.0f); /* nothing written on any failure */
+  hemilight_scene_release(empty);
+  free(pos);
+  free(nrm);
+  free(out);
+}
+
+int main(void) {
+  test_sample();
+  test_cache();
+  printf("%d passed, %d failed\n", passed, failed);
+  return failed == 0 ? 0 : 1;
+}

@@ -1,0 +1,688 @@
+// Tests of raster.hpp (and the hemicube cross of hemicube.hpp): the software hemicube rasterizer.
+// References, all independent of the rasterizer: a ray caster written here (double precision,
+// Moeller-Trumbore-free: plane intersection + edge planes through the eye), closed meshes built
+// here whose every direction from an inside point crosses exactly one triangle, and closed forms.
+#include "hemilight/raster.hpp"
+#include "hemilight/reference_scenes.hpp"
+#include "hemilight/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <cstring>
+#include <set>
+#include <string>
+
+using namespace hemilight;
+
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+// A frame with normal n rolled by `roll` radians about n (built here, not by make_frame).
+frame rolled_frame(glm::dvec3 n, double roll) {
+  n = glm::normalize(n);
+  const glm::dvec3 helper = std::fabs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 t0 = glm::normalize(glm::cross(helper, n));
+  const glm::dvec3 b0 = glm::cross(n, t0);
+  const glm::dvec3 t = std::cos(roll) * t0 + std::sin(roll) * b0;
+  const glm::dvec3 b = glm::cross(n, t);
+  return {glm::vec3(t), glm::vec3(b), glm::vec3(n)};
+}
+
+frame random_frame(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 6.283185307179586);
+  glm::dvec3 n;
+  do n = {g(rng), g(rng), g(rng)};
+  while (glm::length(n) < 1e-3);
+  return rolled_frame(n, u(rng));
+}
+
+// ---- the independent ray caster ------------------------------------------------------------------
+
+struct ray_result {
+  bool ambiguous = false;  // the ray passes within `edge_eps` of an edge of a front-most candidate
+  long triangle = -1;      // scene_desc index, -1 for a miss
+  double t = inf;          // distance along the unit ray
+  bool back = false;       // hit the back of the triangle (winding)
+  glm::dvec2 uv{0.0};      // lightmap UV of the hit (if the mesh has UVs)
+};
+
+// Nearest triangle along the unit ray origin + t dir whose hit point is in front of the near plane
+// of the face with forward axis `forward` (the rasterizer clips w = forward . (p - origin) < near).
+// Edge proximity: the sine of the angle between dir and the plane through the eye and an edge.
+ray_result cast_ray(const scene_mesh& m, const glm::dvec3& origin, const glm::dvec3& dir, const glm::dvec3& forward,
+                    double near, double edge_eps) {
+  ray_result best;
+  bool best_near_edge = false;
+  const double fw = glm::dot(forward, dir);
+  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+    glm::dvec3 v[3];
+    for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(m.positions[m.indices[3 * i + static_cast<std::size_t>(k)]]) - origin;
+    const glm::dvec3 nrm = glm::cross(v[1] - v[0], v[2] - v[0]);
+    const double len = glm::length(nrm);
+    if (len == 0.0) continue;
+    const double denom = glm::dot(nrm, dir);
+    if (denom == 0.0) continue;
+    const double t = glm::dot(nrm, v[0]) / denom;
+    if (!(t > 0.0)) continue;
+    const double w = t * fw;
+    if (w < near * (1 - 1e-4)) continue;  // clipped away for sure
+    bool near_edge = std::fabs(w - near) <= 1e-4 * near;
+    // Edge planes through the eye: inside when all signed sines agree.
+    double s[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 c = glm::cross(v[k], v[(k + 1) % 3]);
+      const double cl = glm::length(c);
+      s[k] = cl > 0 ? glm::dot(dir, c) / cl : 0.0;
+    }
+    const bool inside = (s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0);
+    // Near an edge: inside the triangle grown by edge_eps, and within edge_eps of an edge's plane.
+    const bool inside_grown = (s[0] >= -edge_eps && s[1] >= -edge_eps && s[2] >= -edge_eps) ||
+                              (s[0] <= edge_eps && s[1] <= edge_eps && s[2] <= edge_eps);
+    const double closest = std::min({std::fabs(s[0]), std::fabs(s[1]), std::fabs(s[2])});
+    if (inside_grown && closest < edge_eps) near_edge = true;
+    // Grazing: the plane seen almost edge-on (|cos| < 1e-3); the distance is ill-conditioned.
+    if (std::fabs(denom) / len < 1e-3) near_edge = true;
+    if (!inside && !near_edge) continue;
+    if (t < best.t) {
+      best.t = t;
+      best_near_edge = near_edge;
+      best.triangle = inside ? static_cast<long>(i) : -1;
+      best.back = denom > 0;
+      if (!m.lightmap_uvs.empty()) {
+        const glm::dvec3 q = t * dir - v[0];
+        const double nn = glm::dot(nrm, nrm);
+        const double b1 = glm::dot(glm::cross(v[2] - v[0], nrm), q) / nn;
+        const double b2 = glm::dot(glm::cross(nrm, v[1] - v[0]), q) / nn;
+        const auto uv = [&](int k) { return glm::dvec2(m.lightmap_uvs[m.indices[3 * i + static_cast<std::size_t>(k)]]); };
+        best.uv = uv(0) + b1 * (uv(1) - uv(0)) + b2 * (uv(2) - uv(0));
+      }
+    }
+  }
+  best.ambiguous = best_near_edge;
+  if (best.ambiguous) best.triangle = -1;
+  if (best.triangle < 0 && !best.ambiguous) best.t = inf;
+  return best;
+}
+
+// Renders one hemicube and compares every unambiguous texel with the ray caster: the triangle
+// seen, the distance (relative error 1e-4: float plane intersection is good to ~1e-6 away from
+// grazing angles, which the caster excludes), the flags and the radiance (exact: copied).
+// Returns the number of texels checked.
+std::size_t compare_with_ray_caster(const scene_mesh& m, const glm::vec3& position, const frame& basis, int n,
+                                    float near = 0.0f, double min_checked = 0.8) {
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s, raster_options{near});
+  hemicube_buffer buf;
+  r.render(position, basis, n, buf);
+  // Edge margin: 2% of a texel's angular size (the fixed-point snapping moves edges by at most
+  // 1/512 texel, 10x less).
+  const double edge_eps = 0.02 * 2.0 / n / std::sqrt(3.0);
+  std::size_t checked = 0, ambiguous = 0, mismatches = 0;
+  std::string first;
+  for (std::size_t i = 0; i < hemicube_texel_count(n); ++i) {
+    const glm::dvec3 d = glm::dvec3(hemicube_texel_direction(n, i));
+    const glm::dvec3 a = glm::dvec3(hemicube_axes(hemicube_texel_from_index(n, i).face).forward);
+    const glm::dvec3 wd = glm::normalize(glm::dvec3(basis.t) * d.x + glm::dvec3(basis.b) * d.y + glm::dvec3(basis.n) * d.z);
+    const ray_result ref = cast_ray(m, glm::dvec3(position), wd, glm::dvec3(basis.t) * a.x + glm::dvec3(basis.b) * a.y + glm::dvec3(basis.n) * a.z,
+                                    r.near_distance(), edge_eps);
+    if (ref.ambiguous) {
+      ++ambiguous;
+      continue;
+    }
+    ++checked;
+    const std::uint32_t seen = r.seen_triangle(i);
+    bool ok;
+    glm::vec3 expected_radiance;
+    std::uint8_t expected_flags;
+    if (ref.triangle < 0) {
+      ok = seen == hemicube_rasterizer::no_triangle && std::isinf(buf.distance[i]);
+      expected_radiance = m.sky_radiance;
+      expected_flags = texel_miss;
+    } else {
+      const material& mat = m.materials[static_cast<std::size_t>(ref.triangle)];
+      const bool back = ref.back && !mat.two_sided;
+      expected_radiance = back ? glm::vec3(0.0f) : mat.emission;
+      expected_flags = back ? texel_back_face : texel_hit_front;
+      ok = seen == static_cast<std::uint32_t>(ref.triangle) && std::fabs(buf.distance[i] - ref.t) <= 1e-4 * ref.t;
+    }
+    ok = ok && buf.flags[i] == expected_flags && buf.radiance[3 * i] == expected_radiance.x &&
+         buf.radiance[3 * i + 1] == expected_radiance.y && buf.radiance[3 * i + 2] == expected_radiance.z;
+    if (!ok && mismatches++ == 0)
+      first = "texel " + std::to_string(i) + ": rasterizer triangle " + std::to_string(static_cast<long>(seen == hemicube_rasterizer::no_triangle ? -1 : long(seen))) +
+              " distance " + std::to_string(buf.distance[i]) + " flags " + std::to_string(buf.flags[i]) +
+              "; ray caster triangle " + std::to_string(ref.triangle) + " distance " + std::to_string(ref.t);
+  }
+  INFO("N = " << n << ", checked " << checked << ", ambiguous " << ambiguous << ", first mismatch: " << first);
+  CHECK(mismatches == 0);
+  // Ambiguous texels are a thin set (near edges): most of the hemicube must be checked.
+  CHECK(static_cast<double>(checked) >= min_checked * static_cast<double>(hemicube_texel_count(n)));
+  return checked;
+}
+
+// ---- closed meshes -----------------------------------------------------------------------------
+
+// Orients every triangle of m so its front faces the point `inside` (for a star-shaped mesh).
+void face_towards(scene_mesh& m, const glm::vec3& inside) {
+  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+    std::uint32_t* idx = m.indices.data() + 3 * i;
+    const glm::dvec3 a(m.positions[idx[0]]), b(m.positions[idx[1]]), c(m.positions[idx[2]]);
+    if (glm::dot(glm::cross(b - a, c - a), glm::dvec3(inside) - a) < 0) std::swap(idx[1], idx[2]);
+  }
+}
+
+// A unit sphere triangulated irregularly: rings at jittered polar angles with random vertex
+// counts and phases, zipped together; pole fans. Every vertex is shared by index: closed.
+scene_mesh irregular_sphere(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::uniform_int_distribution<int> count(5, 17);
+  const double pi = 3.14159265358979323846;
+  scene_mesh m;
+  const int rings = 9;
+  // Per ring: vertex indices and their azimuths (increasing, starting within half a segment of 0).
+  std::vector<std::vector<std::uint32_t>> ring(rings);
+  std::vector<std::vector<double>> azimuth(rings);
+  m.positions.push_back({0, 0, 1});  // north pole
+  for (std::size_t j = 0; j < rings; ++j) {
+    const double theta = pi * (static_cast<double>(j) + 1.0 + 0.6 * (u(rng) - 0.5)) / (rings + 1);
+    const int k = count(rng);
+    const double seg = 2 * pi / k;
+    const double phase = 0.5 * seg * u(rng);
+    for (int i = 0; i < k; ++i) {
+      const double phi = phase + seg * (i + 0.4 * u(rng));
+      azimuth[j].push_back(phi);
+      ring[j].push_back(static_cast<std::uint32_t>(m.positions.size()));
+      m.positions.push_back(glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)));
+    }
+  }
+  const auto south = static_cast<std::uint32_t>(m.positions.size());
+  m.positions.push_back({0, 0, -1});
+  const material mat{glm::vec3(1.0f), glm::vec3(0.5f), false};
+  const auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    m.indices.insert(m.indices.end(), {a, b, c});
+    m.materials.push_back(mat);
+  };
+  const auto& first = ring.front();
+  for (std::size_t i = 0; i < first.size(); ++i) tri(0, first[i], first[(i + 1) % first.size()]);
+  const auto& last = ring.back();
+  for (std::size_t i = 0; i < last.size(); ++i) tri(south, last[i], last[(i + 1) % last.size()]);
+  // Zip ring j and j + 1 by azimuth: always advance the ring whose next vertex comes first.
+  for (std::size_t j = 0; j + 1 < ring.size(); ++j) {
+    const auto& A = ring[j];
+    const auto& B = ring[j + 1];
+    const auto next = [&](std::size_t r, std::size_t i) {
+      const auto& az = azimuth[r];
+      return i + 1 < az.size() ? az[i + 1] : az[0] + 2 * pi;
+    };
+    std::size_t ia = 0, ib = 0;
+    while (ia < A.size() || ib < B.size()) {
+      const double fa = ia < A.size() ? next(j, ia) : 1e9;
+      const double fb = ib < B.size() ? next(j + 1, ib) : 1e9;
+      if (fa <= fb) {
+        tri(A[ia % A.size()], A[(ia + 1) % A.size()], B[ib % B.size()]);
+        ++ia;
+      } else {
+        tri(A[ia % A.size()], B[(ib + 1) % B.size()], B[ib % B.size()]);
+        ++ib;
+      }
+    }
+  }
+  face_towards(m, glm::vec3(0.0f));
+  return m;
+}
+
+// An axis-aligned box [lo, hi] whose 12 edges carry random extra vertices (shared by the two
+// faces of the edge) and whose faces are fans from a random interior point: irregular, closed,
+// no T-junctions. Faces towards the inside unless `outward`.
+scene_mesh fan_box(std::mt19937& rng, const glm::vec3& lo, const glm::vec3& hi, bool outward = false) {
+  std::uniform_real_distribution<float> u(0.05f, 0.95f);
+  std::uniform_int_distribution<int> extra(0, 3);
+  scene_mesh m;
+  const auto corner = [&](int c) { return glm::vec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z); };
+  for (int c = 0; c < 8; ++c) m.positions.push_back(corner(c));
+  // Edge (a, b) with a < b -> its interior vertices in order from a to b.
+  std::vector<std::vector<std::uint32_t>> edge_points(64);
+  for (int a = 0; a < 8; ++a)
+    for (int bit = 1; bit < 8; bit <<= 1) {
+      if (a & bit) continue;
+      const int b = a | bit;
+      std::vector<float> ts(static_cast<std::size_t>(extra(rng)));
+      for (float& t : ts) t = u(rng);
+      std::sort(ts.begin(), ts.end());
+      for (float t : ts) {
+        edge_points[static_cast<std::size_t>(a * 8 + b)].push_back(static_cast<std::uint32_t>(m.positions.size()));
+        m.positions.push_back((1.0f - t) * corner(a) + t * corner(b));
+      }
+    }
+  const auto edge = [&](int a, int b) {
+    std::vector<std::uint32_t> pts = edge_points[static_cast<std::size_t>(std::min(a, b) * 8 + std::max(a, b))];
+    if (a > b) std::reverse(pts.begin(), pts.end());
+    return pts;
+  };
+  const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+  const material mat{glm::vec3(0.25f, 0.5f, 1.0f), glm::vec3(0.5f), false};
+  for (const auto& f : faces) {
+    std::vector<std::uint32_t> loop;
+    for (int k = 0; k < 4; ++k) {
+      loop.push_back(static_cast<std::uint32_t>(f[k]));
+      for (std::uint32_t p : edge(f[k], f[(k + 1) % 4])) loop.push_back(p);
+    }
+    const float s = u(rng), t = u(rng);
+    const glm::vec3 centre = (1 - t) * ((1 - s) * corner(f[0]) + s * corner(f[1])) + t * ((1 - s) * corner(f[3]) + s * corner(f[2]));
+    const auto ci = static_cast<std::uint32_t>(m.positions.size());
+    m.positions.push_back(centre);
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      m.indices.insert(m.indices.end(), {ci, loop[k], loop[(k + 1) % loop.size()]});
+      m.materials.push_back(mat);
+    }
+  }
+  face_towards(m, 0.5f * (lo + hi));
+  if (outward)
+    for (std::size_t i = 0; i < m.triangle_count(); ++i) std::swap(m.indices[3 * i + 1], m.indices[3 * i + 2]);
+  return m;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("raster: closed irregular meshes around the point cover every texel exactly once", "[raster]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int mesh = 0; mesh < 6; ++mesh) {
+    const bool sphere = mesh % 2 == 0;
+    const scene_mesh m = sphere ? irregular_sphere(rng) : fan_box(rng, {-0.7f, -1.1f, -0.9f}, {1.3f, 0.8f, 1.0f});
+    const auto s = scene::create(m.desc());
+    hemicube_rasterizer r(s);
+    std::vector<std::uint32_t> counts;
+    hemicube_buffer buf;
+    for (int k = 0; k < 12; ++k) {
+      // A random point well inside (the sphere's inscribed polyhedron contains the ball of
+      // radius 0.6; the box contains [-0.6, 0.7]^3).
+      glm::vec3 p(u(rng), u(rng), u(rng));
+      p *= 0.55f / std::max(1.0f, glm::length(p));
+      const frame f = random_frame(rng);
+      const int n = k % 3 == 0 ? 64 : (k % 3 == 1 ? 16 : 6);
+      r.render_coverage(p, f, n, counts);
+      std::size_t wrong = 0;
+      for (std::uint32_t c : counts) wrong += c != 1;
+      INFO("mesh " << mesh << " (" << (sphere ? "sphere" : "box") << ", " << m.triangle_count() << " triangles), N = " << n);
+      CHECK(wrong == 0);
+      r.render(p, f, n, buf);
+      std::size_t sky = 0, back = 0;
+      for (std::uint8_t fl : buf.flags) {
+        sky += (fl & texel_miss) != 0;
+        back += (fl & texel_back_face) != 0;
+      }
+      CHECK(sky == 0);
+      CHECK(back == 0);
+    }
+  }
+}
+
+TEST_CASE("raster: agrees with an independent ray caster on the reference scenes", "[raster]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  {
+    const scene_mesh m = cornell_box();
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 p(0.05f + 0.45f * u(rng), 0.02f + 0.5f * u(rng), 0.03f + 0.5f * u(rng));
+      compare_with_ray_caster(m, p, random_frame(rng), 24);
+    }
+    // On the floor, looking up (the baker's case).
+    compare_with_ray_caster(m, {0.4f, 0.0f, 0.1f}, rolled_frame({0, 1, 0}, 0.3), 32);
+  }
+  {
+    const scene_mesh m = hexagon_room(2);
+    compare_with_ray_caster(m, {0.5f, 1.5f, -0.3f}, random_frame(rng), 24);
+    compare_with_ray_caster(m, {1.0f, 3.0f, 0.5f}, rolled_frame({0, -1, 0}, 1.0), 24);  // on the ceiling
+  }
+  {
+    const scene_mesh m = sky_and_occluders();
+    compare_with_ray_caster(m, {0.0f, 0.0f, 0.0f}, rolled_frame({0, 1, 0}, 0.0), 24);
+    compare_with_ray_caster(m, {1.5f, 0.5f, -0.5f}, random_frame(rng), 24);
+  }
+}
+
+TEST_CASE("raster: hemicube resolutions N = 2 and N = 512", "[raster]") {
+  std::mt19937 rng(3);
+  const scene_mesh box = fan_box(rng, {-1, -1, -1}, {1, 2, 1.5f});
+  compare_with_ray_caster(box, {0.1f, 0.2f, -0.3f}, random_frame(rng), 2);
+  compare_with_ray_caster(cornell_box(), {0.3f, 0.2f, 0.25f}, random_frame(rng), 2);
+  const auto s = scene::create(box.desc());
+  hemicube_rasterizer r(s);
+  std::vector<std::uint32_t> counts;
+  r.render_coverage({0.1f, 0.2f, -0.3f}, random_frame(rng), 512, counts);
+  CHECK(std::count(counts.begin(), counts.end(), 1u) == static_cast<std::ptrdiff_t>(counts.size()));
+  compare_with_ray_caster(cornell_box(), {0.2f, 0.1f, 0.3f}, rolled_frame({0.3, 1, -0.2}, 0.7), 512);
+}
+
+TEST_CASE("raster: near-plane clipping of a wall crossing it and of a triangle through the point", "[raster]") {
+  const material grey{glm::vec3(0.5f), glm::vec3(0.5f), false};
+  // A wall x = 0.03 (local = world here) crossing the near plane 0.05: on the +x face it is entirely
+  // clipped, on the top face only where z >= 0.05 survives. The ray caster applies the same rule.
+  scene_mesh wall;
+  wall.add_quad({0.03f, -5, -1}, {0.03f, -5, 5}, {0.03f, 5, 5}, {0.03f, 5, -1}, grey);
+  wall.add_quad({5, -5, 4}, {5, 5, 4}, {-5, 5, 4}, {-5, -5, 4}, grey);  // a ceiling behind it
+  const frame identity{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  compare_with_ray_caster(wall, {0, 0, 0}, identity, 32, 0.05f);
+  {
+    const auto s = scene::create(wall.desc());
+    hemicube_rasterizer r(s, raster_options{0.05f});
+    hemicube_buffer buf;
+    r.render({0, 0, 0}, identity, 32, buf);
+    std::size_t on_wall_top = 0, on_wall_pos_x = 0;
+    for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+      const hemicube_face face = hemicube_texel_from_index(32, i).face;
+      if (r.seen_triangle(i) < 2 && face == hemicube_face::top) ++on_wall_top;
+      if (r.seen_triangle(i) < 2 && face == hemicube_face::pos_x) ++on_wall_pos_x;
+    }
+    CHECK(on_wall_top > 0);     // the wall is seen above z = near on the top face...
+    CHECK(on_wall_pos_x == 0);  // ...and clipped away on the +x face (x = 0.03 < near)
+  }
+  // A triangle through the point, tilted 30 degrees from the tangent plane, plus surroundings.
+  scene_mesh through;
+  through.add_triangle({-1, -1, -0.577f}, {1, -1, -0.577f}, {0, 2, 1.155f}, grey);
+  through.add_quad({-3, -3, 2}, {3, -3, 2}, {3, 3, 2}, {-3, 3, 2}, grey);
+  std::mt19937 rng(5);
+  compare_with_ray_caster(through, {0, 0, 0}, identity, 32);
+  compare_with_ray_caster(through, {0, 0, 0}, random_frame(rng), 32, 0.01f);
+}
+
+TEST_CASE("raster: geometry entirely behind the tangent plane is culled and never seen", "[raster]") {
+  std::mt19937 rng(9);
+  scene_mesh m = fan_box(rng, {-2, -2, -3}, {2, 2, -0.5f}, true);
+  m.sky_radiance = {0.5f, 0.25f, 2.0f};
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 16, buf);
+  for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+    REQUIRE(buf.flags[i] == texel_miss);
+    REQUIRE(std::isinf(buf.distance[i]));
+    REQUIRE((buf.radiance[3 * i] == 0.5f && buf.radiance[3 * i + 1] == 0.25f && buf.radiance[3 * i + 2] == 2.0f));
+  }
+  CHECK(r.statistics().triangles_tested == 0);  // the BVH root is rejected: no triangle is touched
+  CHECK(r.statistics().nodes_visited == 1);
+}
+
+TEST_CASE("raster: culling makes the cost follow what the hemicube can see", "[raster]") {
+  // Many boxes on a ground; a point on the ground sees everything above it, but a point facing
+  // down from above the boxes sees nothing: only a few BVH nodes are visited.
+  const auto s = scene::create(many_boxes(400).desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render({0, 2.5f, 0}, rolled_frame({0, 1, 0}, 0.0), 16, buf);
+  CHECK(r.statistics().triangles_tested == 0);
+  r.render({0, 0.5f, 0}, rolled_frame({1, 0, 0}, 0.0), 16, buf);
+  // Facing +x from the middle: about half the scene lies behind the tangent plane.
+  CHECK(r.statistics().triangles_tested < s->drawable_triangle_count() * 6 / 10);
+  CHECK(r.statistics().triangles_tested > 0);
+}
+
+TEST_CASE("raster: a point inside an outward-facing box sees back faces on every texel", "[raster]") {
+  std::mt19937 rng(13);
+  const scene_mesh m = fan_box(rng, {-1, -1, -1}, {1, 1, 1}, true);
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  for (int k = 0; k < 4; ++k) {
+    const frame f = random_frame(rng);
+    const glm::vec3 p(0.1f * static_cast<float>(k), -0.2f, 0.3f);
+    r.render(p, f, 16, buf);
+    for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+      REQUIRE(buf.flags[i] == texel_back_face);
+      REQUIRE((buf.radiance[3 * i] == 0 && buf.radiance[3 * i + 1] == 0 && buf.radiance[3 * i + 2] == 0));
+      // Closed form: distance to the box [-1, 1]^3 along d (float intersection, 1e-5 relative).
+      const glm::dvec3 d = glm::dvec3(f.to_world(hemicube_texel_direction(16, i)));
+      double t = inf;
+      for (int c = 0; c < 3; ++c)
+        if (d[c] != 0) t = std::min(t, ((d[c] > 0 ? 1.0 : -1.0) - p[c]) / d[c]);
+      REQUIRE(buf.distance[i] == Approx(t).epsilon(1e-5));
+    }
+    compare_with_ray_caster(m, p, f, 16);
+  }
+}
+
+TEST_CASE("raster: two-sided triangles look the same from both sides", "[raster]") {
+  scene_mesh m;
+  m.add_quad({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, {glm::vec3(2.0f, 3.0f, 4.0f), glm::vec3(0.5f), true});
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 8, buf);  // sees its back
+  const std::size_t centre = hemicube_texel_index(8, {hemicube_face::top, 4, 4});
+  CHECK(buf.flags[centre] == texel_hit_front);
+  CHECK(buf.radiance[3 * centre + 2] == 4.0f);
+  CHECK(buf.distance[centre] == Approx(std::sqrt(1.0 + 2 * (0.125 * 0.125))).epsilon(1e-6));
+}
+
+TEST_CASE("raster: degenerate triangles are accepted and never drawn", "[raster]") {
+  scene_mesh m;
+  const material lit{glm::vec3(1.0f), glm::vec3(0.5f), false};
+  m.add_triangle({0, 0, 1}, {0, 0, 1}, {1, 0, 1}, lit);            // two equal vertices
+  m.add_triangle({-1, -1, 1}, {0, 0, 1}, {1, 1, 1}, lit);          // collinear
+  m.add_triangle({0.2f, 0.2f, 1}, {0.2f, 0.2f, 1}, {0.2f, 0.2f, 1}, lit);  // a point
+  m.add_quad({-2, -2, 2}, {2, -2, 2}, {2, 2, 2}, {-2, 2, 2}, lit);  // a real ceiling behind them
+  m.indices.insert(m.indices.end(), {3, 3, 4});                    // repeated index
+  m.materials.push_back(lit);
+  const auto s = scene::create(m.desc());
+  CHECK(s->triangle_count() == 6);
+  CHECK(s->drawable_triangle_count() == 2);
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 32, buf);
+  std::set<std::uint32_t> seen;
+  for (std::size_t i = 0; i < buf.texel_count(); ++i) seen.insert(r.seen_triangle(i));
+  for (std::uint32_t t : seen) CHECK((t == 3 || t == 4 || t == hemicube_rasterizer::no_triangle));
+  compare_with_ray_caster(m, {0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 32);
+}
+
+TEST_CASE("raster: an empty scene is all sky", "[raster]") {
+  scene_mesh m;
+  m.sky_radiance = {1.0f, 2.0f, 3.0f};
+  const auto s = scene::create(m.desc());
+  CHECK(s->size() == 0.0f);
+  hemicube_rasterizer r(s);
+  CHECK(r.near_distance() == 1e-4f);
+  hemicube_buffer buf;
+  r.render({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 4, buf);
+  for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+    CHECK(buf.flags[i] == texel_miss);
+    CHECK(std::isinf(buf.distance[i]));
+    CHECK(buf.radiance[3 * i + 1] == 2.0f);
+    CHECK(r.seen_triangle(i) == hemicube_rasterizer::no_triangle);
+  }
+}
+
+TEST_CASE("raster: perspective-correct UVs on a textured quad at a grazing angle", "[raster]") {
+  // A long ceiling strip 0.2 above the point, seen at grazing angles far away. The texture's R
+  // and G are the continuous texel coordinates x, y: bilinear filtering reproduces a linear
+  // function exactly, so the radiance read back is the UV the rasterizer computed, and can be
+  // compared with the ray caster's UV. Affine (screen-space) interpolation would be off by
+  // many texels here.
+  scene_mesh m;
+  const material mat{glm::vec3(0.0f), glm::vec3(0.5f), false};
+  m.add_quad({-1, 0.5f, 0.2f}, {-1, 20, 0.2f}, {1, 20, 0.2f}, {1, 0.5f, 0.2f}, mat);  // faces down (-z)
+  m.lightmap_uvs = {{0, 0}, {0, 1}, {1, 0}, {1, 1}};  // add_quad's vertex order: a, b, d, c
+  const int w = 32, h = 64;
+  image tex = image::make(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      tex.at(x, y)[0] = static_cast<float>(x);
+      tex.at(x, y)[1] = static_cast<float>(y);
+    }
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  const frame identity{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const radiance_texture view(tex);
+  const int n = 64;
+  r.render({0, 0, 0}, identity, n, buf, &view);
+  std::size_t checked = 0, grazing = 0;
+  double worst = 0;
+  for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+    const glm::dvec3 d(hemicube_texel_direction(n, i));
+    const ray_result ref = cast_ray(m, {0, 0, 0}, d, glm::dvec3(hemicube_axes(hemicube_texel_from_index(n, i).face).forward),
+                                    r.near_distance(), 0.02 * 2.0 / n / std::sqrt(3.0));
+    if (ref.ambiguous || ref.triangle < 0) continue;
+    ++checked;
+    if (d.z < 0.1) ++grazing;
+    // Expected continuous texel coordinates, clamped like clamp-to-edge filtering.
+    const double ex = std::clamp(ref.uv.x * w - 0.5, 0.0, w - 1.0), ey = std::clamp(ref.uv.y * h - 0.5, 0.0, h - 1.0);
+    worst = std::max({worst, std::fabs(buf.radiance[3 * i] - ex), std::fabs(buf.radiance[3 * i + 1] - ey)});
+  }
+  INFO("checked " << checked << " texels (" << grazing << " at cos < 0.1), worst error " << worst << " texels");
+  CHECK(grazing > 20);
+  // 0.01 texel: float barycentrics at cos ~ 0.01 lose ~1e-5 of the quad's 64 texels.
+  CHECK(worst < 0.01);
+}
+
+TEST_CASE("raster: bad arguments give clear errors and leave the buffer untouched", "[raster]") {
+  const auto s = scene::create(cornell_box().desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  const frame identity{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const auto fails_with = [&](const glm::vec3& p, const frame& f, int n, const radiance_texture* tex, const char* text) {
+    try {
+      r.render(p, f, n, buf, tex);
+      FAIL("no error for " << text);
+    } catch (const error& e) {
+      CHECK(e.code() == status::invalid_argument);
+      CHECK_THAT(e.what(), Catch::Contains(text));
+    }
+    CHECK(buf.resolution == 0);
+  };
+  fails_with({std::nanf(""), 0, 0}, identity, 16, nullptr, "position.x is nan");
+  fails_with({0, std::numeric_limits<float>::infinity(), 0}, identity, 16, nullptr, "position.y is inf");
+  fails_with({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1.1f}}, 16, nullptr, "basis.n has length");
+  fails_with({0, 0, 0}, frame{{1, 0, 0}, {0.1f, 0.995f, 0}, {0, 0, 1}}, 16, nullptr, "basis t . b");
+  fails_with({0, 0, 0}, frame{{0, 1, 0}, {1, 0, 0}, {0, 0, 1}}, 16, nullptr, "left-handed");
+  fails_with({0, 0, 0}, identity, 15, nullptr, "resolution 15");
+  fails_with({0, 0, 0}, identity, 0, nullptr, "resolution 0");
+  const radiance_texture no_pixels;
+  fails_with({0, 0, 0}, identity, 16, &no_pixels, "pixels is null");
+  const float px[3] = {0, 0, 0};
+  const radiance_texture two_channels(px, 1, 1, 2);
+  fails_with({0, 0, 0}, identity, 16, &two_channels, "channels is 2");
+  CHECK_THROWS_WITH(hemicube_rasterizer(nullptr), Catch::Contains("scene is null"));
+  CHECK_THROWS_WITH(hemicube_rasterizer(s, raster_options{-1.0f}), Catch::Contains("near_distance is -1"));
+  CHECK_THROWS_WITH(hemicube_rasterizer(s, raster_options{std::nanf("")}), Catch::Contains("near_distance is nan"));
+  // The default near distance is 1e-4 of the scene's diagonal.
+  CHECK(r.near_distance() == Approx(1e-4 * std::sqrt(0.556 * 0.556 + 0.5488 * 0.5488 + 0.5592 * 0.5592)).epsilon(1e-5));
+}
+
+TEST_CASE("raster: rasterizers on several threads share one scene and agree with one thread", "[raster]") {
+  const auto s = scene::create(hexagon_room(2).desc());
+  std::mt19937 rng(17);
+  std::vector<glm::vec3> points(16);
+  std::vector<frame> frames(16);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    points[i] = {u(rng), 1.5f + 0.5f * u(rng), u(rng)};
+    frames[i] = random_frame(rng);
+  }
+  std::vector<hemicube_buffer> serial(points.size()), threaded(points.size());
+  hemicube_rasterizer one(s);
+  for (std::size_t i = 0; i < points.size(); ++i) one.render(points[i], frames[i], 16, serial[i]);
+  std::vector<hemicube_rasterizer> per_worker(static_cast<std::size_t>(resolve_thread_count(2)), hemicube_rasterizer(s));
+  parallel_for(points.size(), 2, 1, [&](int worker, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      per_worker[static_cast<std::size_t>(worker)].render(points[i], frames[i], 16, threaded[i]);
+  });
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    CHECK(serial[i].radiance == threaded[i].radiance);
+    CHECK(serial[i].distance == threaded[i].distance);
+    CHECK(serial[i].flags == threaded[i].flags);
+  }
+}
+
+TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round-trip", "[raster]") {
+  for (int n : {2, 8}) {
+    std::set<std::pair<int, int>> used;
+    for (std::size_t i = 0; i < hemicube_texel_count(n); ++i) {
+      const glm::ivec2 p = hemicube_cross_pixel(n, hemicube_texel_from_index(n, i));
+      REQUIRE((p.x >= 0 && p.x < 2 * n && p.y >= 0 && p.y < 2 * n));
+      REQUIRE(used.insert({p.x, p.y}).second);
+    }
+  }
+  // Top face texel (0, 0) (towards -x, -y) is at the picture's lower left of the centre square;
+  // +x side face is to the right of the top face.
+  CHECK(hemicube_cross_pixel(8, {hemicube_face::top, 0, 0}) == glm::ivec2(4, 11));
+  CHECK(hemicube_cross_pixel(8, {hemicube_face::pos_x, 0, 0}).x == 12);
+
+  const auto s = scene::create(cornell_box().desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render({0.3f, 0.25f, 0.05f}, rolled_frame({0, 0, 1}, 0.0), 8, buf);
+  const std::string prefix = std::string(HEMILIGHT_TEST_TMPDIR) + "/cross";
+  write_hemicube_exr(prefix, buf);
+  const image rad = read_exr(prefix + "_radiance.exr"), dist = read_exr(prefix + "_distance.exr"),
+              flags = read_exr(prefix + "_flags.exr");
+  REQUIRE((rad.width == 16 && rad.height == 16));
+  for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+    const glm::ivec2 p = hemicube_cross_pixel(8, hemicube_texel_from_index(8, i));
+    CHECK(rad.at(p.x, p.y)[1] == buf.radiance[3 * i + 1]);
+    CHECK(dist.at(p.x, p.y)[0] == (std::isinf(buf.distance[i]) ? 0.0f : buf.distance[i]));
+    CHECK(flags.at(p.x, p.y)[0] == ((buf.flags[i] & texel_miss) ? 1.0f : 0.0f));
+    CHECK(flags.at(p.x, p.y)[2] == 1.0f);
+  }
+  CHECK(flags.at(0, 0)[2] == 0.0f);  // a corner outside the cross
+  hemicube_buffer bad;
+  CHECK_THROWS_AS(write_hemicube_exr(prefix, bad), error);
+}
+
+TEST_CASE("raster: the SSE2 path gives bit-identical buffers to the scalar reference path", "[raster]") {
+  std::mt19937 rng(23);
+  const scene_mesh scenes[] = {cornell_box(), hexagon_room(2), sky_and_occluders(), heightfield(3000),
+                               fan_box(rng, {-1, -1, -1}, {1, 1, 1})};
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  for (const scene_mesh& m : scenes) {
+    const auto s = scene::create(m.desc());
+    raster_options scalar;
+    scalar.simd = false;
+    hemicube_rasterizer fast(s), reference(s, scalar);
+    hemicube_buffer a, b;
+    for (int k = 0; k < 6; ++k) {
+      const glm::vec3 p = 0.5f * (s->bounds_lo() + s->bounds_hi()) + glm::vec3(u(rng), u(rng), u(rng)) * 0.2f * s->size();
+      const frame f = random_frame(rng);
+      const int n = k % 2 ? 30 : 64;  // 30: spans whose length is not a multiple of 4
+      fast.render(p, f, n, a);
+      reference.render(p, f, n, b);
+      // Bitwise: compare the bytes (so NaN or -0 differences would show).
+      CHECK(std::memcmp(a.distance.data(), b.distance.data(), a.distance.size() * sizeof(float)) == 0);
+      CHECK(std::memcmp(a.radiance.data(), b.radiance.data(), a.radiance.size() * sizeof(float)) == 0);
+      CHECK(a.flags == b.flags);
+    }
+  }
+}
+
+TEST_CASE("raster: culling of small far nodes between texel centres changes no texel", "[raster]") {
+  // A fine heightfield seen at N = 16 from just above it: most BVH leaves far away are smaller
+  // than a texel and many fall between texel centres. The ray caster sees every triangle, so any
+  // texel lost to over-eager culling would show as a mismatch.
+  // Near the horizon the texels look at many tiny triangles, one of whose edges is usually
+  // within 2% of a texel: those texels are ambiguous, so only 30% of the hemicube (the sky and
+  // the nearer ground) is required to be checked here.
+  const scene_mesh m = heightfield(12000);
+  const glm::vec3 p(0.3f, 0.4f, -0.2f);
+  const frame f = rolled_frame({0.05, 1, 0.02}, 0.4);
+  compare_with_ray_caster(m, p, f, 16, 0.0f, 0.3);
+  const auto s = scene::create(m.desc());
+  hemicube_rasterizer r(s);
+  hemicube_buffer buf;
+  r.render(p, f, 16, buf);
+  std::size_t above = 0;  // triangles with a vertex above the tangent plane (counted here)
+  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+    bool up = false;
+    for (int k = 0; k < 3; ++k) up = up || glm::dot(m.positions[m.indices[3 * i + static_cast<std::size_t>(k)]] - p, f.n) > 0;
+    above += up;
+  }
+  INFO("triangles above the tangent plane " << above << ", tested " << r.statistics().triangles_tested);
+  CHECK(r.statistics().triangles_tested < above * 8 / 10);
+}

@@ -1,0 +1,225 @@
+// Tests of scene.hpp and reference_scenes.hpp: validation messages, bounds, the BVH's invariants,
+// and the reference scenes' documented sizes, winding and closedness. References: counts and
+// closed forms written here, and edge-incidence counting done in the test.
+#include "hemilight/reference_scenes.hpp"
+#include "hemilight/scene.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <tuple>
+
+using namespace hemilight;
+
+namespace {
+
+scene_mesh one_triangle() {
+  scene_mesh m;
+  m.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, material{glm::vec3(1.0f), glm::vec3(0.5f), false});
+  return m;
+}
+
+void fails_with(const scene_desc& d, status code, const char* text) {
+  try {
+    (void)scene::create(d);
+    FAIL("no error; expected " << text);
+  } catch (const error& e) {
+    CHECK(e.code() == code);
+    CHECK_THAT(e.what(), Catch::Contains(text));
+  }
+}
+
+glm::dvec3 normal_of(const scene_mesh& m, std::size_t i) {
+  const glm::dvec3 a(m.positions[m.indices[3 * i]]), b(m.positions[m.indices[3 * i + 1]]), c(m.positions[m.indices[3 * i + 2]]);
+  return glm::cross(b - a, c - a);
+}
+
+glm::dvec3 centroid_of(const scene_mesh& m, std::size_t i) {
+  return (glm::dvec3(m.positions[m.indices[3 * i]]) + glm::dvec3(m.positions[m.indices[3 * i + 1]]) +
+          glm::dvec3(m.positions[m.indices[3 * i + 2]])) / 3.0;
+}
+
+// Number of directed edges (by position, not index) without an opposite partner: 0 for a closed,
+// consistently wound mesh without T-junctions.
+std::size_t open_edges(const scene_mesh& m) {
+  using key = std::tuple<float, float, float, float, float, float>;
+  std::map<key, int> edges;
+  for (std::size_t i = 0; i < m.triangle_count(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 a = m.positions[m.indices[3 * i + static_cast<std::size_t>(k)]];
+      const glm::vec3 b = m.positions[m.indices[3 * i + static_cast<std::size_t>((k + 1) % 3)]];
+      const key fwd{a.x, a.y, a.z, b.x, b.y, b.z}, rev{b.x, b.y, b.z, a.x, a.y, a.z};
+      auto it = edges.find(rev);
+      if (it != edges.end() && --it->second == 0)
+        edges.erase(it);
+      else if (it == edges.end())
+        ++edges[fwd];
+    }
+  std::size_t open = 0;
+  for (const auto& e : edges) open += static_cast<std::size_t>(e.second);
+  return open;
+}
+
+}  // namespace
+
+TEST_CASE("scene: validation names the argument and the index", "[scene]") {
+  scene_mesh m = one_triangle();
+  scene_desc d = m.desc();
+
+  m.positions[1].y = std::numeric_limits<float>::quiet_NaN();
+  fails_with(m.desc(), status::invalid_argument, "positions[1].y is nan");
+  m.positions[1].y = 0;
+  m.positions[2].z = -std::numeric_limits<float>::infinity();
+  fails_with(m.desc(), status::invalid_argument, "positions[2].z is -inf");
+  m.positions[2].z = 0;
+
+  m.indices[2] = 900;
+  fails_with(m.desc(), status::invalid_argument, "indices[2] = 900 is out of range: 3 vertices");
+  m.indices[2] = 2;
+
+  m.materials[0].emission.y = -1.0f;
+  fails_with(m.desc(), status::invalid_argument, "materials[0].emission.g is -1");
+  m.materials[0].emission.y = 0.0f;
+  m.materials[0].albedo.z = std::numeric_limits<float>::quiet_NaN();
+  fails_with(m.desc(), status::invalid_argument, "materials[0].albedo.b is nan");
+  m.materials[0].albedo.z = 0.5f;
+  m.sky_radiance.x = -0.5f;
+  fails_with(m.desc(), status::invalid_argument, "sky_radiance.r is -0.5");
+  m.sky_radiance.x = 0.0f;
+  m.lightmap_uvs = {{0, 0}, {1, std::numeric_limits<float>::infinity()}, {0, 1}};
+  fails_with(m.desc(), status::invalid_argument, "lightmap_uvs[1].v is inf");
+  m.lightmap_uvs.clear();
+
+  d = m.desc();
+  d.positions = nullptr;
+  fails_with(d, status::invalid_argument, "positions is null but vertex_count is 3");
+  d = m.desc();
+  d.indices = nullptr;
+  fails_with(d, status::invalid_argument, "indices is null but triangle_count is 1");
+  d = m.desc();
+  d.triangle_count = std::numeric_limits<std::size_t>::max() / 2;  // 3 * count would overflow
+  fails_with(d, status::out_of_memory, "triangle_count");
+  d = m.desc();
+  d.vertex_count = max_scene_elements + 1;
+  fails_with(d, status::out_of_memory, "vertex_count");
+
+  // Without materials every triangle is black and one-sided.
+  d = m.desc();
+  d.materials = nullptr;
+  const auto s = scene::create(d);
+  CHECK(s->triangle_material(0).emission == glm::vec3(0.0f));
+  CHECK_FALSE(s->triangle_material(0).two_sided);
+}
+
+TEST_CASE("scene: bounds, size and an empty scene", "[scene]") {
+  const auto s = scene::create(one_triangle().desc());
+  CHECK(s->bounds_lo() == glm::vec3(0, 0, 0));
+  CHECK(s->bounds_hi() == glm::vec3(1, 1, 0));
+  CHECK(s->size() == Approx(std::sqrt(2.0)));
+  CHECK(s->drawable_triangle_count() == 1);
+  const auto e = scene::create(scene_desc{});
+  CHECK(e->triangle_count() == 0);
+  CHECK(e->size() == 0.0f);
+  CHECK(e->bvh().empty());
+}
+
+TEST_CASE("scene: the BVH holds every drawable triangle once, inside its nodes' boxes", "[scene]") {
+  for (const scene_mesh& m : {heightfield(2000), many_boxes(50), cornell_box()}) {
+    const auto s = scene::create(m.desc());
+    const auto& nodes = s->bvh();
+    const auto& tris = s->triangles();
+    REQUIRE(tris.size() == m.triangle_count());  // none of these has degenerate triangles
+    std::vector<int> seen(tris.size(), 0);
+    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
+    while (!stack.empty()) {
+      const auto [ni, depth] = stack.back();
+      stack.pop_back();
+      REQUIRE(ni < nodes.size());
+      REQUIRE(depth < 64);
+      const bvh_node& node = nodes[ni];
+      if (node.count == 0) {
+        for (std::uint32_t c : {node.first, node.first + 1}) {
+          REQUIRE(c < nodes.size());
+          CHECK(glm::all(glm::lessThanEqual(node.lo, nodes[c].lo)));
+          CHECK(glm::all(glm::greaterThanEqual(node.hi, nodes[c].hi)));
+          stack.push_back({c, depth + 1});
+        }
+        continue;
+      }
+      CHECK(node.count <= scene::max_leaf_triangles);
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+        ++seen[k];
+        for (const glm::vec3& v : {tris[k].v0, tris[k].v1, tris[k].v2}) {
+          CHECK(glm::all(glm::lessThanEqual(node.lo, v)));
+          CHECK(glm::all(glm::greaterThanEqual(node.hi, v)));
+        }
+      }
+    }
+    CHECK(std::count(seen.begin(), seen.end(), 1) == static_cast<std::ptrdiff_t>(seen.size()));
+  }
+}
+
+TEST_CASE("reference scenes: sizes and triangle counts as documented", "[scene]") {
+  CHECK(cornell_box().triangle_count() == 32);
+  CHECK(hexagon_room(1).triangle_count() == 142);
+  CHECK(hexagon_room(2).triangle_count() == 496);
+  CHECK(hexagon_room(3).triangle_count() == 1062);
+  CHECK(sky_and_occluders().triangle_count() == 42);
+  CHECK(heightfield(10000).triangle_count() == 2 * 71 * 71);
+  CHECK(many_boxes(100).triangle_count() == 1002);
+  CHECK_THROWS_AS(hexagon_room(0), error);
+  const auto c = scene::create(cornell_box().desc());
+  CHECK(c->bounds_hi().x == Approx(0.556f));
+  CHECK(c->bounds_hi().y == Approx(0.5488f));
+  CHECK(c->bounds_hi().z == Approx(0.5592f));
+  // Deterministic: two builds are identical.
+  CHECK(many_boxes(30).positions == many_boxes(30).positions);
+}
+
+TEST_CASE("reference scenes: rooms face inwards, boxes outwards, ground up", "[scene]") {
+  {
+    // Hexagon room: every triangle faces the room's axis (walls) or its middle height (floor up,
+    // ceiling down), and the room is closed except for the window's four edges.
+    const scene_mesh m = hexagon_room(2);
+    for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+      const glm::dvec3 c = centroid_of(m, i);
+      CHECK(glm::dot(normal_of(m, i), glm::dvec3(0, 1.5, 0) - c) > 0);
+    }
+    // Window hole: 4 sides of 2 cells' quads each... counted as directed edges without partner:
+    // the hole's boundary has (2 t) segments on each side with t = 2.
+    CHECK(open_edges(m) == 4 * 2);
+  }
+  {
+    const scene_mesh m = cornell_box();
+    const glm::dvec3 middle(0.278, 0.2744, 0.2796);
+    std::size_t emitters = 0;
+    for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+      const glm::dvec3 n = normal_of(m, i), c = centroid_of(m, i);
+      if (i < 10) CHECK(glm::dot(n, middle - c) > 0);  // floor, ceiling, back, left, right face in
+      if (m.materials[i].emission.x > 0) {
+        ++emitters;
+        CHECK(n.y < 0);  // the light faces down
+      }
+      if (i >= 12) {
+        // Box faces point away from their box's vertical axis or up.
+        // Triangles 12..21 are the short box, 22..31 the tall one (footprint centres below).
+        const glm::dvec3 axis = i >= 22 ? glm::dvec3(0.3685, c.y, 0.35125) : glm::dvec3(0.1855, c.y, 0.169);
+        CHECK((n.y > 0 || glm::dot(n, c - axis) > 0));
+      }
+    }
+    CHECK(emitters == 2);
+    CHECK(m.materials[6].albedo.x > m.materials[6].albedo.y);  // left wall (x = 0.556) is red
+  }
+  {
+    const scene_mesh m = heightfield(500);
+    for (std::size_t i = 0; i < m.triangle_count(); ++i) CHECK(normal_of(m, i).y > 0);
+    const scene_mesh g = sky_and_occluders();
+    CHECK(normal_of(g, 0).y > 0);
+    scene_mesh box;
+    box.add_box({-1, -2, -3}, {1, 2, 3}, material{}, true);
+    CHECK(open_edges(box) == 0);
+    for (std::size_t i = 0; i < box.triangle_count(); ++i) CHECK(glm::dot(normal_of(box, i), -centroid_of(box, i)) > 0);
+  }
+}
