@@ -5,6 +5,7 @@
 #include "hemilight.h"
 
 #include "hemilight/error.hpp"
+#include "hemilight/cubemap.hpp"
 #include "hemilight/scene.hpp"
 
 #include <memory>
@@ -18,6 +19,7 @@
 /// The opaque scene handle of the C ABI: a shared, immutable C++ scene.
 struct hemilight_scene {
   std::shared_ptr<const hemilight::scene> scene;
+  std::shared_ptr<const hemilight::cubemap> sky;  ///< optional environment sky (null: the scene's constant sky)
 };
 
 namespace hemilight::capi {

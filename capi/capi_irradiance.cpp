@@ -51,7 +51,9 @@ hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const
     if (!c.integrator || c.integrator->resolution() != resolution)
       c.integrator = std::make_unique<hemilight::hemicube_integrator>(resolution);
     const glm::vec3 x(position[0], position[1], position[2]);
-    hemilight::hemicube_rasterizer raster(scene->scene);
+    hemilight::raster_options ro;
+    ro.sky = scene->sky;
+    hemilight::hemicube_rasterizer raster(scene->scene, ro);
     raster.render(x, hemilight::make_frame(n / len), resolution, c.buffer);
     const hemilight::irradiance_sample s = c.integrator->integrate(c.buffer);
     hemilight_irradiance r;
@@ -114,6 +116,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     }
     hemilight::hemicube_sampler_options so;
     so.resolution = options->resolution;
+    so.raster.sky = scene->sky;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
     hemilight::cache_result r;

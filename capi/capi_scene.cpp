@@ -3,6 +3,7 @@
 
 #include "hemilight/scene.hpp"
 
+#include <cmath>
 #include <memory>
 #include <new>
 #include <string>
@@ -71,5 +72,29 @@ hemilight_status hemilight_scene_create(const float* positions, size_t vertex_co
 }
 
 void hemilight_scene_release(hemilight_scene* scene) { delete scene; }
+
+hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, const float* faces_rgb, int size,
+                                                  hemilight_scene** out) {
+  const char* fn = "hemilight_scene_with_environment";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!faces_rgb) return invalid(fn, "faces_rgb is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (size < 1 || size > hemilight::cubemap_max_size)
+      return invalid(fn, "size " + std::to_string(size) + " is out of range: 1.." + std::to_string(hemilight::cubemap_max_size));
+    hemilight::cube_image faces = hemilight::cube_image::make(size, 3);
+    for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
+      if (!(faces_rgb[i] >= 0.0f) || !std::isfinite(faces_rgb[i]))
+        return invalid(fn, "faces_rgb[" + std::to_string(i) + "] = " + std::to_string(faces_rgb[i]) +
+                               "; radiance must be finite and >= 0");
+      faces.pixels[i] = faces_rgb[i];
+    }
+    auto handle = std::make_unique<hemilight_scene>();
+    handle->scene = scene->scene;  // shared geometry, not copied
+    handle->sky = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
+    *out = handle.release();
+    return HEMILIGHT_OK;
+  });
+}
 
 }  // extern "C"

@@ -141,8 +141,20 @@ HEMILIGHT_API hemilight_status hemilight_scene_create(const float* positions, si
                                                       const float* triangle_radiance, const float sky_radiance[3],
                                                       hemilight_scene** out);
 
-/* Releases a scene made by hemilight_scene_create. NULL is fine (does nothing). */
+/* Releases a scene made by hemilight_scene_create or hemilight_scene_with_environment. NULL is
+ * fine (does nothing). */
 HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
+
+/* A new scene handle with the same geometry as `scene` (shared, not copied: releasing either
+ * handle keeps the other valid) whose sky is an environment cube map: texels that hit nothing see
+ * the map's radiance along their world direction (seamless bilinear) instead of the constant sky.
+ * faces_rgb: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), size x size RGB floats each,
+ * face-major, finite and >= 0; copied. Directions are the scene's world axes. Release the new
+ * handle with hemilight_scene_release. Errors (nothing written to *out): INVALID_ARGUMENT for NULL
+ * arguments, size outside [1, 16384], negative or non-finite values (the message names the index).
+ * Cost: O(6 size^2) to copy the map. */
+HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, const float* faces_rgb,
+                                                                int size, hemilight_scene** out);
 
 /* ---- irradiance at a point: render + integrate ------------------------------------------------ */
 

@@ -341,6 +341,14 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
                            "; it must be finite and >= 0 (0 = default)");
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
   simd_ = options.simd;
+  if (options.sky) {
+    // A cheap structural check; the values were checked when the map was built (from_image).
+    const cubemap& m = *options.sky;
+    if (m.level_count() < 1 || m.levels[0].size < 1 || (m.channels() != 3 && m.channels() != 4) ||
+        m.levels[0].pixels.size() != 6u * std::size_t(m.size()) * std::size_t(m.size()) * std::size_t(m.channels()))
+      throw_invalid_argument("hemicube_rasterizer: the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
+    sky_ = options.sky;
+  }
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -804,6 +812,16 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   float* radiance = out.radiance.data();
   std::uint8_t* flags = out.flags.data();
   resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags, simd_);
+  if (sky_) {
+    // Misses see the environment along the texel's world direction.
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!(flags[i] & texel_miss)) continue;
+      const glm::vec4 l = sky_->sample(basis.to_world(directions_[i]));
+      radiance[3 * i] = l.x;
+      radiance[3 * i + 1] = l.y;
+      radiance[3 * i + 2] = l.z;
+    }
+  }
   if (!texture || !scene_->has_lightmap_uvs()) return;
   // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();

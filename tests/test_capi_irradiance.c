@@ -170,8 +170,40 @@ static void test_cache(void) {
   free(out);
 }
 
+static void test_environment(void) {
+  /* A uniform environment of radiance (1, 2, 3) must give pi (1, 2, 3); an environment bright only
+   * on its +Y face gives a normal +Y more than a normal -Y. */
+  const float zero_sky[3] = {0.0f, 0.0f, 0.0f};
+  const float p[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f}, down[3] = {0.0f, -1.0f, 0.0f};
+  enum { size = 8, floats = 6 * size * size * 3 };
+  float faces[floats];
+  hemilight_scene* base = NULL;
+  hemilight_scene* env = NULL;
+  hemilight_irradiance r, r2;
+  int i, c;
+  for (i = 0; i < floats; ++i) faces[i] = (float)(i % 3 + 1);
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, zero_sky, &base) == HEMILIGHT_OK);
+  CHECK(hemilight_scene_with_environment(base, faces, size, &env) == HEMILIGHT_OK);
+  hemilight_scene_release(base); /* the new handle keeps the geometry alive */
+  CHECK(hemilight_sample_irradiance(env, p, up, 32, &r) == HEMILIGHT_OK);
+  for (c = 0; c < 3; ++c) CHECK(fabs(r.irradiance[c] / (pi * (c + 1)) - 1.0) < 1e-5);
+  for (i = 0; i < floats; ++i) faces[i] = (i / (size * size * 3) == 2) ? 5.0f : 0.0f; /* face 2 = +Y */
+  CHECK(hemilight_scene_with_environment(env, faces, size, &base) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(base, p, up, 32, &r) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(base, p, down, 32, &r2) == HEMILIGHT_OK);
+  CHECK(r.irradiance[0] > 1.0f && r2.irradiance[0] < 1e-3f);
+  CHECK_FAILS(hemilight_scene_with_environment(NULL, faces, size, &env), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_scene_with_environment(base, NULL, size, &env), HEMILIGHT_ERROR_INVALID_ARGUMENT, "faces_rgb is NULL");
+  CHECK_FAILS(hemilight_scene_with_environment(base, faces, 0, &env), HEMILIGHT_ERROR_INVALID_ARGUMENT, "size 0");
+  faces[7] = -1.0f;
+  CHECK_FAILS(hemilight_scene_with_environment(base, faces, size, &env), HEMILIGHT_ERROR_INVALID_ARGUMENT, "faces_rgb[7]");
+  hemilight_scene_release(base);
+  hemilight_scene_release(env);
+}
+
 int main(void) {
   test_sample();
+  test_environment();
   test_cache();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;

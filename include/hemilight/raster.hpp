@@ -60,6 +60,7 @@
 // scalar path.
 #pragma once
 
+#include "hemilight/cubemap.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
@@ -106,6 +107,12 @@ struct raster_options {
   /// Use the SSE2 depth-test loop where the target has SSE2 (every x86-64). false selects the
   /// scalar reference path; both give bit-identical buffers (tested).
   bool simd = true;
+  /// Optional environment sky: texels that hit nothing get sky->sample(world direction of the
+  /// texel centre) (seamless bilinear, top level; cubemap.hpp) instead of the scene's constant
+  /// sky radiance. The cube map's directions are the scene's world axes (OpenGL face table).
+  /// Shared and immutable; build it with cubemap::from_image (which checks every value); the
+  /// constructor throws error(invalid_argument) for an empty or inconsistent map.
+  std::shared_ptr<const cubemap> sky = nullptr;
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
@@ -206,6 +213,7 @@ class hemicube_rasterizer {
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
   bool simd_ = true;
+  std::shared_ptr<const cubemap> sky_;
   int n_ = 0;
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
   std::vector<std::uint32_t> ids_;     // draw record of the nearest fragment per texel (0 = none)
