@@ -1,4 +1,4 @@
-/* CHECK and CHECK_FAILS for the C99 tests of the C ABI (test_capi.c, test_capi_cubemap.c).
+/* CHECK and CHECK_FAILS for the C99 tests of the C ABI (test_capi*.c).
  * Each test file is its own program and includes this once. */
 #ifndef HEMILIGHT_CAPI_CHECK_H
 #define HEMILIGHT_CAPI_CHECK_H

@@ -2,29 +2,12 @@
  * Reference: a uniform sky of radiance L over unoccluded up-facing quads gives E = pi L at every
  * texel (closed form). Bad input: every failure leaves the caller's buffers untouched.
  * Prints failing checks and a closing "N passed, N failed" line. */
-#include "hemilight.h"
+#include "capi_check.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-static int passed = 0, failed = 0;
-#define CHECK(cond)                                            \
-  do {                                                         \
-    if (cond) {                                                \
-      ++passed;                                                \
-    } else {                                                   \
-      ++failed;                                                \
-      printf("FAILED %s:%d: %s\n", __FILE__, __LINE__, #cond); \
-    }                                                          \
-  } while (0)
-#define CHECK_FAILS(call, expected, needle)                                                      \
-  do {                                                                                           \
-    hemilight_status st_ = (call);                                                               \
-    CHECK(st_ == (expected) && strstr(hemilight_last_error(), (needle)) != NULL);                \
-    if (st_ != (expected) || strstr(hemilight_last_error(), (needle)) == NULL)                   \
-      printf("  call: %s\n  status %d, message: %s\n", #call, (int)st_, hemilight_last_error()); \
-  } while (0)
 
 #define W 8
 #define H 8

@@ -2,30 +2,13 @@
  * hemilight_cache_options_init, hemilight_cache_irradiance. References: closed forms (a uniform
  * sky gives pi L; Lambert's formula for a quad emitter, written here in C).
  * Prints failing checks and a closing "N passed, N failed" line. */
-#include "hemilight.h"
+#include "capi_check.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static int passed = 0, failed = 0;
-#define CHECK(cond)                                            \
-  do {                                                         \
-    if (cond) {                                                \
-      ++passed;                                                \
-    } else {                                                   \
-      ++failed;                                                \
-      printf("FAILED %s:%d: %s\n", __FILE__, __LINE__, #cond); \
-    }                                                          \
-  } while (0)
-#define CHECK_FAILS(call, expected, needle)                                                          \
-  do {                                                                                               \
-    hemilight_status st_ = (call);                                                                   \
-    CHECK(st_ == (expected) && strstr(hemilight_last_error(), (needle)) != NULL);                    \
-    if (st_ != (expected) || strstr(hemilight_last_error(), (needle)) == NULL)                       \
-      printf("  call: %s\n  status %d, message: %s\n", #call, (int)st_, hemilight_last_error());     \
-  } while (0)
 
 static const double pi = 3.14159265358979323846;
 
