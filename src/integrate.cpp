@@ -372,27 +372,15 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   if (options_.translation == translation_estimator::simple) {
     const float* sx = t.simple_x.data();
     const float* sy = t.simple_y.data();
-    double acc[6] = {};
-    for (std::size_t b0 = 0; b0 < count; b0 += block) {
-      const std::size_t b1 = std::min(count, b0 + block);
-      Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
-#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
-      for (std::size_t i = b0; i < b1; ++i) {
-        const Inner wx = Inner(sx[i]) * Inner(inv[i]), wy = Inner(sy[i]) * Inner(inv[i]);
-        a0 += Inner(r[i]) * wx;
-        a1 += Inner(r[i]) * wy;
-        a2 += Inner(g[i]) * wx;
-        a3 += Inner(g[i]) * wy;
-        a4 += Inner(b[i]) * wx;
-        a5 += Inner(b[i]) * wy;
-      }
-      acc[0] += double(a0);
-      acc[1] += double(a1);
-      acc[2] += double(a2);
-      acc[3] += double(a3);
-      acc[4] += double(a4);
-      acc[5] += double(a5);
+    // Per-texel weights 3 P_i w_t,i / r_i, then the same weighted sums as the vector irradiance.
+    // (A comparison estimator: the scratch allocation per call does not matter.)
+    std::vector<float> wx(count), wy(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      wx[i] = sx[i] * inv[i];
+      wy[i] = sy[i] * inv[i];
     }
+    double acc[6] = {};
+    vector_sums_impl<Inner>(r, g, b, wx.data(), wy.data(), count, acc);
     for (std::size_t c = 0; c < 3; ++c)
       out.translation_gradient[c] = f.to_world(glm::vec3(float(acc[2 * c]), float(acc[2 * c + 1]), 0.0f));
   } else if (options_.translation != translation_estimator::none) {
