@@ -183,9 +183,6 @@ hemicube_integrator::hemicube_integrator(int resolution, const integrate_options
                            "; it must be finite and >= 0 (0 = automatic)");
   table_ = integration_table::get(resolution);  // validates the resolution
   const std::size_t count = hemicube_texel_count(resolution);
-  r_.resize(count);
-  g_.resize(count);
-  b_.resize(count);
   inv_r_.resize(count);
 }
 
@@ -229,17 +226,12 @@ inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const 
   }
 }
 
-// Deinterleaves the radiance, inverts the distances, and sums pass 1 (E per channel, total
-// projected solid angle, harmonic sum, back faces) into s1[6]; returns the min distance.
+// Inverts the distances and sums pass 1 (E per channel, total projected solid angle, harmonic
+// sum, back faces) into s1[6]; returns the min distance. r, g, b: the buffer's radiance planes.
 template <class Inner>
-inline __attribute__((always_inline)) float texel_sums_impl(const float* rad, const float* dist, const std::uint8_t* flags,
-                                                            const float* vz, float* r, float* g, float* b, float* inv,
-                                                            std::size_t count, double* s1) {
-  for (std::size_t i = 0; i < count; ++i) {
-    r[i] = rad[3 * i];
-    g[i] = rad[3 * i + 1];
-    b[i] = rad[3 * i + 2];
-  }
+inline __attribute__((always_inline)) float texel_sums_impl(const float* r, const float* g, const float* b,
+                                                            const float* dist, const std::uint8_t* flags,
+                                                            const float* vz, float* inv, std::size_t count, double* s1) {
   float min_d = std::numeric_limits<float>::infinity();
 #pragma omp simd reduction(min : min_d)
   for (std::size_t i = 0; i < count; ++i) {
@@ -317,9 +309,9 @@ void vector_sums_float(const float* r, const float* g, const float* b, const flo
 #if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
 __attribute__((target_clones("avx2", "default")))
 #endif
-float texel_sums_float(const float* rad, const float* dist, const std::uint8_t* flags, const float* vz, float* r, float* g,
-                       float* b, float* inv, std::size_t count, double* s1) {
-  return texel_sums_impl<float>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+float texel_sums_float(const float* r, const float* g, const float* b, const float* dist, const std::uint8_t* flags,
+                       const float* vz, float* inv, std::size_t count, double* s1) {
+  return texel_sums_impl<float>(r, g, b, dist, flags, vz, inv, count, s1);
 }
 
 }  // namespace
@@ -331,24 +323,23 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   const integration_table& t = *table_;
   const std::size_t count = hemicube_texel_count(n_);
   const std::size_t row = static_cast<std::size_t>(n_);
-  const float* rad = buffer.radiance.data();
+  const float* r = buffer.channel(0);
+  const float* g = buffer.channel(1);
+  const float* b = buffer.channel(2);
   const float* dist = buffer.distance.data();
   const std::uint8_t* flags = buffer.flags.data();
-  float* r = r_.data();
-  float* g = g_.data();
-  float* b = b_.data();
   float* inv = inv_r_.data();
   const float* vx = t.vx.data();
   const float* vy = t.vy.data();
   const float* vz = t.vz.data();
-  // Planar copies of the radiance and 1/distance (0 for misses), min distance, and pass 1:
+  // 1/distance (0 for misses), min distance, and pass 1:
   // E, total projected solid angle, harmonic sum, back faces.
   double s1[6] = {};
   float min_d;
   if constexpr (std::is_same<Inner, float>::value)
-    min_d = texel_sums_float(rad, dist, flags, vz, r, g, b, inv, count, s1);
+    min_d = texel_sums_float(r, g, b, dist, flags, vz, inv, count, s1);
   else
-    min_d = texel_sums_impl<Inner>(rad, dist, flags, vz, r, g, b, inv, count, s1);
+    min_d = texel_sums_impl<Inner>(r, g, b, dist, flags, vz, inv, count, s1);
   assert(min_d > 0.0f);
   irradiance_sample out;
   out.irradiance = glm::vec3(float(s1[0]), float(s1[1]), float(s1[2]));

@@ -135,7 +135,7 @@ class hemicube_integrator {
   int n_;
   integrate_options options_;
   std::shared_ptr<const integration_table> table_;
-  std::vector<float> r_, g_, b_, inv_r_;  // planar scratch copies of radiance and 1/distance
+  std::vector<float> inv_r_;  // scratch: 1/distance per texel
 };
 
 /// Convenience: integrate one buffer with a temporary integrator (fetches the cached table;

@@ -107,6 +107,9 @@ struct raster_options {
   /// Use the SSE2 depth-test loop where the target has SSE2 (every x86-64). false selects the
   /// scalar reference path; both give bit-identical buffers (tested).
   bool simd = true;
+  /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked at
+  /// run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine. Bit-identical.
+  bool avx2 = true;
   /// Optional environment sky: texels that hit nothing get sky->sample(world direction of the
   /// texel centre) (seamless bilinear, top level; cubemap.hpp) instead of the scene's constant
   /// sky radiance. The cube map's directions are the scene's world axes (OpenGL face table).
@@ -213,6 +216,7 @@ class hemicube_rasterizer {
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
   bool simd_ = true;
+  bool avx2_ = false;  // simd_ and the CPU has AVX2
   std::shared_ptr<const cubemap> sky_;
   int n_ = 0;
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
