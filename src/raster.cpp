@@ -180,6 +180,10 @@ struct fixed_point {
 #if HEMILIGHT_RASTER_SSE2
 // Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
 constexpr std::int64_t simd_extent = 32 * sub_one;
+// The same for the AVX2 kernel, which also takes the big triangles of small hemicubes: with both
+// extents <= 64 texels (2^14 in fixed point), every edge value it forms, up to 8 texels past the
+// box, is below 2^14 * 2^14 + 2^14 * (2^14 + 2^11) + 1 < 2^29.2: exact in 32-bit lanes.
+constexpr std::int64_t avx2_extent = 64 * sub_one;
 
 // See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
 // E = ex x + ey y + e0; covered iff all three are >= 0.
@@ -332,15 +336,18 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3],
 }
 
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
-// texels are left to the caller.
+// texels are left to the caller. Runs are found by shade key (keys[id]: the first record with
+// the same shade), so the two triangles of a quad, or all black surfaces, make one run.
 HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
                                                const hemicube_rasterizer::shade* __restrict shades,
-                                               float* __restrict distance, float* __restrict red,
-                                               float* __restrict green, float* __restrict blue,
-                                               std::uint8_t* __restrict flags) noexcept {
+                                               const std::uint32_t* __restrict keys, float* __restrict distance,
+                                               float* __restrict red, float* __restrict green,
+                                               float* __restrict blue, std::uint8_t* __restrict flags) noexcept {
   const __m256 zero = _mm256_setzero_ps();
-  __m256i run_id = _mm256_set1_epi32(-1);  // no record yet (record numbers are < 2^31)
+  // The current run: its shade key, and its record when all its texels so far had one record
+  // (a cheap first test); -1 = none (record numbers are < 2^31).
+  __m256i run_id = _mm256_set1_epi32(-1), run_key = _mm256_set1_epi32(-1);
   __m256 run_r = zero, run_g = zero, run_b = zero;
   std::uint64_t run_flags = 0;
   for (std::size_t i = 0; i + 8 <= count; i += 8) {
@@ -350,9 +357,18 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* _
                                         _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(ids + i), id);
     if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) != -1) {
-      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
-      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, first)) != -1) {
-        run_id = _mm256_set1_epi32(-1);
+      const __m256i key = _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
+      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1) {
+        run_id = _mm256_set1_epi32(-1);  // same shade, other records
+        _mm256_storeu_ps(red + i, run_r);
+        _mm256_storeu_ps(green + i, run_g);
+        _mm256_storeu_ps(blue + i, run_b);
+        std::memcpy(flags + i, &run_flags, 8);
+        continue;
+      }
+      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
+      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
+        run_id = run_key = _mm256_set1_epi32(-1);
         alignas(32) std::uint32_t lane[8];
         _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
         for (std::size_t k = 0; k < 8; ++k) {
@@ -364,8 +380,11 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* _
         }
         continue;
       }
-      run_id = first;
-      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(id))];
+      // A new run of shade key `first`.
+      run_key = first;
+      const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
+      run_id = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1 ? id0 : _mm256_set1_epi32(-1);
+      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
       run_r = _mm256_set1_ps(sh.r);
       run_g = _mm256_set1_ps(sh.g);
       run_b = _mm256_set1_ps(sh.b);
@@ -563,6 +582,8 @@ void hemicube_rasterizer::prepare(int resolution) {
   draws_.front().index = no_triangle;
   shades_.clear();
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_miss});
+  shade_keys_.assign(1, 0u);
+  std::fill(std::begin(shade_cache_), std::end(shade_cache_), 0u);
   stats_ = {};
 }
 
@@ -697,7 +718,19 @@ std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& 
   }
   const auto draw = static_cast<std::uint32_t>(draws_.size());
   draws_.push_back(rec);
-  shades_.push_back({rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags});
+  const shade sh{rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags};
+  shades_.push_back(sh);
+  // Shade key: an earlier record with the same bits, if the cache remembers one.
+  std::uint32_t bits[4];
+  std::memcpy(bits, &sh, sizeof bits);
+  const std::uint32_t h = (bits[0] * 0x9e3779b1u) ^ (bits[1] * 0x85ebca77u) ^ (bits[2] * 0xc2b2ae3du) ^ bits[3];
+  std::uint32_t& slot = shade_cache_[(h >> 26) & 63u];
+  if (slot != 0 && std::memcmp(&shades_[slot], &sh, sizeof sh) == 0) {
+    shade_keys_.push_back(slot);
+  } else {
+    slot = draw;
+    shade_keys_.push_back(draw);
+  }
   return draw;
 }
 
@@ -857,19 +890,22 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
       e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
     }
 
+#if HEMILIGHT_RASTER_AVX2
+    if (avx2_ && max_x - min_x <= avx2_extent && max_y - min_y <= avx2_extent) {
+      // Triangles up to 64 texels across, AVX2: the box is scanned eight texels per step with
+      // 32-bit edge values (see avx2_extent), the coverage mask going straight into the depth
+      // test. Cheaper than the span walk below even for triangles that fill half their box.
+      small_triangle_avx2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                                 dzdy, dzdx, draw);
+      continue;
+    }
+#endif
 #if HEMILIGHT_RASTER_SSE2
     if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
       // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
       // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
       // additions, and the coverage mask goes straight into the depth test: no span search,
       // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
-#if HEMILIGHT_RASTER_AVX2
-      if (avx2_) {
-        small_triangle_avx2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts,
-                                                   z00, dzdy, dzdx, draw);
-        continue;
-      }
-#endif
       small_triangle_sse2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
                                                  dzdy, dzdx, draw);
       continue;
@@ -991,7 +1027,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   std::uint8_t* flags = out.flags.data();
 #if HEMILIGHT_RASTER_AVX2
   if (avx2_) {
-    resolve_texels_avx2(count, depth, lengths, ids, shades, distance, red, green, blue, flags);
+    resolve_texels_avx2(count, depth, lengths, ids, shades, shade_keys_.data(), distance, red, green, blue, flags);
     const std::size_t done = count - count % 8, rest = count - done;
     resolve_texels(rest, depth + done, lengths + done, ids + done, shades, distance + done, red + done,
                    green + done, blue + done, flags + done, false);

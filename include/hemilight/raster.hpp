@@ -226,6 +226,10 @@ class hemicube_rasterizer {
   std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
   std::vector<draw_record> draws_;     // [0] = nothing hit
   std::vector<shade> shades_;          // radiance + flags of each draw record, compact for the resolve
+  // Per draw record, the first record drawn with the same shade (bitwise), found through a small
+  // direct-mapped cache: the AVX2 resolve finds runs of equal shades across triangle edges.
+  std::vector<std::uint32_t> shade_keys_;
+  std::uint32_t shade_cache_[64] = {};
   std::vector<std::uint32_t> stack_;
   raster_statistics stats_;
 };
