@@ -251,20 +251,38 @@ TEST_CASE("integrate: gradients against finite differences of re-rendered hemicu
   CHECK(rel(gr, fd_r) < 0.08);
 }
 
-TEST_CASE("integrate: float and double accumulation agree", "[integrate]") {
+TEST_CASE("integrate: float and double accumulation agree (both float kernels)", "[integrate]") {
   const closed_form_scene s = lit_room();
-  const hemicube_buffer buf = render(s, 128, s.position, s.normal);
-  integrate_options of, od;
+  hemicube_buffer buf = render(s, 128, s.position, s.normal);
+  // Some back-face texels (every seventh), so the back-face sums are exercised too; and N = 6
+  // (108 texels, not a multiple of 8) for the kernels' tails.
+  for (std::size_t i = 0; i < buf.texel_count(); i += 7) buf.flags[i] = texel_back_face;
+  const hemicube_buffer small = render(s, 6, s.position, s.normal);
+  for (const hemicube_buffer* b : {static_cast<const hemicube_buffer*>(&buf), &small}) {
+    for (bool simd_kernels : {true, false}) {
+      integrate_options of, od;
+      od.double_precision = true;
+      of.simd_kernels = simd_kernels;
+      of.directional = od.directional = true;
+      const irradiance_sample a = integrate(*b, of), d = integrate(*b, od);
+      INFO("N " << b->resolution << ", simd kernels " << simd_kernels);
+      // Float lanes over blocks of 1024 texels: relative error ~ (1024/8) x 6e-8 ~ 1e-5 per sum at
+      // worst, ~1e-6 typically; the gradients are sums of signed terms that cancel to ~10% of their
+      // magnitude, so 1e-4.
+      CHECK(a.irradiance.x == Approx(d.irradiance.x).epsilon(1e-5));
+      CHECK(a.harmonic_mean_distance == Approx(d.harmonic_mean_distance).epsilon(1e-5));
+      CHECK(a.backface_fraction == Approx(d.backface_fraction).epsilon(1e-5));
+      CHECK(a.min_distance == d.min_distance);
+      CHECK(glm::length(a.translation_gradient[0] - d.translation_gradient[0]) <
+            1e-4f * glm::length(d.translation_gradient[0]));
+      CHECK(glm::length(a.rotation_gradient[0] - d.rotation_gradient[0]) < 1e-4f * glm::length(d.rotation_gradient[0]));
+      CHECK(a.hl2[0].x == Approx(d.hl2[0].x).epsilon(1e-5));
+    }
+  }
+  // The back-face fraction itself: the weight of the flagged texels (1 in 7, spread evenly).
+  integrate_options od;
   od.double_precision = true;
-  of.directional = od.directional = true;
-  const irradiance_sample a = integrate(buf, of), d = integrate(buf, od);
-  // Float lanes over rows of 128 texels: relative error ~ (128/8) x 6e-8 = 1e-6 per sum; the
-  // gradients are sums of signed terms that cancel to ~10% of their magnitude, so 1e-4.
-  CHECK(a.irradiance.x == Approx(d.irradiance.x).epsilon(1e-5));
-  CHECK(a.harmonic_mean_distance == Approx(d.harmonic_mean_distance).epsilon(1e-5));
-  CHECK(glm::length(a.translation_gradient[0] - d.translation_gradient[0]) < 1e-4f * glm::length(d.translation_gradient[0]));
-  CHECK(glm::length(a.rotation_gradient[0] - d.rotation_gradient[0]) < 1e-4f * glm::length(d.rotation_gradient[0]));
-  CHECK(a.hl2[0].x == Approx(d.hl2[0].x).epsilon(1e-5));
+  CHECK(integrate(buf, od).backface_fraction == Approx(1.0 / 7.0).epsilon(0.02));
 }
 
 TEST_CASE("integrate: the result does not depend on the hemicube's roll beyond the discretisation bound", "[integrate]") {
