@@ -269,6 +269,38 @@ inline __attribute__((always_inline)) float texel_sums_impl(const float* r, cons
   return min_d;
 }
 
+// The sums of the directional outputs not shared with E and g_r: per channel, L_i times the
+// texel's solid angle and its three HL2 weights, into d[12] (channel-major: R Omega, R h0, R h1,
+// R h2, G ...).
+template <class Inner>
+inline __attribute__((always_inline)) void directional_sums_impl(const float* r, const float* g, const float* b,
+                                                                 const float* omega, const float* h0, const float* h1,
+                                                                 const float* h2, std::size_t count, double* d) {
+  for (std::size_t b0 = 0; b0 < count; b0 += block) {
+    const std::size_t b1 = std::min(count, b0 + block);
+    Inner r0 = 0, r1 = 0, r2 = 0, r3 = 0, g0 = 0, g1 = 0, g2 = 0, g3 = 0, c0 = 0, c1 = 0, c2 = 0, c3 = 0;
+#pragma omp simd reduction(+ : r0, r1, r2, r3, g0, g1, g2, g3, c0, c1, c2, c3)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner w = Inner(omega[i]), k0 = Inner(h0[i]), k1 = Inner(h1[i]), k2 = Inner(h2[i]);
+      const Inner lr = Inner(r[i]), lg = Inner(g[i]), lb = Inner(b[i]);
+      r0 += lr * w;
+      r1 += lr * k0;
+      r2 += lr * k1;
+      r3 += lr * k2;
+      g0 += lg * w;
+      g1 += lg * k0;
+      g2 += lg * k1;
+      g3 += lg * k2;
+      c0 += lb * w;
+      c1 += lb * k0;
+      c2 += lb * k1;
+      c3 += lb * k2;
+    }
+    const Inner sums[12] = {r0, r1, r2, r3, g0, g1, g2, g3, c0, c1, c2, c3};
+    for (int k = 0; k < 12; ++k) d[k] += double(sums[k]);
+  }
+}
+
 // Sums L_i (x, y) of the texels' vector solid angles per channel into phi[6] (for g_r).
 template <class Inner>
 inline __attribute__((always_inline)) void vector_sums_impl(const float* r, const float* g, const float* b, const float* vx,
@@ -298,6 +330,14 @@ inline __attribute__((always_inline)) void vector_sums_impl(const float* r, cons
 // The float kernel is compiled twice where the compiler can dispatch at load time (GCC/Clang on
 // x86-64 Linux: an AVX2 clone and the portable SSE2 default, picked by the CPU); the two give the
 // same sums up to the order of float additions inside a block.
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void directional_sums_float(const float* r, const float* g, const float* b, const float* omega, const float* h0,
+                            const float* h1, const float* h2, std::size_t count, double* d) {
+  directional_sums_impl<float>(r, g, b, omega, h0, h1, h2, count, d);
+}
+
 #if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
 __attribute__((target_clones("avx2", "default")))
 #endif
@@ -529,13 +569,13 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   out.backface_fraction = float(s1[5] / total);
   const frame& f = buffer.basis;
 
+  if ((options_.rotation_gradient || options_.directional) && !have_phi) {
+    if constexpr (std::is_same<Inner, float>::value)
+      vector_sums_float(r, g, b, vx, vy, count, phi);
+    else
+      vector_sums_impl<Inner>(r, g, b, vx, vy, count, phi);
+  }
   if (options_.rotation_gradient) {
-    if (!have_phi) {
-      if constexpr (std::is_same<Inner, float>::value)
-        vector_sums_float(r, g, b, vx, vy, count, phi);
-      else
-        vector_sums_impl<Inner>(r, g, b, vx, vy, count, phi);
-    }
     // g_r = n x Phi; in the local frame z x (x, y, z) = (-y, x, 0).
     for (std::size_t c = 0; c < 3; ++c)
       out.rotation_gradient[c] = f.to_world(glm::vec3(-float(phi[2 * c + 1]), float(phi[2 * c]), 0.0f));
@@ -601,26 +641,21 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   }
 
   if (options_.directional) {
-    // Rarely asked for; plain double sums. 15 quantities: SH band 0, the vector (x, y, z) and
-    // the three HL2 weights, each for R, G, B.
-    double sh0[3] = {}, sv[3][3] = {}, h[3][3] = {};
-    for (std::size_t i = 0; i < count; ++i) {
-      const double l[3] = {r[i], g[i], b[i]};
-      for (std::size_t c = 0; c < 3; ++c) {
-        sh0[c] += l[c] * t.solid_angle[i];
-        sv[c][0] += l[c] * vx[i];
-        sv[c][1] += l[c] * vy[i];
-        sv[c][2] += l[c] * vz[i];
-        for (std::size_t k = 0; k < 3; ++k) h[k][c] += l[c] * t.hl2[k][i];
-      }
-    }
+    // SH band 1 is the vector irradiance: its local (x, y) are the vector sums phi (pass 1 or
+    // above) and z is E. The other 12 sums (per channel: solid angle, three HL2 weights) here.
+    double d[12] = {};
+    if constexpr (std::is_same<Inner, float>::value)
+      directional_sums_float(r, g, b, t.solid_angle.data(), t.hl2[0].data(), t.hl2[1].data(), t.hl2[2].data(), count, d);
+    else
+      directional_sums_impl<Inner>(r, g, b, t.solid_angle.data(), t.hl2[0].data(), t.hl2[1].data(), t.hl2[2].data(),
+                                   count, d);
     for (std::size_t c = 0; c < 3; ++c) {
-      const glm::vec3 w = f.to_world(glm::vec3(float(sv[c][0]), float(sv[c][1]), float(sv[c][2])));
-      out.sh_l1[0][int(c)] = sh_y00 * float(sh0[c]);
+      const glm::vec3 w = f.to_world(glm::vec3(float(phi[2 * c]), float(phi[2 * c + 1]), float(s1[c])));
+      out.sh_l1[0][int(c)] = sh_y00 * float(d[4 * c]);
       out.sh_l1[1][int(c)] = sh_y1 * w.y;
       out.sh_l1[2][int(c)] = sh_y1 * w.z;
       out.sh_l1[3][int(c)] = sh_y1 * w.x;
-      for (std::size_t k = 0; k < 3; ++k) out.hl2[k][int(c)] = float(h[k][c]);
+      for (std::size_t k = 0; k < 3; ++k) out.hl2[k][int(c)] = float(d[4 * c + 1 + k]);
     }
   }
   return out;

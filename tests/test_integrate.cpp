@@ -131,6 +131,30 @@ TEST_CASE("integrate: Half-Life 2 basis irradiance under a uniform sky matches t
   }
 }
 
+TEST_CASE("integrate: L1 SH band 1 of an unoccluded polygon is its vector irradiance, with or without g_r", "[integrate]") {
+  // For radiance seen only in the upper hemisphere, the band-1 projection of L is
+  // Y1 * integral of L w d omega = Y1 * Phi (the vector irradiance, Lambert's polygon formula),
+  // in world order (y, z, x). The hemicube's vector solid angles are exact per texel, so only
+  // the emitter's edge texels (partly covered) err: the same bound as E's (2% at N = 256 is ample:
+  // the emitter spans ~150 texels across there).
+  const closed_form_scene s = unoccluded_emitter();
+  const hemicube_buffer buf = render(s, 256, s.position, s.normal);
+  const glm::dvec3 phi = polygon_vector_irradiance({{-0.3, -0.2, 1.0}, {-0.3, 0.4, 1.0}, {0.5, 0.4, 1.0}, {0.5, -0.2, 1.0}},
+                                                   s.position, 1.0);
+  const double y1 = 0.488602511902920;
+  for (bool gradients : {true, false})
+    for (bool simd_kernels : {true, false}) {
+      integrate_options o;
+      o.directional = true;
+      o.rotation_gradient = gradients;
+      o.simd_kernels = simd_kernels;
+      const irradiance_sample r = integrate(buf, o);
+      INFO("rotation gradient " << gradients << ", simd kernels " << simd_kernels);
+      const glm::dvec3 band1(r.sh_l1[3].x, r.sh_l1[1].x, r.sh_l1[2].x);  // (x, y, z) of red
+      CHECK(glm::length(band1 / y1 - phi * double(s.tint.x)) < 0.02 * glm::length(phi));
+    }
+}
+
 TEST_CASE("integrate: polygon emitter irradiance converges to Lambert's formula within the derived bound", "[integrate]") {
   const closed_form_scene s = unoccluded_emitter();
   const double e_ref = s.irradiance(s.position, s.normal);
