@@ -574,7 +574,8 @@ void hemicube_rasterizer::prepare(int resolution) {
     n_ = resolution;
   }
   // Padded by 8 texels: the AVX2 kernels may load and store back up to 7 texels past a row's end.
-  depth_.assign(count + 8, 0.0f);
+  depth_.resize(count + 8);
+  std::memset(depth_.data(), 0, depth_.size() * sizeof(float));  // 0.0f is all zero bits
   ids_.resize(count + 8);  // stale ids are masked by depth 0 (never written)
   // Record 0 stands for "nothing hit" (the sky): texels start there.
   draws_.clear();
