@@ -303,6 +303,31 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3],
   const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
   const int xb = static_cast<int>(x_begin), xe = static_cast<int>(x_end);
   const __m256i end = _mm256_set1_epi32(xe + 1);
+  if (!count_mode && xe - xb < 8) {
+    // One group per row (most triangles of big scenes): the lanes' x, their depth step and the
+    // box mask are the same on every row. The same operations as below, so the same bits.
+    const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(xb), lane);
+    const __m256i box = _mm256_cmpgt_epi32(end, xi);
+    const __m256 zx = _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi));
+    __m256i a = row[0], b = row[1], c = row[2];
+    for (std::int64_t y = y_begin; y <= y_end; ++y) {
+      const __m256i in = _mm256_andnot_si256(_mm256_or_si256(_mm256_or_si256(a, b), c), box);
+      a = _mm256_add_epi32(a, dy[0]);
+      b = _mm256_add_epi32(b, dy[1]);
+      c = _mm256_add_epi32(c, dy[2]);
+      const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
+      if (_mm256_movemask_ps(mask) == 0) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
+      const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
+      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
+      const __m256 old = _mm256_loadu_ps(depth + i);
+      const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
+      _mm256_storeu_ps(depth + i, _mm256_blendv_ps(old, z, closer));
+      float* ip = reinterpret_cast<float*>(ids + i);
+      _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+    }
+    return;
+  }
   for (std::int64_t y = y_begin; y <= y_end; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
     const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
