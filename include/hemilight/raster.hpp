@@ -140,7 +140,9 @@ struct raster_statistics {
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
 /// direction tables, plus ~100 bytes per triangle drawn; kept between renders and grown on demand.
-class hemicube_rasterizer {
+/// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
+/// must not share a line, or the counters one writes slow down the members the other reads.
+class alignas(64) hemicube_rasterizer {
  public:
   /// Value of seen_triangle() for a texel that sees nothing.
   static constexpr std::uint32_t no_triangle = 0xffffffffu;
