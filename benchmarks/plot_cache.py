@@ -9,7 +9,8 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
   plot_cache.py DIR      draws DIR/cache.png from DIR/cache_sweep.csv (bash benchmarks/run.sh cache)
                          and, if DIR/cache_resolution.csv exists (bash benchmarks/run.sh cache_resolution),
                          DIR/cache_resolution.png and DIR/cache_resolution.md (the table of
-                         interpolated hemicube fractions at the targets and gradient savings).
+                         interpolated hemicube fractions at the targets and gradient savings);
+                         the same for cache_resolution_k128.csv (hexagon ceiling, 128 x 128 grid).
 """
 import math
 import os
@@ -42,7 +43,7 @@ def fraction_for(pts, target):
             if i == 0:
                 return f
             f0, e0 = pts[i - 1]
-            if e0 <= target or e0 == e:
+            if e0 <= target or e0 == e or e <= 0.0:
                 return f
             t = (math.log(e0) - math.log(target)) / (math.log(e0) - math.log(e))
             return math.exp(math.log(f0) + t * (math.log(f) - math.log(f0)))
@@ -65,7 +66,7 @@ def chart(rows, path):
                     continue
                 c = COLORS.get(n, "k")
                 for grad, style in ((1, "o-"), (0, "s--")):
-                    pts = curve(rows, scene, n, grad, key)
+                    pts = [p for p in curve(rows, scene, n, grad, key) if p[1] > 0]  # 0: every point rendered
                     if pts:
                         ax.plot([100 * p[0] for p in pts], [100 * p[1] for p in pts], style, color=c, ms=3.5,
                                 alpha=1.0 if grad else 0.6,
@@ -122,6 +123,8 @@ def table(rows, path):
                 ng = curve(rows, scene, n, 0, key)
                 savings = []
                 for f, e in g:
+                    if e <= 0.0:  # every point rendered: nothing to compare
+                        continue
                     f_ng = fraction_for(ng, e)
                     if f_ng is None:
                         savings.append(f"{100 * e:.2f}%: > {max(p[0] for p in ng) / f:.1f}x")
@@ -138,7 +141,10 @@ def table(rows, path):
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 if os.path.exists(f"{out}/cache_sweep.csv"):
     chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
-if os.path.exists(f"{out}/cache_resolution.csv"):
-    rows = load_csv(f"{out}/cache_resolution.csv")
-    chart(rows, f"{out}/cache_resolution.png")
-    table(rows, f"{out}/cache_resolution.md")
+for name in ("cache_resolution", "cache_resolution_k128"):
+    if os.path.exists(f"{out}/{name}.csv"):
+        rows = load_csv(f"{out}/{name}.csv")
+        if not rows:
+            continue
+        chart(rows, f"{out}/{name}.png")
+        table(rows, f"{out}/{name}.md")

@@ -35,6 +35,10 @@ for n in "${names[@]}"; do
       --converged 1024 --stride 19 --check 2048 --check-stride 6
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes sky --n 64,128 \
       --converged 512 --stride 7 --check 1024 --check-stride 4
+    # the hexagon room ceiling again on the default 128 x 128 grid (fractions depend on the grid)
+    rm -f docs/bench/cache_resolution_k128.csv
+    "$build/benchmarks/sweep_cache" docs/bench/cache_resolution_k128.csv --grid 128 --a 0.1,0.2,0.3,0.5 \
+      --truth-cache "$truth" --rolls 4 --scenes hexagon --n 512 --converged 1024 --stride 28 --check 2048 --check-stride 4
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
     continue
   fi
