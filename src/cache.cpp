@@ -135,10 +135,12 @@ class record_bvh {
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
+// `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered).
 float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
-                  bool* own = nullptr) {
+                  bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr) {
   glm::vec3 sum(0.0f);
+  std::array<glm::vec3, 4> sh_sum{};
   float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   bvh.query(x, [&](std::uint32_t i) {
@@ -148,12 +150,16 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
     const glm::vec3 e = extrapolate(r, x, n, o.use_gradients);
     sum += w * e;
     wsum += w;
+    if (sh)
+      for (std::size_t k = 0; k < 4; ++k) sh_sum[k] += w * r.sh_l1[k];
     const float l = luminance(e);
     lo = std::min(lo, l);
     hi = std::max(hi, l);
     at_record = at_record || r.position == x;
   });
   out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+  if (sh)
+    for (std::size_t k = 0; k < 4; ++k) (*sh)[k] = wsum > 0.0f ? sh_sum[k] / wsum : glm::vec3(0.0f);
   if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
   if (own) *own = at_record;
   return wsum;
@@ -264,6 +270,21 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
   }
   if (weight_sum) *weight_sum = wsum;
   return wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+}
+
+std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_record>& records, const glm::vec3& x,
+                                                   const glm::vec3& n, const cache_options& o) {
+  std::array<glm::vec3, 4> sum{};
+  float wsum = 0.0f;
+  for (const cache_record& r : records) {
+    const float w = record_weight(r, x, n, o);
+    if (w <= 0.0f || record_is_behind(r, x, n)) continue;
+    for (std::size_t k = 0; k < 4; ++k) sum[k] += w * r.sh_l1[k];
+    wsum += w;
+  }
+  if (wsum > 0.0f)
+    for (glm::vec3& c : sum) c /= wsum;
+  return sum;
 }
 
 cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
@@ -410,6 +431,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       r.rotation_gradient = s.rotation_gradient;
       r.translation_gradient = s.translation_gradient;
       r.harmonic_distance = s.harmonic_mean_distance;
+      if (o.directional) r.sh_l1 = s.sh_l1;
       float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o.max_radius;
       if (o.gradient_radius_limit) {
         const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
@@ -480,12 +502,16 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   cache_result result;
   result.irradiance.assign(count, glm::vec3(0.0f));
   result.valid.assign(count, 0);
+  if (o.directional) result.sh_l1.assign(count, std::array<glm::vec3, 4>{});
   parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       glm::vec3 v;
-      if (!inside[i] && interpolate(records, bvh, positions[i], normals[i], o, v) > 0.0f) {
+      std::array<glm::vec3, 4> sh{};
+      if (!inside[i] &&
+          interpolate(records, bvh, positions[i], normals[i], o, v, nullptr, nullptr, o.directional ? &sh : nullptr) > 0.0f) {
         result.irradiance[i] = v;
         result.valid[i] = 1;
+        if (o.directional) result.sh_l1[i] = sh;
       }
     }
   });
@@ -511,13 +537,18 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
           }
         }
         glm::vec3 sum(0.0f);
+        std::array<glm::vec3, 4> sh{};
         float wsum = 0.0f;
         for (const auto& bw : best)
           if (bw.first > 0.0f) {
             sum += bw.first * records[bw.second].irradiance;
+            if (o.directional)
+              for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * records[bw.second].sh_l1[c];
             wsum += bw.first;
           }
         result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+        if (o.directional && wsum > 0.0f)
+          for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
       }
     });
   }

@@ -44,6 +44,10 @@ struct cache_record {
   std::array<glm::vec3, 3> translation_gradient{};
   float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
   float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
+  /// L1 spherical harmonics of the incoming radiance, world space, the sample's
+  /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
+  /// channel c: sh_l1[k][c]). Zero unless cache_options::directional.
+  std::array<glm::vec3, 4> sh_l1{};
 };
 
 /// Weighting of records.
@@ -75,6 +79,13 @@ struct cache_options {
   bool refine_disagreement = true;
   cache_weight weight = cache_weight::ward;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
+  /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
+  /// sh_l1; the sampler must compute it: make_hemicube_sampler with integrate.directional = true),
+  /// and cache_result::sh_l1 gets, per point, the plain weighted average of the covering records'
+  /// coefficients with the same weights as E (no gradients: SH coefficients are not extrapolated,
+  /// and not rotated towards the point's normal). Off: records carry zeros and the interpolation
+  /// costs nothing extra.
+  bool directional = false;
   int thread_count = 0;                    ///< 0 = all cores
   /// Called from the calling thread between rounds and during rendering with the fraction of
   /// points covered so far, in [0, 1]; return false to cancel (error(status::cancelled) is thrown
@@ -120,6 +131,10 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, con
 struct cache_result {
   std::vector<glm::vec3> irradiance;  ///< per point, RGB, >= 0
   std::vector<std::uint8_t> valid;    ///< per point: 1 = interpolated from covering records, 0 = filled (inside geometry or uncovered)
+  /// Per point with options.directional (else empty): the Ward-weighted average of the covering
+  /// records' world-space L1 SH (filled points: of the same nearest records as their E). Not
+  /// clamped: band-1 coefficients are signed.
+  std::vector<std::array<glm::vec3, 4>> sh_l1;
   std::vector<cache_record> records;
   cache_stats stats;
 };
@@ -139,6 +154,12 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 /// *weight_sum if given (0 when no record covers the point: the result is then 0).
 glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& position,
                               const glm::vec3& normal, const cache_options& options, float* weight_sum = nullptr);
+
+/// Interpolates the records' L1 SH at one point with the weights of interpolate_records (plain
+/// weighted average, no gradients, not clamped); zero when no record covers the point. Brute
+/// force over all records: for tests and tools.
+std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_record>& records, const glm::vec3& position,
+                                                   const glm::vec3& normal, const cache_options& options);
 
 /// The weight of one record at (position, normal) under options.weight and error_threshold,
 /// before the behind test: Ward's w when w > 1/a, the Tabellion-Lamorlette w when w > 0, else 0.
