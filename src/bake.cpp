@@ -479,7 +479,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     so.resolution = o.resolution;
     so.roll = true;
     so.raster.sky = o.environment;
-    so.integrate.directional = pass_directional;
+    so.sh_l1 = pass_directional;  // the cheap SH (cache.hpp); the integrator's directional pass is not needed
     co.directional = pass_directional;
     if (pass > 0) {
       // Radiance texture of this pass: emission + albedo E_{k-1} / pi of each texel's owner.

@@ -565,6 +565,9 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
   if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");
   if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
+  if (o.sh_l1 && !o.integrate.rotation_gradient)
+    throw_invalid_argument("make_hemicube_sampler: sh_l1 needs integrate.rotation_gradient (band 1 comes from it)");
+  std::shared_ptr<const hemicube_table> table = o.sh_l1 ? hemicube_table::get(o.resolution) : nullptr;
   struct context {
     hemicube_rasterizer raster;
     hemicube_integrator integrator;
@@ -574,7 +577,7 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
   for (int w = 0; w < workers; ++w)
     contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
                                                           hemicube_integrator(o.resolution, o.integrate), {}}));
-  return [contexts, o](int worker, const glm::vec3& x, const glm::vec3& n) {
+  return [contexts, o, table](int worker, const glm::vec3& x, const glm::vec3& n) {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
     context& c = *(*contexts)[std::size_t(worker)];
@@ -589,7 +592,29 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
       f.t = t;
     }
     c.raster.render(x, f, o.resolution, c.buffer, o.texture);
-    return c.integrator.integrate(c.buffer);
+    irradiance_sample out = c.integrator.integrate(c.buffer);
+    if (o.sh_l1) {
+      // Band 0: solid-angle-weighted radiance; band 1: Y1 times Phi = E n + g_r x n (per channel).
+      constexpr double y00 = 0.282094791773878143, y1 = 0.488602511902919921;
+      const float* omega = table->solid_angle();
+      const float* l = c.buffer.radiance.data();
+      const std::size_t count = table->size();
+      double s0[3] = {0.0, 0.0, 0.0};
+      for (std::size_t i = 0; i < count; ++i) {
+        s0[0] += double(l[3 * i] * omega[i]);
+        s0[1] += double(l[3 * i + 1] * omega[i]);
+        s0[2] += double(l[3 * i + 2] * omega[i]);
+      }
+      for (int ch = 0; ch < 3; ++ch) {
+        const glm::dvec3 phi = double(out.irradiance[ch]) * glm::dvec3(f.n) +
+                               glm::cross(glm::dvec3(out.rotation_gradient[std::size_t(ch)]), glm::dvec3(f.n));
+        out.sh_l1[0][ch] = float(y00 * s0[ch]);
+        out.sh_l1[1][ch] = float(y1 * phi.y);
+        out.sh_l1[2][ch] = float(y1 * phi.z);
+        out.sh_l1[3][ch] = float(y1 * phi.x);
+      }
+    }
+    return out;
   };
 }
 

@@ -3,6 +3,7 @@
 // and accuracy against closed forms. Hemicubes come from the reference ray caster, so the cache
 // is tested on its own.
 #include "hemilight/cache.hpp"
+#include "hemilight/reference_scenes.hpp"
 
 #include "integrate_scenes.hpp"
 
@@ -366,4 +367,37 @@ TEST_CASE("cache: directional records carry world-space L1 SH - uniform sky clos
   CHECK(q.sh_l1.empty());
   for (const cache_record& rec : q.records) CHECK(rec.sh_l1[0] == glm::vec3(0.0f));
   CHECK(q.irradiance == r.irradiance);  // E does not depend on the option
+}
+
+TEST_CASE("cache: the sampler's cheap L1 SH equals the integrator's directional SH", "[cache]") {
+  // hemicube_sampler_options::sh_l1 derives band 1 from the rotation gradient (Phi = E n + g_r x n)
+  // and band 0 from one solid-angle sum; integrate_options::directional sums both directly. Same
+  // hemicubes (same roll), so they must agree to float rounding of 12k-texel sums: 1e-5 of c_00.
+  auto sc = scene::create(cornell_box().desc());
+  hemicube_sampler_options cheap;
+  cheap.resolution = 32;
+  cheap.sh_l1 = true;
+  hemicube_sampler_options full = cheap;
+  full.sh_l1 = false;
+  full.integrate.directional = true;
+  const irradiance_sampler a = make_hemicube_sampler(sc, cheap, 1), b = make_hemicube_sampler(sc, full, 1);
+  const glm::vec3 points[][2] = {{{0.28f, 0.01f, 0.28f}, {0, 1, 0}},
+                                 {{0.01f, 0.3f, 0.2f}, {1, 0, 0}},
+                                 {{0.3f, 0.54f, 0.1f}, {0, -1, 0}},
+                                 {{0.2f, 0.2f, 0.55f}, {0, 0, -1}}};
+  int lit = 0;
+  for (const auto& pn : points) {
+    const irradiance_sample sa = a(0, pn[0], pn[1]), sb = b(0, pn[0], pn[1]);
+    lit += sa.sh_l1[0].x > 0.0f ? 1 : 0;
+    for (std::size_t k = 0; k < 4; ++k)
+      for (int c = 0; c < 3; ++c) {
+        INFO("point " << pn[0].x << " " << pn[0].y << " " << pn[0].z << ", coefficient " << k << ", channel " << c);
+        CHECK(std::fabs(sa.sh_l1[k][c] - sb.sh_l1[k][c]) <= 1e-5f * sb.sh_l1[0][c]);
+      }
+    CHECK(sa.irradiance == sb.irradiance);
+  }
+  CHECK(lit >= 3);  // all but the point under the ceiling facing down see the lamp (emission only)
+  hemicube_sampler_options bad = cheap;
+  bad.integrate.rotation_gradient = false;
+  CHECK_THROWS_WITH(make_hemicube_sampler(sc, bad, 1), Catch::Contains("rotation_gradient"));
 }

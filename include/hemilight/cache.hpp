@@ -118,12 +118,20 @@ struct hemicube_sampler_options {
   /// deterministic, and it turns the texel grid's aliasing into fine noise instead of bands.
   bool roll = true;
   const radiance_texture* texture = nullptr;  ///< optional radiance texture (bounce passes); must outlive the sampler
+  /// Fill irradiance_sample::sh_l1 (world-space L1 SH, integrate.hpp) cheaply, without
+  /// integrate.directional: band 1 = Y1 Phi with the vector irradiance Phi = E n + g_r x n that
+  /// the rotation gradient already holds (g_r = n x Phi, integrate.hpp), band 0 = Y00 sum_i L_i
+  /// Omega_i over the buffer (exact texel solid angles, summed in double). The same values as the
+  /// integrator's directional SH to float rounding, for one extra pass of 3 multiply-adds per
+  /// texel instead of 15 double ones; irradiance_sample::hl2 stays zero. Needs
+  /// integrate.rotation_gradient (make_hemicube_sampler throws error(invalid_argument) otherwise).
+  bool sh_l1 = false;
 };
 
 /// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
 /// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache). Throws
 /// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
-/// options. The sampler throws error(invalid_argument) for a worker index out of range.
+/// options, or sh_l1 without integrate.rotation_gradient. The sampler throws error(invalid_argument) for a worker index out of range.
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
                                          int workers);
 
