@@ -694,3 +694,37 @@ TEST_CASE("write_bake_exrs writes the irradiance, mask and the requested directi
   const image back = read_exr(files[3]);
   CHECK(back.pixels == r.hl2[1].pixels);  // float32 round-trips exactly
 }
+
+TEST_CASE("White furnace: directional maps of the full and the indirect-only bake match the uniform closed forms", "[bake]") {
+  // In the closed uniform room (albedo a = 0.5, emission 1) pass k sees a uniform radiance
+  // L = 1 + a + ... + a^(k-1) from every direction, so (integrate.hpp's definitions) the SH is
+  // (sqrt(pi) L, (sqrt(3 pi)/2) L (n_y, n_z, n_x)) and every HL2 value pi L (1 + 1/sqrt3) / 2.
+  // Indirect only: L - 1 (the first pass sees the emission L = 1). Float sums: 1e-4 L.
+  material m;
+  m.albedo = glm::vec3(0.5f);
+  m.emission = glm::vec3(1.0f);
+  scene_mesh room = closed_room(m, m, 2);
+  generate_lightmap_uvs(room, 32, 2);
+  const lightmap_samples smp = compute_lightmap_samples(input_of(room), 32, 32);
+  bake_options o;
+  o.width = o.height = 32;
+  o.resolution = 16;
+  o.bounces = 3;
+  o.output_sh_l1 = o.output_hl2 = true;
+  for (bool indirect : {false, true}) {
+    o.indirect_only = indirect;
+    const bake_result r = bake_lightmap(input_of(room), o);
+    const double l = indirect ? 0.75 : 1.75, k1 = std::sqrt(3.0 * pi) / 2.0;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < r.sampled.size(); ++k) {
+      if (!r.sampled[k]) continue;
+      const glm::dvec3 n(smp.normal[k]);
+      const double sh[4] = {std::sqrt(pi) * l, k1 * l * n.y, k1 * l * n.z, k1 * l * n.x};
+      for (int j = 0; j < 4; ++j) worst = std::max(worst, std::fabs(r.sh_l1[std::size_t(j)].pixels[3 * k + 1] - sh[j]));
+      for (int j = 0; j < 3; ++j)
+        worst = std::max(worst, std::fabs(r.hl2[std::size_t(j)].pixels[3 * k + 1] - pi * l * (1 + 1 / std::sqrt(3.0)) / 2));
+    }
+    INFO((indirect ? "indirect only" : "full") << ": worst deviation " << worst << " for L = " << l);
+    CHECK(worst < 1e-4 * l);
+  }
+}
