@@ -306,8 +306,8 @@ HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh
 
 /* hemilight_bake_lightmap plus the directional lightmaps, each optional (NULL = not wanted; a
  * NULL buffer's capacity is ignored). Asking for either makes the last bounce (and the first, with
- * indirect_only) integrate directionally: hemicubes cost a little more, the cache carries 12 more
- * floats per record (docs/bake.md).
+ * indirect_only) integrate directionally: hemicubes of that pass cost a little more (HL2: about
+ * 20% more for the whole one-bounce bake, docs/bake.md).
  * sh_l1_rgb: NULL, or at least 12 width height floats (sh_l1_capacity): four RGB images one after
  *   another, coefficient k of texel (x, y) at sh_l1_rgb[3 (k width height + y width + x)]. The L1
  *   spherical harmonics of the incoming radiance, WORLD space, c_k = integral over the texel's upper
@@ -319,9 +319,10 @@ HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh
  *   1/sqrt3), (-1/sqrt6, -1/sqrt2, 1/sqrt3), (sqrt(2/3), 0, 1/sqrt3) of each texel's LIGHTMAP
  *   TANGENT FRAME (t, b, n): t = dP/du of the texel's triangle projected onto the tangent plane of
  *   the shading normal n and normalised; b = +-(n x t) with the sign that makes b . dP/dv >= 0
- *   (u, v: lightmap UVs). Evaluated from the L1 SH above, which is exact for a uniform sky (every
- *   value pi L (1 + 1/sqrt3) / 2) and under-resolves compact bright sources (docs/bake.md: about 13%
- *   RMS for a small overhead emitter).
+ *   (u, v: lightmap UVs). From the irradiance on the cone of HL2 directions kept per cache record as
+ *   a Fourier series in azimuth (order 3): exact for light within 35.26 degrees of the normal and
+ *   for a uniform sky (every value pi L (1 + 1/sqrt3) / 2); 1.7% RMS for a grazing side light
+ *   (docs/bake.md).
  * Both kinds are dilated like the irradiance. Errors as hemilight_bake_lightmap, and
  * INVALID_ARGUMENT when a capacity is too small (the message names it); nothing is written then. */
 HEMILIGHT_API hemilight_status hemilight_bake_lightmap_directional(const hemilight_bake_mesh* meshes, size_t mesh_count,

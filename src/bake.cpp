@@ -458,6 +458,8 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   // L1 SH per sample, coefficient-major (sh[k][i]); only with directional outputs.
   using sh_planes = std::array<std::vector<glm::vec3>, 4>;
   sh_planes sh, sh_first;
+  // HL2 cones per sample, reference make_frame(normal).t (as cache_result::cone); only with output_hl2.
+  std::vector<hl2_cone> cone, cone_first;
   std::vector<std::uint8_t> valid(count, 1);
   image texture;
   radiance_texture texture_view;
@@ -479,7 +481,8 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     so.resolution = o.resolution;
     so.roll = true;
     so.raster.sky = o.environment;
-    so.sh_l1 = pass_directional;  // the cheap SH (cache.hpp); the integrator's directional pass is not needed
+    so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
+    so.hl2_cone = pass_directional && o.output_hl2;
     co.directional = pass_directional;
     if (pass > 0) {
       // Radiance texture of this pass: emission + albedo E_{k-1} / pi of each texel's owner.
@@ -501,16 +504,20 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     }
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
-    if (pass_directional)
+    if (pass_directional) {
       for (auto& plane : sh) plane.assign(count, glm::vec3(0.0f));
+      cone.assign(count, hl2_cone{});
+    }
     if (o.use_cache) {
       if (o.progress) co.progress = [&](float f) { return report(base + span * f); };
       cache_result cr = cache_irradiance(positions.data(), normals.data(), count, sampler, co);
       for (std::size_t i = 0; i < count; ++i) {
         e[i] = cr.irradiance[i];
         valid[i] = std::uint8_t(valid[i] & cr.valid[i]);
-        if (pass_directional)
+        if (pass_directional) {
           for (std::size_t c = 0; c < 4; ++c) sh[c][i] = cr.sh_l1[i][c];
+          cone[i] = cr.cone[i];
+        }
       }
       r.stats.hemicubes += cr.stats.hemicubes;
       r.stats.records += cr.stats.records;
@@ -526,11 +533,13 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
         const std::size_t end = std::min(count, b + block);
         parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
           for (std::size_t i = b + lo; i < b + hi; ++i) {
-            const irradiance_sample smp = sampler(worker, positions[i], normals[i]);
+            const cache_sample smp = sampler(worker, positions[i], normals[i]);
             e[i] = smp.irradiance;
             backface[i] = smp.backface_fraction;
-            if (pass_directional)
+            if (pass_directional) {
               for (std::size_t c = 0; c < 4; ++c) sh[c][i] = smp.sh_l1[c];
+              cone[i] = rotate_hl2_cone(smp.cone, normals[i], make_frame(normals[i]).t);
+            }
           }
         });
       }
@@ -555,8 +564,17 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
             if (backface[i] > co.invalid_backface_fraction) std::memcpy(&values[i], tmp.pixels.data() + 3 * texel_of[i], sizeof(glm::vec3));
         };
         fill(e);
-        if (pass_directional)
+        if (pass_directional) {
           for (auto& plane : sh) fill(plane);
+          // Cone coefficients term by term (neighbours on a chart share the normal and so the
+          // reference tangent).
+          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) {
+            std::vector<glm::vec3> plane(count);
+            for (std::size_t i = 0; i < count; ++i) plane[i] = cone[i].coefficients[t];
+            fill(plane);
+            for (std::size_t i = 0; i < count; ++i) cone[i].coefficients[t] = plane[i];
+          }
+        }
       }
       cache_stats cs;
       cs.hemicubes = count;
@@ -570,7 +588,10 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     }
     if (pass == 0 && o.indirect_only) {
       e_first = e;
-      if (pass_directional) sh_first = sh;
+      if (pass_directional) {
+        sh_first = sh;
+        cone_first = cone;
+      }
     }
   }
   if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
@@ -613,7 +634,10 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
       std::vector<std::array<glm::vec3, 3>> h(count);
       for (std::size_t i = 0; i < count; ++i) {
         const std::size_t k = texel_of[i];
-        h[i] = hl2_from_sh_l1(coefficients(i), frame{s.tangent[k], s.bitangent[k], s.normal[k]});
+        hl2_cone c = cone[i];
+        if (o.indirect_only)
+          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= cone_first[i].coefficients[t];
+        h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
       }
       for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = to_image([&](std::size_t i) { return h[i][j]; });
     }

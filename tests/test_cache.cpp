@@ -401,3 +401,41 @@ TEST_CASE("cache: the sampler's cheap L1 SH equals the integrator's directional 
   bad.integrate.rotation_gradient = false;
   CHECK_THROWS_WITH(make_hemicube_sampler(sc, bad, 1), Catch::Contains("rotation_gradient"));
 }
+
+TEST_CASE("cache: HL2 cone series - uniform sky closed form and exact rotation", "[cache]") {
+  // Under a uniform sky L every direction b on the HL2 cone (54.74 degrees from n) is a plane
+  // tilted by that angle under the sky hemisphere: E = pi L (1 + 1/sqrt3) / 2, the same for all
+  // azimuths, so a_0 is that and every other coefficient 0. The per-texel weights integrate the
+  // clamped cosine by the midpoint rule on 8 x 8 sub-rectangles (N = 32 here): 1e-4 relative.
+  scene_mesh empty;
+  empty.sky_radiance = glm::vec3(1.0f, 2.0f, 0.5f);
+  hemicube_sampler_options so;
+  so.resolution = 32;
+  so.hl2_cone = true;
+  const irradiance_sampler sampler = make_hemicube_sampler(scene::create(empty.desc()), so, 1);
+  const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.8f, -0.5f));
+  const cache_sample s = sampler(0, glm::vec3(1.0f, 2.0f, 3.0f), n);
+  const double closed = 3.14159265358979 * (1.0 + 1.0 / std::sqrt(3.0)) / 2.0;
+  for (int c = 0; c < 3; ++c) {
+    CHECK(s.cone.coefficients[0][c] == Approx(closed * empty.sky_radiance[c]).epsilon(1e-4));
+    for (std::size_t k = 1; k < std::size_t(hl2_cone_terms); ++k) CHECK(std::fabs(s.cone.coefficients[k][c]) < 1e-4 * closed * empty.sky_radiance[c]);
+  }
+  CHECK(std::fabs(glm::dot(s.cone.reference, n)) < 1e-6f);  // the reference is a tangent
+  // Rotation is exact: a cone re-referenced to another tangent gives the same value in every
+  // world direction (azimuth shifted by the angle between the references). Hand-made series.
+  hl2_cone c;
+  const frame f = make_frame(n);
+  c.reference = f.t;
+  for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) c.coefficients[k] = glm::vec3(1.0f / float(k + 1), -0.3f * float(k), 0.1f);
+  const glm::vec3 other = std::cos(0.7f) * f.t + std::sin(0.7f) * f.b;  // azimuth 0.7 in c's frame
+  const hl2_cone r = rotate_hl2_cone(c, n, other);
+  for (float phi : {0.0f, 1.0f, 2.5f, -2.0f}) CHECK(glm::length(evaluate_hl2_cone(r, phi) - evaluate_hl2_cone(c, phi + 0.7f)) < 1e-5f);
+  // hl2_from_cone reads the series at the basis azimuths (120, -120, 0 degrees from t; mirrored
+  // for a left-handed frame).
+  const frame right{other, glm::cross(n, other), n}, left{other, -glm::cross(n, other), n};
+  const std::array<glm::vec3, 3> hr = hl2_from_cone(c, right), hl = hl2_from_cone(c, left);
+  const float third = 2.0943951f;
+  CHECK(glm::length(hr[0] - glm::max(evaluate_hl2_cone(c, 0.7f + third), glm::vec3(0.0f))) < 1e-5f);
+  CHECK(glm::length(hl[0] - glm::max(evaluate_hl2_cone(c, 0.7f - third), glm::vec3(0.0f))) < 1e-5f);
+  CHECK(glm::length(hl[2] - hr[2]) < 1e-6f);
+}

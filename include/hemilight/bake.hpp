@@ -33,16 +33,17 @@
 //      empty texel with a filled 8-neighbour gets the mean of its filled 8-neighbours), so
 //      bilinear lookups at chart borders do not pull in black.
 //
-//   6. Directional lightmaps (optional, bake_options::output_sh_l1 / output_hl2). The last pass
-//      (and, with indirect_only, the first) integrates with integrate_options::directional; cache
-//      records carry the world-space L1 SH of the incoming radiance and the texels get the
-//      Ward-weighted average (cache.hpp). SH maps are those coefficients. HL2 maps are evaluated
-//      per texel from the interpolated SH in the texel's tangent frame (lightmap_tangent_frame):
-//      E_k = max(0, (sqrt(pi)/2) c_00 + sqrt(pi/3) c_1 . b_k), the clamped-cosine convolution of
-//      the L1 radiance (Ramamoorthi & Hanrahan 2001) along each basis vector b_k. It is exact when
-//      the incoming radiance has no band >= 2 content along the basis cone (a uniform sky is exact);
-//      for compact bright sources it under-weights the lobe facing the source and leaks into the
-//      others (measured in docs/bake.md). Both kinds of map are dilated like the irradiance.
+//   6. Directional lightmaps (optional, bake_options::output_sh_l1 / output_hl2). In the last pass
+//      (and, with indirect_only, the first) the hemicube sampler also computes the world-space L1
+//      SH of the incoming radiance and/or the irradiance on the cone of HL2 directions (54.74
+//      degrees from the normal) as a Fourier series in azimuth (cache.hpp, hl2_cone); cache
+//      records carry both and each texel gets their Ward-weighted average (cones rotated to a
+//      common reference tangent first). SH maps are those coefficients. HL2 maps are the cone
+//      series read at the azimuths of the three basis vectors of the texel's lightmap tangent
+//      frame (lightmap_tangent_frame, hl2_from_cone): frame-correct for any tangent, exact for
+//      light within 35.26 degrees of the normal, otherwise cut at azimuthal order 3 (measured 1.7%
+//      RMS for a grazing side light, where going through L1 SH would give 25%; docs/bake.md).
+//      All of them are dilated like the irradiance.
 //
 // UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
 // its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
@@ -95,11 +96,13 @@ struct bake_options {
   bool use_cache = true;
   int thread_count = 0;  ///< 0 = all cores
   /// Output the L1 SH lightmaps (bake_result::sh_l1): world-space coefficients of the incoming
-  /// radiance. Costs one directional integration per hemicube of the last pass (and of the first
-  /// with indirect_only) and 48 bytes per cache record; off by default.
+  /// radiance. Costs 3 multiply-adds per hemicube texel in the last pass (and the first with
+  /// indirect_only): a few percent of the bake; off by default.
   bool output_sh_l1 = false;
   /// Output the Half-Life 2 basis lightmaps (bake_result::hl2), in each texel's lightmap tangent
-  /// frame, evaluated from the interpolated L1 SH (top of this header). Same cost as output_sh_l1.
+  /// frame, from the interpolated HL2 cone series (top of this header). Costs 21 multiply-adds per
+  /// hemicube texel in the directional passes, 96 bytes per record, and once per process a weight
+  /// table (~0.25 s at N = 64); off by default.
   bool output_hl2 = false;
   /// Optional environment sky: hemicube texels that hit nothing see this cube map's radiance along
   /// their world direction (raster_options::sky; seamless bilinear, directions = the scene's world
@@ -144,8 +147,8 @@ struct bake_result {
   std::array<image, 4> sh_l1;
   /// With output_hl2 (else three empty images): irradiance through the Half-Life 2 basis vectors
   /// hl2_basis[k] of each texel's lightmap tangent frame (lightmap_tangent_frame), >= 0, from the
-  /// interpolated L1 SH (top of this header). A uniform sky L gives pi L (1 + 1/sqrt 3) / 2 in all
-  /// three. Dilated.
+  /// interpolated HL2 cone series (top of this header). A uniform sky L gives pi L (1 + 1/sqrt 3) / 2
+  /// in all three. With indirect_only: last pass minus first pass. Dilated.
   std::array<image, 3> hl2;
   bake_stats stats;
 };
@@ -241,9 +244,11 @@ inline constexpr float hl2_basis[3][3] = {
 /// hemisphere; otherwise the band-2 part of the true irradiance is missing. Cost: O(1).
 glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept;
 
-/// The three Half-Life 2 values of a texel: sh_l1_irradiance along the world directions of
-/// hl2_basis in frame f (f.t, f.b, f.n unit and orthogonal; left-handed frames are fine: the
-/// basis follows the frame). Cost: O(1).
+/// The three Half-Life 2 values of a texel from L1 SH alone: sh_l1_irradiance along the world
+/// directions of hl2_basis in frame f (f.t, f.b, f.n unit and orthogonal; left-handed frames are
+/// fine: the basis follows the frame). For engines that keep only the SH maps. L1 loses the
+/// band >= 2 part of the clamped cosine: 13% RMS for a small overhead lamp, 25% for a grazing side
+/// light (docs/bake.md); the baker's own HL2 maps use the cone series instead. Cost: O(1).
 std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, const frame& f) noexcept;
 
 /// The lightmap tangent frame of a triangle (positions p, lightmap UVs uv) at a point of unit
