@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, threads);
     // Reference: a hemicube at every point.
     const std::size_t count = ps.p.size();
-    std::vector<irradiance_sample> ref(count);  // sliced from cache_sample
+    std::vector<irradiance_sample> ref(count);
     const auto t0 = std::chrono::steady_clock::now();
     parallel_for(count, threads, 64, [&](int w, std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) ref[i] = sampler(w, ps.p[i], ps.n[i]);
