@@ -1,7 +1,19 @@
-"""Charts of the irradiance cache: RMS relative error against the fraction of points given a
-hemicube, one panel per scene (docs/bench/cache.png, from cache_sweep.csv). Solid: error against
-a hemicube at every point (same N); dashed: error against a converged reference (N = 256), with
-the N = 64 hemicube-at-every-point's own error as a grey line."""
+"""Charts of the irradiance cache (issue 5): RMS relative error against the fraction of points
+given a hemicube, one column per scene, curves per hemicube resolution N (solid: with gradients,
+dashed: without). Top row: error against the converged reference (the cache's total error), with
+the per-point reference's own error at each N as a dotted horizontal line in the same colour.
+Bottom row: error against a hemicube at every point with the same N (the interpolation error
+alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the points; previews:
+<= 3% at <= 3%).
+
+  plot_cache.py DIR      draws DIR/cache.png from DIR/cache_sweep.csv (bash benchmarks/run.sh cache)
+                         and, if DIR/cache_resolution.csv exists (bash benchmarks/run.sh cache_resolution),
+                         DIR/cache_resolution.png and DIR/cache_resolution.md (the table of
+                         interpolated hemicube fractions at the targets and gradient savings);
+                         the same for cache_resolution_k128.csv (hexagon ceiling, 128 x 128 grid).
+"""
+import math
+import os
 import sys
 
 import matplotlib
@@ -10,27 +22,129 @@ import matplotlib.pyplot as plt
 
 from bench_csv import load_csv
 
+COLORS = {64: "C1", 128: "C0", 256: "C2", 512: "C3", 1024: "C4"}
+
+
+def resolution(r):
+    return int(r.get("resolution", 64) or 64)
+
+
+def curve(rows, scene, n, grad, key):
+    """(fraction, error) points of one curve, sorted by fraction."""
+    return sorted((r["fraction"], r[key]) for r in rows
+                  if r["scene"] == scene and resolution(r) == n and int(r["gradients"]) == grad)
+
+
+def fraction_for(pts, target):
+    """Smallest hemicube fraction at which the curve (piecewise linear in log-log, in order of
+    fraction) reaches RMS <= target; None if it never does within the measured range."""
+    for i, (f, e) in enumerate(pts):
+        if e <= target:
+            if i == 0:
+                return f
+            f0, e0 = pts[i - 1]
+            if e0 <= target or e0 == e or e <= 0.0:
+                return f
+            t = (math.log(e0) - math.log(target)) / (math.log(e0) - math.log(e))
+            return math.exp(math.log(f0) + t * (math.log(f) - math.log(f0)))
+    return None
+
+
+def chart(rows, path):
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    ns = sorted({resolution(r) for r in rows})
+    has_converged = "rms_rel_err_converged" in rows[0]
+    keys = [("rms_rel_err_converged", "RMS error vs converged (%)")] if has_converged else []
+    keys.append(("rms_rel_err", "RMS error vs hemicube per point (%)"))
+    fig, axes = plt.subplots(len(keys), len(scenes), figsize=(4.8 * len(scenes), 3.9 * len(keys)), squeeze=False)
+    for col, scene in enumerate(scenes):
+        sr = [r for r in rows if r["scene"] == scene]
+        for row, (key, ylabel) in enumerate(keys):
+            ax = axes[row][col]
+            for n in ns:
+                if not any(resolution(r) == n for r in sr):
+                    continue
+                c = COLORS.get(n, "k")
+                for grad, style in ((1, "o-"), (0, "s--")):
+                    pts = [p for p in curve(rows, scene, n, grad, key) if p[1] > 0]  # 0: every point rendered
+                    if pts:
+                        ax.plot([100 * p[0] for p in pts], [100 * p[1] for p in pts], style, color=c, ms=3.5,
+                                alpha=1.0 if grad else 0.6,
+                                label=f"N={n} {'gradients' if grad else 'no gradients'}")
+                if key == "rms_rel_err_converged":
+                    ref = [r["reference_rms_rel_err_converged"] for r in sr if resolution(r) == n][0]
+                    ax.axhline(100 * ref, color=c, ls=":", lw=1.2, label=f"N={n} hemicube per point")
+            r0 = sr[0]
+            title = f"{scene} ({int(r0['points'])} points"
+            if "grid" in r0:
+                title += f", grid {int(r0['grid'])}"
+            title += ")"
+            if key == "rms_rel_err_converged" and "converged_resolution" in r0:
+                title += f"\nconverged: N={int(r0['converged_resolution'])}"
+                if "converged_rolls" in r0 and int(r0["converged_rolls"]) > 1:
+                    title += f" x {int(r0['converged_rolls'])} rolls"
+                title += f" at {int(r0['converged_points'])} points"
+            ax.set_title(title, fontsize=8.5)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlim(0.8, 110)
+            lo, hi = ax.get_ylim()
+            lo = min(lo, 0.5)
+            for x1, y in ((10.0, 1.0), (3.0, 3.0)):  # the targets
+                ax.fill_between([0.8, x1], [lo, lo], [y, y], color="0.6", alpha=0.2, lw=0)
+            ax.set_ylim(lo, max(hi, 3.5))
+            ax.set_xlabel("points given a hemicube (%)")
+            if col == 0:
+                ax.set_ylabel(ylabel)
+            ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"wrote {path}")
+
+
+def table(rows, path):
+    """Markdown: per scene and N, the per-point reference's own error, the hemicube fraction at
+    which the curves reach 1% and 3% RMS, and the gradient savings at equal RMS."""
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    out = ["| scene | N | per-point vs converged (RMS) | error vs | fraction for 1% (grad / no grad) | "
+           "fraction for 3% (grad / no grad) | gradient savings at equal RMS (no-grad fraction / grad fraction) |",
+           "| --- | --- | --- | --- | --- | --- | --- |"]
+
+    def fmt(f):
+        return "not reached" if f is None else f"{100 * f:.1f}%"
+
+    for scene in scenes:
+        for n in sorted({resolution(r) for r in rows if r["scene"] == scene}):
+            ref = [r["reference_rms_rel_err_converged"] for r in rows
+                   if r["scene"] == scene and resolution(r) == n][0]
+            for key, what in (("rms_rel_err", "per point"), ("rms_rel_err_converged", "converged")):
+                g = curve(rows, scene, n, 1, key)
+                ng = curve(rows, scene, n, 0, key)
+                savings = []
+                for f, e in g:
+                    if e <= 0.0:  # every point rendered: nothing to compare
+                        continue
+                    f_ng = fraction_for(ng, e)
+                    if f_ng is None:
+                        savings.append(f"{100 * e:.2f}%: > {max(p[0] for p in ng) / f:.1f}x")
+                    else:
+                        savings.append(f"{100 * e:.2f}%: {f_ng / f:.1f}x")
+                out.append(f"| {scene} | {n} | {100 * ref:.2f}% | {what} | {fmt(fraction_for(g, 0.01))} / "
+                           f"{fmt(fraction_for(ng, 0.01))} | {fmt(fraction_for(g, 0.03))} / {fmt(fraction_for(ng, 0.03))} | "
+                           + "; ".join(savings) + " |")
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+    print(f"wrote {path}")
+
+
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
-rows = load_csv(f"{out}/cache_sweep.csv")
-scenes = list(dict.fromkeys(r["scene"] for r in rows))
-fig, axes = plt.subplots(1, len(scenes), figsize=(4.6 * len(scenes), 3.9))
-for ax, scene in zip(axes, scenes):
-    for grad, color in ((1, "C0"), (0, "C3")):
-        pts = sorted((r["fraction"], r["rms_rel_err"], r["rms_rel_err_converged"]) for r in rows
-                     if r["scene"] == scene and r["gradients"] == grad)
-        label = "gradients" if grad else "no gradients"
-        ax.plot([100 * p[0] for p in pts], [100 * p[1] for p in pts], "o-", color=color, label=f"{label}: vs hemicube per point")
-        ax.plot([100 * p[0] for p in pts], [100 * p[2] for p in pts], "s--", color=color, alpha=0.7,
-                label=f"{label}: vs converged (N=256)")
-    ref = [r["reference_rms_rel_err_converged"] for r in rows if r["scene"] == scene][0]
-    ax.axhline(100 * ref, color="grey", lw=1, label="hemicube per point (N=64) vs converged")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_title(scene, fontsize=10)
-    ax.set_xlabel("points given a hemicube (%)")
-    ax.grid(True, which="both", alpha=0.3)
-axes[0].set_ylabel("RMS relative error (%)")
-axes[0].legend(fontsize=6.5)
-fig.tight_layout()
-fig.savefig(f"{out}/cache.png", dpi=110)
-print(f"wrote {out}/cache.png")
+if os.path.exists(f"{out}/cache_sweep.csv"):
+    chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
+for name in ("cache_resolution", "cache_resolution_k128"):
+    if os.path.exists(f"{out}/{name}.csv"):
+        rows = load_csv(f"{out}/{name}.csv")
+        if not rows:
+            continue
+        chart(rows, f"{out}/{name}.png")
+        table(rows, f"{out}/{name}.md")

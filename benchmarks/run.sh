@@ -2,6 +2,8 @@
 # Regenerates the benchmark CSVs and charts under docs/bench/ (one command for all of them):
 #   bash benchmarks/run.sh            every benchmark and sweep
 #   bash benchmarks/run.sh NAME...    only these (e.g. geometry raster)
+#   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
+#                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
 # benchmarks/plot_NAME.py (if any) draws docs/bench/NAME.png from the CSV(s).
@@ -22,6 +24,24 @@ if [ ${#names[@]} -eq 0 ]; then
   done
 fi
 for n in "${names[@]}"; do
+  if [ "$n" = cache_resolution ]; then
+    echo "== sweep_cache (resolution study)"
+    csv=docs/bench/cache_resolution.csv truth="$build/cache_truth" a=0.05,0.1,0.2,0.3,0.5
+    rm -f "$csv"; mkdir -p "$truth"
+    common=(--append --grid 64 --a "$a" --truth-cache "$truth" --rolls 4)
+    "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes hexagon --n 64,128,256,512 \
+      --converged 1024 --stride 7 --check 2048 --check-stride 4
+    "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes cornell --n 64,128,256,512 \
+      --converged 1024 --stride 19 --check 2048 --check-stride 6
+    "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes sky --n 64,128 \
+      --converged 512 --stride 7 --check 1024 --check-stride 4
+    # the hexagon room ceiling again on the default 128 x 128 grid (fractions depend on the grid)
+    rm -f docs/bench/cache_resolution_k128.csv
+    "$build/benchmarks/sweep_cache" docs/bench/cache_resolution_k128.csv --grid 128 --a 0.1,0.2,0.3,0.5 \
+      --truth-cache "$truth" --rolls 4 --scenes hexagon --n 512 --converged 1024 --stride 28 --check 2048 --check-stride 4
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
   if [ -x "$build/benchmarks/bench_$n" ]; then
     echo "== bench_$n"
     "$build/benchmarks/bench_$n" --benchmark_repetitions="${REPETITIONS:-5}" \

@@ -22,7 +22,7 @@ void write_hemicube_exr(const std::string& path_prefix, const hemicube_buffer& b
     float* r = radiance.at(px.x, px.y);
     float* d = distance.at(px.x, px.y);
     float* f = flags.at(px.x, px.y);
-    for (int c = 0; c < 3; ++c) r[c] = buffer.radiance[3 * i + static_cast<std::size_t>(c)];
+    for (int c = 0; c < 3; ++c) r[c] = buffer.channel(c)[i];
     const float dist = std::isfinite(buffer.distance[i]) ? buffer.distance[i] : 0.0f;
     d[0] = d[1] = d[2] = dist;
     f[0] = (buffer.flags[i] & texel_miss) ? 1.0f : 0.0f;

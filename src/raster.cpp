@@ -14,6 +14,15 @@
 #else
 #define HEMILIGHT_RASTER_SSE2 0
 #endif
+// AVX2 kernels (eight texels per step), compiled for AVX2 with a target attribute and picked at
+// run time, so the library itself still runs on any x86-64. GCC and Clang only.
+#if HEMILIGHT_RASTER_SSE2 && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define HEMILIGHT_RASTER_AVX2 1
+#define HEMILIGHT_TARGET_AVX2 __attribute__((target("avx2")))
+#else
+#define HEMILIGHT_RASTER_AVX2 0
+#endif
 
 namespace hemilight {
 
@@ -171,6 +180,10 @@ struct fixed_point {
 #if HEMILIGHT_RASTER_SSE2
 // Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
 constexpr std::int64_t simd_extent = 32 * sub_one;
+// The same for the AVX2 kernel, which also takes the big triangles of small hemicubes: with both
+// extents <= 64 texels (2^14 in fixed point), every edge value it forms, up to 8 texels past the
+// box, is below 2^14 * 2^14 + 2^14 * (2^14 + 2^11) + 1 < 2^29.2: exact in 32-bit lanes.
+constexpr std::int64_t avx2_extent = 64 * sub_one;
 
 // See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
 // E = ex x + ey y + e0; covered iff all three are >= 0.
@@ -246,35 +259,225 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 }
 #endif
 
+#if HEMILIGHT_RASTER_AVX2
+// The AVX2 kernels compute exactly what the scalar reference does (the same float operations in
+// the same order; target("avx2") does not enable FMA contraction), so buffers stay bit-identical.
+// They may read and write back up to 7 texels past the last one they own (the rows are contiguous
+// and the visibility buffers are padded by 8): masked lanes store the values they loaded.
+
+// Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
+HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
+                                     std::uint32_t draw) noexcept {
+  const __m256 zr = _mm256_set1_ps(zrow), dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
+  const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), end = _mm256_set1_epi32(hi + 1);
+  for (int x = lo; x <= hi; x += 8) {
+    const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
+    const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
+    const __m256 old = _mm256_loadu_ps(drow + x);
+    const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)));
+    _mm256_storeu_ps(drow + x, _mm256_blendv_ps(old, z, closer));
+    float* ip = reinterpret_cast<float*>(irow + x);
+    _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+  }
+}
+
+// The small-triangle path of small_triangle_sse2_impl, eight texels per step.
+template <bool count_mode>
+HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3],
+                                                    const std::int64_t (&e0)[3], std::int64_t x_begin, std::int64_t x_end,
+                                                    std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
+                                                    std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
+                                                    float dzdx, std::uint32_t draw) noexcept {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256i step[3], row[3], dy[3];
+  for (int k = 0; k < 3; ++k) {
+    // Values at (x_begin + lane, y_begin): exact in int64, small enough for int32 here.
+    const auto base = static_cast<std::int32_t>(ex[k] * x_begin + ey[k] * y_begin + e0[k]);
+    const auto ek = static_cast<std::int32_t>(ex[k]);
+    row[k] = _mm256_add_epi32(_mm256_set1_epi32(base), _mm256_mullo_epi32(_mm256_set1_epi32(ek), lane));
+    step[k] = _mm256_set1_epi32(8 * ek);
+    dy[k] = _mm256_set1_epi32(static_cast<std::int32_t>(ey[k]));
+  }
+  const __m256 dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
+  const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
+  const int xb = static_cast<int>(x_begin), xe = static_cast<int>(x_end);
+  const __m256i end = _mm256_set1_epi32(xe + 1);
+  if (!count_mode && xe - xb < 8) {
+    // One group per row (most triangles of big scenes): the lanes' x, their depth step and the
+    // box mask are the same on every row. The same operations as below, so the same bits.
+    const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(xb), lane);
+    const __m256i box = _mm256_cmpgt_epi32(end, xi);
+    const __m256 zx = _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi));
+    __m256i a = row[0], b = row[1], c = row[2];
+    for (std::int64_t y = y_begin; y <= y_end; ++y) {
+      const __m256i in = _mm256_andnot_si256(_mm256_or_si256(_mm256_or_si256(a, b), c), box);
+      a = _mm256_add_epi32(a, dy[0]);
+      b = _mm256_add_epi32(b, dy[1]);
+      c = _mm256_add_epi32(c, dy[2]);
+      const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
+      if (_mm256_movemask_ps(mask) == 0) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
+      const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
+      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
+      const __m256 old = _mm256_loadu_ps(depth + i);
+      const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
+      _mm256_storeu_ps(depth + i, _mm256_blendv_ps(old, z, closer));
+      float* ip = reinterpret_cast<float*>(ids + i);
+      _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+    }
+    return;
+  }
+  for (std::int64_t y = y_begin; y <= y_end; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
+    const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
+    __m256i a = row[0], b = row[1], c = row[2];
+    for (int x = xb; x <= xe; x += 8) {
+      const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
+      // Covered lanes (the OR of the three edge values has a clear sign bit) inside the box.
+      const __m256i in = _mm256_andnot_si256(_mm256_or_si256(_mm256_or_si256(a, b), c), _mm256_cmpgt_epi32(end, xi));
+      a = _mm256_add_epi32(a, step[0]);
+      b = _mm256_add_epi32(b, step[1]);
+      c = _mm256_add_epi32(c, step[2]);
+      const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
+      if (_mm256_movemask_ps(mask) == 0) continue;
+      const std::size_t i = r + static_cast<std::size_t>(x);
+      if (count_mode) {
+        __m256i* cp = reinterpret_cast<__m256i*>(counts + i);
+        _mm256_storeu_si256(cp, _mm256_sub_epi32(_mm256_loadu_si256(cp), _mm256_castps_si256(mask)));
+        continue;
+      }
+      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
+      const __m256 old = _mm256_loadu_ps(depth + i);
+      const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
+      _mm256_storeu_ps(depth + i, _mm256_blendv_ps(old, z, closer));
+      float* ip = reinterpret_cast<float*>(ids + i);
+      _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+    }
+    row[0] = _mm256_add_epi32(row[0], dy[0]);
+    row[1] = _mm256_add_epi32(row[1], dy[1]);
+    row[2] = _mm256_add_epi32(row[2], dy[2]);
+  }
+}
+
+// The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
+// texels are left to the caller. Runs are found by shade key (keys[id]: the first record with
+// the same shade), so the two triangles of a quad, or all black surfaces, make one run.
+HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* __restrict depth,
+                                               const float* __restrict lengths, std::uint32_t* __restrict ids,
+                                               const hemicube_rasterizer::shade* __restrict shades,
+                                               const std::uint32_t* __restrict keys, float* __restrict distance,
+                                               float* __restrict red, float* __restrict green,
+                                               float* __restrict blue, std::uint8_t* __restrict flags) noexcept {
+  const __m256 zero = _mm256_setzero_ps();
+  // The current run: its shade key, and its record when all its texels so far had one record
+  // (a cheap first test); -1 = none (record numbers are < 2^31).
+  __m256i run_id = _mm256_set1_epi32(-1), run_key = _mm256_set1_epi32(-1);
+  __m256 run_r = zero, run_g = zero, run_b = zero;
+  std::uint64_t run_flags = 0;
+  for (std::size_t i = 0; i + 8 <= count; i += 8) {
+    const __m256 d = _mm256_loadu_ps(depth + i);
+    _mm256_storeu_ps(distance + i, _mm256_div_ps(_mm256_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
+    const __m256i id = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ids + i)),
+                                        _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ids + i), id);
+    if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) != -1) {
+      const __m256i key = _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
+      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1) {
+        run_id = _mm256_set1_epi32(-1);  // same shade, other records
+        _mm256_storeu_ps(red + i, run_r);
+        _mm256_storeu_ps(green + i, run_g);
+        _mm256_storeu_ps(blue + i, run_b);
+        std::memcpy(flags + i, &run_flags, 8);
+        continue;
+      }
+      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
+      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
+        run_id = run_key = _mm256_set1_epi32(-1);
+        alignas(32) std::uint32_t lane[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
+        for (std::size_t k = 0; k < 8; ++k) {
+          const hemicube_rasterizer::shade& sh = shades[lane[k]];
+          red[i + k] = sh.r;
+          green[i + k] = sh.g;
+          blue[i + k] = sh.b;
+          flags[i + k] = static_cast<std::uint8_t>(sh.flags);
+        }
+        continue;
+      }
+      // A new run of shade key `first`.
+      run_key = first;
+      const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
+      run_id = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1 ? id0 : _mm256_set1_epi32(-1);
+      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+      run_r = _mm256_set1_ps(sh.r);
+      run_g = _mm256_set1_ps(sh.g);
+      run_b = _mm256_set1_ps(sh.b);
+      run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
+    }
+    _mm256_storeu_ps(red + i, run_r);
+    _mm256_storeu_ps(green + i, run_g);
+    _mm256_storeu_ps(blue + i, run_b);
+    std::memcpy(flags + i, &run_flags, 8);
+  }
+}
+#endif
+
 // The resolve loops, with restrict pointers so that the byte stores of the flags do not force
 // reloads (char stores may alias anything). Texels never written have depth 0 (their id is
-// stale): they are set to record 0, the sky. Stores are the bottleneck: one 16-byte store per texel
-// writes its RGB plus one float that the next texel overwrites (the last texel is written
-// exactly), and the flags go out eight at a time.
+// stale): they are set to record 0, the sky. The radiance is planar (hemicube_buffer).
 void resolve_texels(std::size_t count, const float* __restrict depth, const float* __restrict lengths,
                     std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
-                    float* __restrict distance, float* __restrict radiance, std::uint8_t* __restrict flags,
-                    bool simd) noexcept {
+                    float* __restrict distance, float* __restrict red, float* __restrict green,
+                    float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
 #if HEMILIGHT_RASTER_SSE2
   if (simd) {
-    // One pass, four texels at a time: distance, id of unwritten texels -> 0, radiance, flags.
+    // Four texels at a time: distance, id of unwritten texels -> 0, radiance, flags. Texels come
+    // in runs that see the same record (a triangle, or the sky): when four neighbours share one,
+    // its channels go out as three broadcast stores, kept while the record does not change, and
+    // its flags as one word; mixed groups are written texel by texel.
     const __m128 zero = _mm_setzero_ps();
-    for (; i + 4 < count; i += 4) {  // '<': the 16-byte radiance stores never pass the end
+    __m128i run_id = _mm_set1_epi32(-1);  // no record yet (record numbers are < 2^31)
+    __m128 run_r = zero, run_g = zero, run_b = zero;
+    std::uint32_t run_flags = 0;
+    for (; i + 4 <= count; i += 4) {
       const __m128 d = _mm_loadu_ps(depth + i);
       _mm_storeu_ps(distance + i, _mm_div_ps(_mm_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
       const __m128i id = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)),
                                        _mm_castps_si128(_mm_cmpgt_ps(d, zero)));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(ids + i), id);
+      bool uniform = true;
+      if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, run_id)) != 0xffff) {
+        const __m128i first = _mm_shuffle_epi32(id, 0);
+        if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
+          run_id = first;
+          const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm_cvtsi128_si32(id))];
+          run_r = _mm_set1_ps(sh.r);
+          run_g = _mm_set1_ps(sh.g);
+          run_b = _mm_set1_ps(sh.b);
+          run_flags = (sh.flags & 0xffu) * 0x01010101u;
+        } else {
+          run_id = _mm_set1_epi32(-1);
+          uniform = false;
+        }
+      }
+      if (uniform) {
+        _mm_storeu_ps(red + i, run_r);
+        _mm_storeu_ps(green + i, run_g);
+        _mm_storeu_ps(blue + i, run_b);
+        std::memcpy(flags + i, &run_flags, 4);
+        continue;
+      }
       std::uint32_t lane[4];
       _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
-      std::uint8_t packed[4];
       for (std::size_t k = 0; k < 4; ++k) {
         const hemicube_rasterizer::shade& sh = shades[lane[k]];
-        _mm_storeu_ps(radiance + 3 * (i + k), _mm_loadu_ps(&sh.r));
-        packed[k] = static_cast<std::uint8_t>(sh.flags);
+        red[i + k] = sh.r;
+        green[i + k] = sh.g;
+        blue[i + k] = sh.b;
+        flags[i + k] = static_cast<std::uint8_t>(sh.flags);
       }
-      std::memcpy(flags + i, packed, 4);
     }
   }
 #endif
@@ -283,9 +486,9 @@ void resolve_texels(std::size_t count, const float* __restrict depth, const floa
     distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
     ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
     const hemicube_rasterizer::shade& sh = shades[ids[i]];
-    radiance[3 * i] = sh.r;
-    radiance[3 * i + 1] = sh.g;
-    radiance[3 * i + 2] = sh.b;
+    red[i] = sh.r;
+    green[i] = sh.g;
+    blue[i] = sh.b;
     flags[i] = static_cast<std::uint8_t>(sh.flags);
   }
 }
@@ -341,6 +544,9 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
                            "; it must be finite and >= 0 (0 = default)");
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
   simd_ = options.simd;
+#if HEMILIGHT_RASTER_AVX2
+  avx2_ = options.simd && options.avx2 && __builtin_cpu_supports("avx2");
+#endif
   if (options.sky) {
     // A cheap structural check; the values were checked when the map was built (from_image).
     const cubemap& m = *options.sky;
@@ -392,19 +598,23 @@ void hemicube_rasterizer::prepare(int resolution) {
     }
     n_ = resolution;
   }
-  depth_.assign(count, 0.0f);
-  ids_.resize(count);  // stale ids are masked by depth 0 (never written)
+  // Padded by 8 texels: the AVX2 kernels may load and store back up to 7 texels past a row's end.
+  depth_.resize(count + 8);
+  std::memset(depth_.data(), 0, depth_.size() * sizeof(float));  // 0.0f is all zero bits
+  ids_.resize(count + 8);  // stale ids are masked by depth 0 (never written)
   // Record 0 stands for "nothing hit" (the sky): texels start there.
   draws_.clear();
   draws_.push_back(draw_record{});
   draws_.front().index = no_triangle;
   shades_.clear();
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_miss});
+  shade_keys_.assign(1, 0u);
+  std::fill(std::begin(shade_cache_), std::end(shade_cache_), 0u);
   stats_ = {};
 }
 
 std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
-  assert(texel < ids_.size());
+  assert(texel < hemicube_texel_count(n_));
   return draws_[ids_[texel]].index;  // the resolve set unwritten texels to record 0
 }
 
@@ -534,7 +744,19 @@ std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& 
   }
   const auto draw = static_cast<std::uint32_t>(draws_.size());
   draws_.push_back(rec);
-  shades_.push_back({rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags});
+  const shade sh{rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags};
+  shades_.push_back(sh);
+  // Shade key: an earlier record with the same bits, if the cache remembers one.
+  std::uint32_t bits[4];
+  std::memcpy(bits, &sh, sizeof bits);
+  const std::uint32_t h = (bits[0] * 0x9e3779b1u) ^ (bits[1] * 0x85ebca77u) ^ (bits[2] * 0xc2b2ae3du) ^ bits[3];
+  std::uint32_t& slot = shade_cache_[(h >> 26) & 63u];
+  if (slot != 0 && std::memcmp(&shades_[slot], &sh, sizeof sh) == 0) {
+    shade_keys_.push_back(slot);
+  } else {
+    slot = draw;
+    shade_keys_.push_back(draw);
+  }
   return draw;
 }
 
@@ -624,6 +846,12 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
     float* drow = depth + row;
     std::uint32_t* irow = ids + row;
     int x = lo;
+#if HEMILIGHT_RASTER_AVX2
+    if (avx2_) {
+      span_avx2(drow, irow, lo, hi, zrow, dzdx, draw);
+      return;
+    }
+#endif
 #if HEMILIGHT_RASTER_SSE2
     if (simd_ && hi - lo >= 3) {
       // Four texels at a time; the same operations in the same order as the scalar loop below,
@@ -688,6 +916,16 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
       e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
     }
 
+#if HEMILIGHT_RASTER_AVX2
+    if (avx2_ && max_x - min_x <= avx2_extent && max_y - min_y <= avx2_extent) {
+      // Triangles up to 64 texels across, AVX2: the box is scanned eight texels per step with
+      // 32-bit edge values (see avx2_extent), the coverage mask going straight into the depth
+      // test. Cheaper than the span walk below even for triangles that fill half their box.
+      small_triangle_avx2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                                 dzdy, dzdx, draw);
+      continue;
+    }
+#endif
 #if HEMILIGHT_RASTER_SSE2
     if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
       // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
@@ -809,17 +1047,27 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   std::uint32_t* ids = ids_.data();
   const shade* shades = shades_.data();
   float* distance = out.distance.data();
-  float* radiance = out.radiance.data();
+  float* red = out.channel(0);
+  float* green = out.channel(1);
+  float* blue = out.channel(2);
   std::uint8_t* flags = out.flags.data();
-  resolve_texels(count, depth, lengths, ids, shades, distance, radiance, flags, simd_);
+#if HEMILIGHT_RASTER_AVX2
+  if (avx2_) {
+    resolve_texels_avx2(count, depth, lengths, ids, shades, shade_keys_.data(), distance, red, green, blue, flags);
+    const std::size_t done = count - count % 8, rest = count - done;
+    resolve_texels(rest, depth + done, lengths + done, ids + done, shades, distance + done, red + done,
+                   green + done, blue + done, flags + done, false);
+  } else
+#endif
+    resolve_texels(count, depth, lengths, ids, shades, distance, red, green, blue, flags, simd_);
   if (sky_) {
     // Misses see the environment along the texel's world direction.
     for (std::size_t i = 0; i < count; ++i) {
       if (!(flags[i] & texel_miss)) continue;
       const glm::vec4 l = sky_->sample(basis.to_world(directions_[i]));
-      radiance[3 * i] = l.x;
-      radiance[3 * i + 1] = l.y;
-      radiance[3 * i + 2] = l.z;
+      red[i] = l.x;
+      green[i] = l.y;
+      blue[i] = l.z;
     }
   }
   if (!texture || !scene_->has_lightmap_uvs()) return;
@@ -835,9 +1083,9 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
     const glm::vec2& uv0 = uvs[indices[tri]];
     const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
     const glm::vec3 l = texture->sample(uv);
-    radiance[3 * i] = l.x;
-    radiance[3 * i + 1] = l.y;
-    radiance[3 * i + 2] = l.z;
+    red[i] = l.x;
+    green[i] = l.y;
+    blue[i] = l.z;
   }
 }
 
@@ -845,10 +1093,12 @@ void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame
                                           std::vector<std::uint32_t>& counts) {
   check_arguments("hemicube_rasterizer::render_coverage", position, basis, resolution);
   prepare(resolution);
-  counts.assign(hemicube_texel_count(resolution), 0u);
+  // Padded while drawing like the visibility buffers (the AVX2 kernel stores back past the end).
+  counts.assign(hemicube_texel_count(resolution) + 8, 0u);
   counts_ = &counts;
   draw_all<mode::count>(position, basis, nullptr);
   counts_ = nullptr;
+  counts.resize(hemicube_texel_count(resolution));
   std::fill(ids_.begin(), ids_.end(), 0u);  // seen_triangle() after this: no_triangle everywhere
 }
 

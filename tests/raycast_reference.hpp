@@ -79,9 +79,7 @@ inline hemicube_buffer raycast_hemicube(const std::vector<ref_triangle>& tris, c
       l = back ? glm::vec3(0.0f) : tris[std::size_t(hit)].radiance;
       flag = back ? texel_back_face : texel_hit_front;
     }
-    buf.radiance[3 * i] = l.x;
-    buf.radiance[3 * i + 1] = l.y;
-    buf.radiance[3 * i + 2] = l.z;
+    buf.set_radiance(i, l);
     buf.distance[i] = hit >= 0 ? static_cast<float>(dist) : std::numeric_limits<float>::infinity();
     buf.flags[i] = flag;
   }

@@ -679,9 +679,9 @@ TEST_CASE("irradiance: the rasterizer's environment sky agrees with the cosine f
   for (std::size_t i = 0; i < buf.texel_count(); ++i) {
     const float y = open_buf.basis.to_world(hemicube_texel_direction(32, i)).y;
     if (std::fabs(y) < 1e-4f) continue;
-    const float expected = y < 0.0f ? 0.0f : open_buf.radiance[3 * i];
+    const float expected = y < 0.0f ? 0.0f : open_buf.radiance_at(i).x;
     down += y < 0.0f ? 1u : 0u;
-    mismatches += buf.radiance[3 * i] == expected ? 0u : 1u;
+    mismatches += buf.radiance_at(i).x == expected ? 0u : 1u;
   }
   CHECK(down > 500);
   CHECK(mismatches == 0);

@@ -131,6 +131,30 @@ TEST_CASE("integrate: Half-Life 2 basis irradiance under a uniform sky matches t
   }
 }
 
+TEST_CASE("integrate: L1 SH band 1 of an unoccluded polygon is its vector irradiance, with or without g_r", "[integrate]") {
+  // For radiance seen only in the upper hemisphere, the band-1 projection of L is
+  // Y1 * integral of L w d omega = Y1 * Phi (the vector irradiance, Lambert's polygon formula),
+  // in world order (y, z, x). The hemicube's vector solid angles are exact per texel, so only
+  // the emitter's edge texels (partly covered) err: the same bound as E's (2% at N = 256 is ample:
+  // the emitter spans ~150 texels across there).
+  const closed_form_scene s = unoccluded_emitter();
+  const hemicube_buffer buf = render(s, 256, s.position, s.normal);
+  const glm::dvec3 phi = polygon_vector_irradiance({{-0.3, -0.2, 1.0}, {-0.3, 0.4, 1.0}, {0.5, 0.4, 1.0}, {0.5, -0.2, 1.0}},
+                                                   s.position, 1.0);
+  const double y1 = 0.488602511902920;
+  for (bool gradients : {true, false})
+    for (bool simd_kernels : {true, false}) {
+      integrate_options o;
+      o.directional = true;
+      o.rotation_gradient = gradients;
+      o.simd_kernels = simd_kernels;
+      const irradiance_sample r = integrate(buf, o);
+      INFO("rotation gradient " << gradients << ", simd kernels " << simd_kernels);
+      const glm::dvec3 band1(r.sh_l1[3].x, r.sh_l1[1].x, r.sh_l1[2].x);  // (x, y, z) of red
+      CHECK(glm::length(band1 / y1 - phi * double(s.tint.x)) < 0.02 * glm::length(phi));
+    }
+}
+
 TEST_CASE("integrate: polygon emitter irradiance converges to Lambert's formula within the derived bound", "[integrate]") {
   const closed_form_scene s = unoccluded_emitter();
   const double e_ref = s.irradiance(s.position, s.normal);
@@ -251,20 +275,38 @@ TEST_CASE("integrate: gradients against finite differences of re-rendered hemicu
   CHECK(rel(gr, fd_r) < 0.08);
 }
 
-TEST_CASE("integrate: float and double accumulation agree", "[integrate]") {
+TEST_CASE("integrate: float and double accumulation agree (both float kernels)", "[integrate]") {
   const closed_form_scene s = lit_room();
-  const hemicube_buffer buf = render(s, 128, s.position, s.normal);
-  integrate_options of, od;
+  hemicube_buffer buf = render(s, 128, s.position, s.normal);
+  // Some back-face texels (every seventh), so the back-face sums are exercised too; and N = 6
+  // (108 texels, not a multiple of 8) for the kernels' tails.
+  for (std::size_t i = 0; i < buf.texel_count(); i += 7) buf.flags[i] = texel_back_face;
+  const hemicube_buffer small = render(s, 6, s.position, s.normal);
+  for (const hemicube_buffer* b : {static_cast<const hemicube_buffer*>(&buf), &small}) {
+    for (bool simd_kernels : {true, false}) {
+      integrate_options of, od;
+      od.double_precision = true;
+      of.simd_kernels = simd_kernels;
+      of.directional = od.directional = true;
+      const irradiance_sample a = integrate(*b, of), d = integrate(*b, od);
+      INFO("N " << b->resolution << ", simd kernels " << simd_kernels);
+      // Float lanes over blocks of 1024 texels: relative error ~ (1024/8) x 6e-8 ~ 1e-5 per sum at
+      // worst, ~1e-6 typically; the gradients are sums of signed terms that cancel to ~10% of their
+      // magnitude, so 1e-4.
+      CHECK(a.irradiance.x == Approx(d.irradiance.x).epsilon(1e-5));
+      CHECK(a.harmonic_mean_distance == Approx(d.harmonic_mean_distance).epsilon(1e-5));
+      CHECK(a.backface_fraction == Approx(d.backface_fraction).epsilon(1e-5));
+      CHECK(a.min_distance == d.min_distance);
+      CHECK(glm::length(a.translation_gradient[0] - d.translation_gradient[0]) <
+            1e-4f * glm::length(d.translation_gradient[0]));
+      CHECK(glm::length(a.rotation_gradient[0] - d.rotation_gradient[0]) < 1e-4f * glm::length(d.rotation_gradient[0]));
+      CHECK(a.hl2[0].x == Approx(d.hl2[0].x).epsilon(1e-5));
+    }
+  }
+  // The back-face fraction itself: the weight of the flagged texels (1 in 7, spread evenly).
+  integrate_options od;
   od.double_precision = true;
-  of.directional = od.directional = true;
-  const irradiance_sample a = integrate(buf, of), d = integrate(buf, od);
-  // Float lanes over rows of 128 texels: relative error ~ (128/8) x 6e-8 = 1e-6 per sum; the
-  // gradients are sums of signed terms that cancel to ~10% of their magnitude, so 1e-4.
-  CHECK(a.irradiance.x == Approx(d.irradiance.x).epsilon(1e-5));
-  CHECK(a.harmonic_mean_distance == Approx(d.harmonic_mean_distance).epsilon(1e-5));
-  CHECK(glm::length(a.translation_gradient[0] - d.translation_gradient[0]) < 1e-4f * glm::length(d.translation_gradient[0]));
-  CHECK(glm::length(a.rotation_gradient[0] - d.rotation_gradient[0]) < 1e-4f * glm::length(d.rotation_gradient[0]));
-  CHECK(a.hl2[0].x == Approx(d.hl2[0].x).epsilon(1e-5));
+  CHECK(integrate(buf, od).backface_fraction == Approx(1.0 / 7.0).epsilon(0.02));
 }
 
 TEST_CASE("integrate: the result does not depend on the hemicube's roll beyond the discretisation bound", "[integrate]") {

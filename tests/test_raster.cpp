@@ -151,8 +151,8 @@ std::size_t compare_with_ray_caster(const scene_mesh& m, const glm::vec3& positi
       expected_flags = back ? texel_back_face : texel_hit_front;
       ok = seen == static_cast<std::uint32_t>(ref.triangle) && std::fabs(buf.distance[i] - ref.t) <= 1e-4 * ref.t;
     }
-    ok = ok && buf.flags[i] == expected_flags && buf.radiance[3 * i] == expected_radiance.x &&
-         buf.radiance[3 * i + 1] == expected_radiance.y && buf.radiance[3 * i + 2] == expected_radiance.z;
+    ok = ok && buf.flags[i] == expected_flags && buf.radiance_at(i).x == expected_radiance.x &&
+         buf.radiance_at(i).y == expected_radiance.y && buf.radiance_at(i).z == expected_radiance.z;
     if (!ok && mismatches++ == 0)
       first = "texel " + std::to_string(i) + ": rasterizer triangle " + std::to_string(static_cast<long>(seen == hemicube_rasterizer::no_triangle ? -1 : long(seen))) +
               " distance " + std::to_string(buf.distance[i]) + " flags " + std::to_string(buf.flags[i]) +
@@ -405,7 +405,7 @@ TEST_CASE("raster: geometry entirely behind the tangent plane is culled and neve
   for (std::size_t i = 0; i < buf.texel_count(); ++i) {
     REQUIRE(buf.flags[i] == texel_miss);
     REQUIRE(std::isinf(buf.distance[i]));
-    REQUIRE((buf.radiance[3 * i] == 0.5f && buf.radiance[3 * i + 1] == 0.25f && buf.radiance[3 * i + 2] == 2.0f));
+    REQUIRE((buf.radiance_at(i).x == 0.5f && buf.radiance_at(i).y == 0.25f && buf.radiance_at(i).z == 2.0f));
   }
   CHECK(r.statistics().triangles_tested == 0);  // the BVH root is rejected: no triangle is touched
   CHECK(r.statistics().nodes_visited == 1);
@@ -437,7 +437,7 @@ TEST_CASE("raster: a point inside an outward-facing box sees back faces on every
     r.render(p, f, 16, buf);
     for (std::size_t i = 0; i < buf.texel_count(); ++i) {
       REQUIRE(buf.flags[i] == texel_back_face);
-      REQUIRE((buf.radiance[3 * i] == 0 && buf.radiance[3 * i + 1] == 0 && buf.radiance[3 * i + 2] == 0));
+      REQUIRE((buf.radiance_at(i).x == 0 && buf.radiance_at(i).y == 0 && buf.radiance_at(i).z == 0));
       // Closed form: distance to the box [-1, 1]^3 along d (float intersection, 1e-5 relative).
       const glm::dvec3 d = glm::dvec3(f.to_world(hemicube_texel_direction(16, i)));
       double t = inf;
@@ -458,7 +458,7 @@ TEST_CASE("raster: two-sided triangles look the same from both sides", "[raster]
   r.render({0, 0, 0}, frame{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, 8, buf);  // sees its back
   const std::size_t centre = hemicube_texel_index(8, {hemicube_face::top, 4, 4});
   CHECK(buf.flags[centre] == texel_hit_front);
-  CHECK(buf.radiance[3 * centre + 2] == 4.0f);
+  CHECK(buf.radiance_at(centre).z == 4.0f);
   CHECK(buf.distance[centre] == Approx(std::sqrt(1.0 + 2 * (0.125 * 0.125))).epsilon(1e-6));
 }
 
@@ -495,7 +495,7 @@ TEST_CASE("raster: an empty scene is all sky", "[raster]") {
   for (std::size_t i = 0; i < buf.texel_count(); ++i) {
     CHECK(buf.flags[i] == texel_miss);
     CHECK(std::isinf(buf.distance[i]));
-    CHECK(buf.radiance[3 * i + 1] == 2.0f);
+    CHECK(buf.radiance_at(i).y == 2.0f);
     CHECK(r.seen_triangle(i) == hemicube_rasterizer::no_triangle);
   }
 }
@@ -535,7 +535,7 @@ TEST_CASE("raster: perspective-correct UVs on a textured quad at a grazing angle
     if (d.z < 0.1) ++grazing;
     // Expected continuous texel coordinates, clamped like clamp-to-edge filtering.
     const double ex = std::clamp(ref.uv.x * w - 0.5, 0.0, w - 1.0), ey = std::clamp(ref.uv.y * h - 0.5, 0.0, h - 1.0);
-    worst = std::max({worst, std::fabs(buf.radiance[3 * i] - ex), std::fabs(buf.radiance[3 * i + 1] - ey)});
+    worst = std::max({worst, std::fabs(buf.radiance_at(i).x - ex), std::fabs(buf.radiance_at(i).y - ey)});
   }
   INFO("checked " << checked << " texels (" << grazing << " at cos < 0.1), worst error " << worst << " texels");
   CHECK(grazing > 20);
@@ -627,7 +627,7 @@ TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round
   REQUIRE((rad.width == 16 && rad.height == 16));
   for (std::size_t i = 0; i < buf.texel_count(); ++i) {
     const glm::ivec2 p = hemicube_cross_pixel(8, hemicube_texel_from_index(8, i));
-    CHECK(rad.at(p.x, p.y)[1] == buf.radiance[3 * i + 1]);
+    CHECK(rad.at(p.x, p.y)[1] == buf.radiance_at(i).y);
     CHECK(dist.at(p.x, p.y)[0] == (std::isinf(buf.distance[i]) ? 0.0f : buf.distance[i]));
     CHECK(flags.at(p.x, p.y)[0] == ((buf.flags[i] & texel_miss) ? 1.0f : 0.0f));
     CHECK(flags.at(p.x, p.y)[2] == 1.0f);
@@ -637,27 +637,45 @@ TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round
   CHECK_THROWS_AS(write_hemicube_exr(prefix, bad), error);
 }
 
-TEST_CASE("raster: the SSE2 path gives bit-identical buffers to the scalar reference path", "[raster]") {
+TEST_CASE("raster: the SIMD paths (AVX2 where the CPU has it, SSE2) give bit-identical buffers to the scalar reference", "[raster]") {
   std::mt19937 rng(23);
   const scene_mesh scenes[] = {cornell_box(), hexagon_room(2), sky_and_occluders(), heightfield(3000),
                                fan_box(rng, {-1, -1, -1}, {1, 1, 1})};
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
   for (const scene_mesh& m : scenes) {
     const auto s = scene::create(m.desc());
-    raster_options scalar;
+    raster_options scalar, sse2;
     scalar.simd = false;
-    hemicube_rasterizer fast(s), reference(s, scalar);
-    hemicube_buffer a, b;
-    for (int k = 0; k < 6; ++k) {
+    sse2.avx2 = false;  // the SSE2 kernels even on an AVX2 machine
+    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar);
+    hemicube_buffer a, b, c;
+    std::vector<std::uint32_t> ca, cb, cc;
+    for (int k = 0; k < 7; ++k) {
       const glm::vec3 p = 0.5f * (s->bounds_lo() + s->bounds_hi()) + glm::vec3(u(rng), u(rng), u(rng)) * 0.2f * s->size();
       const frame f = random_frame(rng);
-      const int n = k % 2 ? 30 : 64;  // 30: spans whose length is not a multiple of 4
-      fast.render(p, f, n, a);
-      reference.render(p, f, n, b);
+      // 30: spans whose length is not a multiple of 4 or 8; 256: triangles over 64 texels across
+      // next to small ones (the AVX2 box scan's limit).
+      const int n = k == 6 ? 256 : (k % 2 ? 30 : 64);
+      best.render(p, f, n, a);
+      sse2_only.render(p, f, n, b);
+      reference.render(p, f, n, c);
       // Bitwise: compare the bytes (so NaN or -0 differences would show).
-      CHECK(std::memcmp(a.distance.data(), b.distance.data(), a.distance.size() * sizeof(float)) == 0);
-      CHECK(std::memcmp(a.radiance.data(), b.radiance.data(), a.radiance.size() * sizeof(float)) == 0);
-      CHECK(a.flags == b.flags);
+      CHECK(std::memcmp(a.distance.data(), c.distance.data(), a.distance.size() * sizeof(float)) == 0);
+      CHECK(std::memcmp(a.radiance.data(), c.radiance.data(), a.radiance.size() * sizeof(float)) == 0);
+      CHECK(a.flags == c.flags);
+      CHECK(std::memcmp(b.distance.data(), c.distance.data(), b.distance.size() * sizeof(float)) == 0);
+      CHECK(std::memcmp(b.radiance.data(), c.radiance.data(), b.radiance.size() * sizeof(float)) == 0);
+      CHECK(b.flags == c.flags);
+      std::size_t same_triangle = 0;
+      for (std::size_t i = 0; i < a.texel_count(); ++i)
+        same_triangle += best.seen_triangle(i) == reference.seen_triangle(i) ? 1u : 0u;
+      CHECK(same_triangle == a.texel_count());
+      // The coverage counts (the SIMD small-triangle kernels have a counting mode).
+      best.render_coverage(p, f, n, ca);
+      sse2_only.render_coverage(p, f, n, cb);
+      reference.render_coverage(p, f, n, cc);
+      CHECK(ca == cc);
+      CHECK(cb == cc);
     }
   }
 }

@@ -26,13 +26,16 @@ enum texel_flags : std::uint8_t {
 /// Euclidean distance from `position` to the visible point along the texel's centre direction
 /// (not the projected depth; +inf where nothing is hit), and texel_flags.
 ///
+/// The radiance is planar (three planes of one float per texel, R then G then B), the layout the
+/// integrator's SIMD loops read and the rasterizer writes in runs.
+///
 /// Memory: 17 bytes per texel (N = 64: 204 KiB). Reuse one buffer per thread: resize() does not
 /// reallocate when the resolution does not grow.
 struct hemicube_buffer {
   int resolution = 0;          ///< N (even, 2..4096); 0 for an empty buffer
   glm::vec3 position{0.0f};    ///< world-space point the hemicube was rendered from
   frame basis{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< world-space frame; basis.n is the normal (local +z)
-  std::vector<float> radiance;       ///< 3 floats per texel, RGB interleaved: radiance[3 i + c]
+  std::vector<float> radiance;       ///< 3 planes: radiance[c * texel_count() + i], c = 0 R, 1 G, 2 B
   std::vector<float> distance;       ///< one float per texel, > 0, +inf for misses
   std::vector<std::uint8_t> flags;   ///< one texel_flags mask per texel
 
@@ -51,12 +54,27 @@ struct hemicube_buffer {
 
   std::size_t texel_count() const noexcept { return distance.size(); }
 
+  /// The plane of channel c (0 = R, 1 = G, 2 = B): texel_count() floats. Precondition: c in [0, 2].
+  float* channel(int c) noexcept { return radiance.data() + static_cast<std::size_t>(c) * distance.size(); }
+  const float* channel(int c) const noexcept { return radiance.data() + static_cast<std::size_t>(c) * distance.size(); }
+
+  /// RGB radiance of texel i (i < texel_count(), unchecked).
+  glm::vec3 radiance_at(std::size_t i) const noexcept {
+    const std::size_t n = distance.size();
+    return {radiance[i], radiance[n + i], radiance[2 * n + i]};
+  }
+  /// Sets the RGB radiance of texel i (i < texel_count(), unchecked).
+  void set_radiance(std::size_t i, const glm::vec3& l) noexcept {
+    const std::size_t n = distance.size();
+    radiance[i] = l.x;
+    radiance[n + i] = l.y;
+    radiance[2 * n + i] = l.z;
+  }
+
   /// Fills every texel with "nothing hit": radiance = sky (RGB), distance = +inf, flag miss.
   void fill_sky(const glm::vec3& sky) noexcept {
     for (std::size_t i = 0; i < distance.size(); ++i) {
-      radiance[3 * i + 0] = sky.x;
-      radiance[3 * i + 1] = sky.y;
-      radiance[3 * i + 2] = sky.z;
+      set_radiance(i, sky);
       distance[i] = std::numeric_limits<float>::infinity();
       flags[i] = texel_miss;
     }

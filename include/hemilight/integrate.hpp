@@ -53,6 +53,10 @@ struct integrate_options {
   float min_wall_distance = 0.0f;
   bool directional = false;  ///< also compute L1 spherical harmonics and the Half-Life 2 basis irradiance
   bool double_precision = false;  ///< accumulate in double instead of float (slower; for checks)
+  /// Float path: use the hand-written AVX2 + FMA kernels where the CPU has both (checked at run
+  /// time). false selects the portable loops the compiler vectorises (for tests and comparisons);
+  /// both give the same sums up to float rounding order.
+  bool simd_kernels = true;
 };
 
 /// Everything integrate() computes from one hemicube. Vectors are world space.
@@ -135,7 +139,7 @@ class hemicube_integrator {
   int n_;
   integrate_options options_;
   std::shared_ptr<const integration_table> table_;
-  std::vector<float> r_, g_, b_, inv_r_;  // planar scratch copies of radiance and 1/distance
+  std::vector<float> inv_r_;  // scratch: 1/distance per texel
 };
 
 /// Convenience: integrate one buffer with a temporary integrator (fetches the cached table;
