@@ -751,12 +751,11 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
     hemicube_rasterizer raster;
     hemicube_integrator integrator;
     hemicube_buffer buffer;
-    std::vector<float> planar;  // radiance as three planes (R, G, B) for the cone sums
   };
   auto contexts = std::make_shared<std::vector<std::unique_ptr<context>>>();
   for (int w = 0; w < workers; ++w)
     contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
-                                                          hemicube_integrator(o.resolution, o.integrate), {}, {}}));
+                                                          hemicube_integrator(o.resolution, o.integrate), {}}));
   return [contexts, o, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> cache_sample {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
@@ -773,19 +772,11 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
     }
     c.raster.render(x, f, o.resolution, c.buffer, o.texture);
     cache_sample out = c.integrator.integrate(c.buffer);
-    const std::size_t count = c.buffer.distance.size();
-    if (cone_table || table) {  // radiance as three planes for the weighted sums below
-      c.planar.resize(3 * count);
-      const float* l = c.buffer.radiance.data();
-      for (std::size_t i = 0; i < count; ++i) {
-        c.planar[i] = l[3 * i];
-        c.planar[count + i] = l[3 * i + 1];
-        c.planar[2 * count + i] = l[3 * i + 2];
-      }
-    }
-    const float* pr = c.planar.data();
-    const float* pg = pr + count;
-    const float* pb = pg + count;
+    const std::size_t count = c.buffer.texel_count();
+    const hemicube_buffer& cb = c.buffer;
+    const float* pr = cb.channel(0);  // the buffer's radiance is planar (hemicube.hpp)
+    const float* pg = cb.channel(1);
+    const float* pb = cb.channel(2);
     if (cone_table) {
       // 7 terms x 3 channels over the planes (weighted_sums: deterministic order).
       double total[hl2_cone_terms][3] = {};
