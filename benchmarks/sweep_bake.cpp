@@ -1,5 +1,6 @@
 // End-to-end bake time and accuracy of the built-in scenes (issue 6's benchmark).
 //   usage: sweep_bake out.csv [sizes...]   (default sizes 256 512)
+//          sweep_bake --target out.csv [runs] the issue's GPU comparison case only (below)
 // Scenes: the hexagon room (tessellation 2, 496 triangles, lit by the sky through its window)
 // and the Cornell box (32 triangles), chart UVs from generate_lightmap_uvs (2 texels padding).
 // For each lightmap size, bounce count (1, 3) and thread count (1, 2): a bake with N = 64 and
@@ -8,8 +9,18 @@
 // every sampled texel (use_cache = false, same N, same roll, same bounces), over texels valid in
 // both: relative RMS of luminance (sqrt(sum dY^2 / sum Y_ref^2)) and the mean of
 // |dY| / max(Y_ref, 5% of the mean Y_ref).
+// --target: the issue's comparison with the GPU hemicube lightmapper (a 654 x 654 lightmap of a
+// ~731-triangle scene, N = 64, one bounce, under 4 s on two cores at equal or lower error). Scene:
+// the hexagon room at tessellation 3 (1062 triangles), 654^2, N = 64, a = 0.2, 1 bounce, 2 threads;
+// `runs` bakes (default 3) with the irradiance only and `runs` with both directional outputs (L1
+// SH + HL2), then one reference bake with a hemicube at every texel. CSV: one row per run plus the
+// reference; the load average (/proc/loadavg) before and after is printed, since the machine may
+// be shared.
 #include "hemilight/bake.hpp"
 #include "hemilight/reference_scenes.hpp"
+
+#include <fstream>
+#include <sstream>
 
 #include <algorithm>
 #include <cmath>
@@ -24,9 +35,92 @@ namespace {
 
 double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
+std::string load_average() {
+  std::ifstream f("/proc/loadavg");
+  std::string a, b, c;
+  f >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+// Relative RMS of luminance and mean relative error (definitions at the top) over texels valid in both.
+void compare(const bake_result& r, const bake_result& ref, double& rms, double& mean) {
+  double mean_ref = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < ref.valid.size(); ++k)
+    if (ref.valid[k]) {
+      mean_ref += luminance(ref.irradiance.pixels.data() + 3 * k);
+      ++n;
+    }
+  mean_ref /= double(std::max<std::size_t>(n, 1));
+  double num = 0, den = 0, rel = 0;
+  std::size_t cnt = 0;
+  for (std::size_t k = 0; k < ref.valid.size(); ++k)
+    if (ref.valid[k] && r.valid[k]) {
+      const double a = luminance(r.irradiance.pixels.data() + 3 * k), b = luminance(ref.irradiance.pixels.data() + 3 * k);
+      num += (a - b) * (a - b);
+      den += b * b;
+      rel += std::fabs(a - b) / std::max(b, 0.05 * mean_ref);
+      ++cnt;
+    }
+  rms = std::sqrt(num / den);
+  mean = rel / double(std::max<std::size_t>(cnt, 1));
+}
+
+int target(const char* path, int runs) {
+  std::FILE* f = std::fopen(path, "w");
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", path);
+    return 1;
+  }
+  std::printf("load average before: %s\n", load_average().c_str());
+  scene_mesh m = hexagon_room(3);
+  const int size = 654;
+  generate_lightmap_uvs(m, size, 2);
+  bake_input in;
+  in.scene = m.desc();
+  bake_options o;
+  o.width = o.height = size;
+  o.resolution = 64;
+  o.bounces = 1;
+  o.thread_count = 2;
+  std::fprintf(f, "run,scene,triangles,size,directional,seconds,sampled_texels,hemicubes,hemicube_fraction,rms_error,mean_error\n");
+  std::vector<bake_result> results;
+  std::vector<std::string> rows;
+  for (int directional = 0; directional < 2; ++directional)
+    for (int run = 0; run < runs; ++run) {
+      o.output_sh_l1 = o.output_hl2 = directional == 1;
+      bake_result r = bake_lightmap(in, o);
+      std::printf("run %d%s: %.3f s, %zu hemicubes for %zu sampled texels\n", run, directional ? " (SH + HL2)" : "", r.stats.seconds,
+                  r.stats.hemicubes, r.stats.sampled_texels);
+      std::fflush(stdout);
+      results.push_back(std::move(r));
+    }
+  o.output_sh_l1 = o.output_hl2 = false;
+  o.use_cache = false;
+  const bake_result ref = bake_lightmap(in, o);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const bake_result& r = results[i];
+    double rms, mean;
+    compare(r, ref, rms, mean);
+    std::fprintf(f, "%zu,hexagon_room_t3,%zu,%d,%d,%.4f,%zu,%zu,%.4f,%.5f,%.5f\n", i % std::size_t(runs), m.triangle_count(), size,
+                 int(i / std::size_t(runs)), r.stats.seconds, r.stats.sampled_texels, r.stats.hemicubes,
+                 double(r.stats.hemicubes) / double(r.stats.sampled_texels), rms, mean);
+  }
+  std::fprintf(f, "reference,hexagon_room_t3,%zu,%d,0,%.4f,%zu,%zu,1,0,0\n", m.triangle_count(), size, ref.stats.seconds,
+               ref.stats.sampled_texels, ref.stats.hemicubes);
+  std::fclose(f);
+  double rms, mean;
+  compare(results[0], ref, rms, mean);
+  std::printf("reference (hemicube per texel): %.2f s; cache vs reference: relative RMS %.4f, mean relative %.4f\n",
+              ref.stats.seconds, rms, mean);
+  std::printf("load average after: %s\n", load_average().c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 3 && std::string(argv[1]) == "--target") return target(argv[2], argc >= 4 ? std::max(1, std::atoi(argv[3])) : 3);
   if (argc < 2) {
     std::fprintf(stderr, "usage: sweep_bake out.csv [sizes...]\n");
     return 2;

@@ -4,6 +4,7 @@
 
 #include "hemilight/bake.hpp"
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,11 @@ hemilight::material to_material(const hemilight_bake_material& m) {
   r.two_sided = m.two_sided != 0;
   return r;
 }
+
+hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
+                      const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
+                      uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
+                      size_t hl2_capacity, hemilight_bake_stats* stats);
 
 }  // namespace
 
@@ -39,13 +45,35 @@ void hemilight_bake_options_init(hemilight_bake_options* options) {
   options->thread_count = 0;
   options->progress = nullptr;
   options->progress_user = nullptr;
+  options->environment_rgb = nullptr;
+  options->environment_size = 0;
 }
 
 hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
                                          const hemilight_bake_options* options, float* irradiance_rgb,
                                          size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
                                          hemilight_bake_stats* stats) {
-  const char* fn = "hemilight_bake_lightmap";
+  return bake("hemilight_bake_lightmap", meshes, mesh_count, options, irradiance_rgb, irradiance_capacity, valid,
+              valid_capacity, nullptr, 0, nullptr, 0, stats);
+}
+
+hemilight_status hemilight_bake_lightmap_directional(const hemilight_bake_mesh* meshes, size_t mesh_count,
+                                                     const hemilight_bake_options* options, float* irradiance_rgb,
+                                                     size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
+                                                     float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
+                                                     size_t hl2_capacity, hemilight_bake_stats* stats) {
+  return bake("hemilight_bake_lightmap_directional", meshes, mesh_count, options, irradiance_rgb, irradiance_capacity,
+              valid, valid_capacity, sh_l1_rgb, sh_l1_capacity, hl2_rgb, hl2_capacity, stats);
+}
+
+}  // extern "C"
+
+namespace {
+
+hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
+                      const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
+                      uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
+                      size_t hl2_capacity, hemilight_bake_stats* stats) {
   return guarded(fn, [&] {
     if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
     if (mesh_count == 0) return invalid(fn, "mesh_count is 0: there is nothing to bake");
@@ -61,6 +89,30 @@ hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size
                              std::to_string(3 * texels) + " floats");
     if (valid && valid_capacity < texels)
       return invalid(fn, "valid_capacity " + std::to_string(valid_capacity) + " is below width x height = " + std::to_string(texels));
+    if (sh_l1_rgb && sh_l1_capacity < 12 * texels)
+      return invalid(fn, "sh_l1_capacity " + std::to_string(sh_l1_capacity) + " is below 12 x width x height = " +
+                             std::to_string(12 * texels) + " floats (four RGB images)");
+    if (hl2_rgb && hl2_capacity < 9 * texels)
+      return invalid(fn, "hl2_capacity " + std::to_string(hl2_capacity) + " is below 9 x width x height = " +
+                             std::to_string(9 * texels) + " floats (three RGB images)");
+    std::shared_ptr<const hemilight::cubemap> environment;
+    if (o.environment_rgb) {
+      if (o.environment_size < 1 || o.environment_size > hemilight::cubemap_max_size)
+        return invalid(fn, "options->environment_size " + std::to_string(o.environment_size) + " is out of range: 1.." +
+                               std::to_string(hemilight::cubemap_max_size) + " with an environment map");
+      hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
+      for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
+        const float v = o.environment_rgb[i];
+        if (!(v >= 0.0f) || !std::isfinite(v))
+          return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
+                                 "; radiance must be finite and >= 0");
+        faces.pixels[i] = v;
+      }
+      environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
+    } else if (o.environment_size != 0) {
+      return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
+                             " but environment_rgb is NULL (use 0 without an environment map)");
+    }
     for (const char* f : {"indirect_only", "use_cache"}) {
       const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
       if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
@@ -127,6 +179,9 @@ hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size
     bo.dilation = o.dilation;
     bo.use_cache = o.use_cache == 1;
     bo.thread_count = o.thread_count;
+    bo.environment = environment;
+    bo.output_sh_l1 = sh_l1_rgb != nullptr;
+    bo.output_hl2 = hl2_rgb != nullptr;
     if (o.progress) {
       const hemilight_progress_fn progress = o.progress;
       void* user = o.progress_user;
@@ -140,6 +195,10 @@ hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size
     }
     std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
     if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
+    if (sh_l1_rgb)
+      for (std::size_t k = 0; k < 4; ++k) std::copy(r.sh_l1[k].pixels.begin(), r.sh_l1[k].pixels.end(), sh_l1_rgb + 3 * texels * k);
+    if (hl2_rgb)
+      for (std::size_t k = 0; k < 3; ++k) std::copy(r.hl2[k].pixels.begin(), r.hl2[k].pixels.end(), hl2_rgb + 3 * texels * k);
     if (stats) {
       stats->sampled_texels = r.stats.sampled_texels;
       stats->invalid_texels = r.stats.invalid_texels;
@@ -153,4 +212,4 @@ hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size
   });
 }
 
-}  // extern "C"
+}  // namespace

@@ -260,6 +260,13 @@ typedef struct hemilight_bake_options {
   float sky_radiance[3];   /* constant radiance seen where nothing is hit, each >= 0 (default 0) */
   hemilight_progress_fn progress; /* fraction of the whole bake, never decreasing; 0 cancels (default NULL) */
   void* progress_user;
+  /* Optional environment sky (default NULL, 0): six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z),
+   * environment_size x environment_size RGB floats each, face-major (the layout of
+   * hemilight_scene_with_environment), finite and >= 0, read during the call only. Where a hemicube
+   * texel hits nothing it sees the map's radiance along its world direction (seamless bilinear)
+   * instead of sky_radiance. environment_size: 1..16384 with a map, 0 without. */
+  const float* environment_rgb;
+  int environment_size;
 } hemilight_bake_options;
 
 /* Fills options with the defaults above. NULL is ignored. */
@@ -289,12 +296,41 @@ typedef struct hemilight_bake_stats {
  * NULL options/irradiance_rgb, capacities too small, options out of range (the message names the
  * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs outside [0, 1],
  * indices out of range, a triangle with 3D area but zero UV area, invalid materials, no texel
- * covered; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
+ * covered, an environment map with a bad size or a negative or non-finite value (named by index);
+ * OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
  * Cost: see hemilight_cache_irradiance, once per bounce. */
 HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
                                                        const hemilight_bake_options* options, float* irradiance_rgb,
                                                        size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
                                                        hemilight_bake_stats* stats);
+
+/* hemilight_bake_lightmap plus the directional lightmaps, each optional (NULL = not wanted; a
+ * NULL buffer's capacity is ignored). Asking for either makes the last bounce (and the first, with
+ * indirect_only) integrate directionally: hemicubes of that pass cost a little more (HL2: about
+ * 20% more for the whole one-bounce bake, docs/bake.md).
+ * sh_l1_rgb: NULL, or at least 12 width height floats (sh_l1_capacity): four RGB images one after
+ *   another, coefficient k of texel (x, y) at sh_l1_rgb[3 (k width height + y width + x)]. The L1
+ *   spherical harmonics of the incoming radiance, WORLD space, c_k = integral over the texel's upper
+ *   hemisphere of L Y_k d omega with Y_0 = 0.282095, (Y_1, Y_2, Y_3) = 0.488603 (y, z, x): a uniform
+ *   sky L over a plane of normal n gives (sqrt(pi) L, (sqrt(3 pi)/2) L (n_y, n_z, n_x)).
+ *   Irradiance for a normal d: max(0, (sqrt(pi)/2) c_0 + sqrt(pi/3) (c_3 d_x + c_1 d_y + c_2 d_z)).
+ * hl2_rgb: NULL, or at least 9 width height floats (hl2_capacity): three RGB images one after another
+ *   (same indexing), the irradiance through the Half-Life 2 basis vectors (-1/sqrt6, 1/sqrt2,
+ *   1/sqrt3), (-1/sqrt6, -1/sqrt2, 1/sqrt3), (sqrt(2/3), 0, 1/sqrt3) of each texel's LIGHTMAP
+ *   TANGENT FRAME (t, b, n): t = dP/du of the texel's triangle projected onto the tangent plane of
+ *   the shading normal n and normalised; b = +-(n x t) with the sign that makes b . dP/dv >= 0
+ *   (u, v: lightmap UVs). From the irradiance on the cone of HL2 directions kept per cache record as
+ *   a Fourier series in azimuth (order 3): exact for light within 35.26 degrees of the normal and
+ *   for a uniform sky (every value pi L (1 + 1/sqrt3) / 2); 1.7% RMS for a grazing side light
+ *   (docs/bake.md).
+ * Both kinds are dilated like the irradiance. Errors as hemilight_bake_lightmap, and
+ * INVALID_ARGUMENT when a capacity is too small (the message names it); nothing is written then. */
+HEMILIGHT_API hemilight_status hemilight_bake_lightmap_directional(const hemilight_bake_mesh* meshes, size_t mesh_count,
+                                                                   const hemilight_bake_options* options,
+                                                                   float* irradiance_rgb, size_t irradiance_capacity,
+                                                                   uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb,
+                                                                   size_t sh_l1_capacity, float* hl2_rgb,
+                                                                   size_t hl2_capacity, hemilight_bake_stats* stats);
 /* ---- cube maps -----------------------------------------------------------------------------------
  * Float RGB cube maps: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), face-major, each
  * size x size texels, rows along the GL t coordinate, columns along s, RGB interleaved

@@ -6,7 +6,10 @@
 //
 // Writes, per scene NAME, into the output directory: NAME_irradiance.exr (RGB float irradiance
 // E), NAME_mask.exr (R = coverage, G = valid, B = sampled), NAME_irradiance.png (tone-mapped
-// preview). Shows a progress bar with the time left and prints the bake's statistics.
+// preview), and with --directional NAME_sh_l1_{0..3}.exr (world-space L1 SH) and/or
+// NAME_hl2_{0..2}.exr (Half-Life 2 basis in the lightmap tangent frame; bake.hpp). Shows a
+// progress bar with the time left and prints the bake's statistics.
+// --environment FILE.exr: an ENVMAP_CUBE EXR as the sky (built-in scenes and models).
 //
 // Models: read with assimp (triangulated, node transforms applied, normals generated when
 // missing). Lightmap UVs are the mesh's UV channel 1 if it has one, else channel 0; they must lie
@@ -17,6 +20,7 @@
 // Preview tone mapping: exposure k = 0.5 / (mean luminance of the sampled texels), then Reinhard
 // c k / (1 + c k) per channel, then the sRGB transfer curve, 8 bits. The EXR holds the raw values.
 #include "hemilight/bake.hpp"
+#include "hemilight/cubemap.hpp"
 #include "hemilight/image_io.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/reference_scenes.hpp"
@@ -35,6 +39,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,6 +62,9 @@ const char* usage =
     "  --sky R,G,B        sky radiance for a model (default 1,1,1)\n"
     "  --indirect-only    store everything but the first bounce\n"
     "  --no-cache         a hemicube at every texel (reference; slow)\n"
+    "  --directional K    also write directional lightmaps: sh (L1 SH, 4 EXRs), hl2 (Half-Life 2\n"
+    "                     basis, 3 EXRs) or both (default: none)\n"
+    "  --environment F    sky from an OpenEXR cube map (ENVMAP_CUBE) instead of the constant sky\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -70,7 +78,7 @@ bool bar_open = false;  // a progress line is on stderr without its newline
 [[noreturn]] void fail(const std::string& message, int code = 1) { throw cli_error{message, code}; }
 
 struct settings {
-  std::string model, out = "out";
+  std::string model, out = "out", environment;
   bake_options options;
   glm::vec3 sky{1.0f};
   bool quiet = false;
@@ -132,6 +140,13 @@ settings parse(int argc, char** argv) {
       s.options.indirect_only = true;
     } else if (a == "--no-cache") {
       s.options.use_cache = false;
+    } else if (a == "--directional") {
+      const std::string v = value();
+      if (v != "sh" && v != "hl2" && v != "both") fail("--directional " + v + " is invalid: it must be sh, hl2 or both", 2);
+      s.options.output_sh_l1 = v != "hl2";
+      s.options.output_hl2 = v != "sh";
+    } else if (a == "--environment") {
+      s.environment = value();
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -276,8 +291,7 @@ void bake_and_write(const std::string& name, const bake_input& in, const setting
   if (bar_open) std::fprintf(stderr, "\n");
   bar_open = false;
   const std::string base = s.out + "/" + name;
-  write_exr(base + "_irradiance.exr", r.irradiance);
-  write_exr(base + "_mask.exr", bake_mask_image(r));
+  const std::vector<std::string> written = write_bake_exrs(r, base);
   write_png_preview(base + "_irradiance.png", r);
   const bake_stats& st = r.stats;
   std::printf("%s: %zu triangles, %d x %d lightmap, N = %d, %d bounce%s%s, %d threads\n", name.c_str(), in.scene.triangle_count,
@@ -288,14 +302,27 @@ void bake_and_write(const std::string& name, const bake_input& in, const setting
   for (std::size_t p = 0; p < st.passes.size(); ++p)
     std::printf("  pass %zu: %zu hemicubes (%.1f%% of sampled texels), %zu records, %.2f s\n", p + 1, st.passes[p].hemicubes,
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
-  std::printf("  total %.2f s (coverage %.3f s); wrote %s_{irradiance.exr,mask.exr,irradiance.png}\n", st.seconds,
-              st.coverage_seconds, base.c_str());
+  std::string suffixes;
+  for (const std::string& w : written) suffixes += w.substr(base.size() + 1) + ",";
+  std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}\n", st.seconds, st.coverage_seconds, base.c_str(),
+              suffixes.c_str());
 }
+
+void run_scenes(const settings& s);
 
 void run(const settings& s) {
   std::error_code ec;
   std::filesystem::create_directories(s.out, ec);
   if (!std::filesystem::is_directory(s.out, ec)) fail("cannot create the output directory '" + s.out + "'");
+  settings with_env = s;
+  if (!s.environment.empty()) {
+    if (!std::filesystem::is_regular_file(s.environment, ec)) fail("cannot read '" + s.environment + "': no such file");
+    with_env.options.environment = std::make_shared<const cubemap>(cubemap::from_image(read_exr_cubemap(s.environment, 3), false));
+  }
+  run_scenes(with_env);
+}
+
+void run_scenes(const settings& s) {
   if (s.model.empty()) {
     // Built-in scenes: chart UVs generated for the lightmap size (2 texels of padding).
     const struct {

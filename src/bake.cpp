@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -202,6 +203,64 @@ texel_clip clip_triangle_to_texel(const glm::vec2& a, const glm::vec2& b, const 
   return out;
 }
 
+glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept {
+  // pi Y00 = sqrt(pi) / 2 and (2 pi / 3) Y1 = sqrt(pi / 3): the clamped-cosine kernel's band 0 and
+  // band 1 factors (pi, 2 pi / 3) times the basis functions' constants (integrate.hpp).
+  constexpr float k0 = 0.886226925f;  // sqrt(pi) / 2
+  constexpr float k1 = 1.023326708f;  // sqrt(pi / 3)
+  const glm::vec3 e = k0 * sh[0] + k1 * (d.x * sh[3] + d.y * sh[1] + d.z * sh[2]);
+  return glm::max(e, glm::vec3(0.0f));
+}
+
+std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, const frame& f) noexcept {
+  std::array<glm::vec3, 3> out;
+  for (std::size_t k = 0; k < 3; ++k)
+    out[k] = sh_l1_irradiance(sh, f.to_world(glm::vec3(hl2_basis[k][0], hl2_basis[k][1], hl2_basis[k][2])));
+  return out;
+}
+
+frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], const glm::vec3& n) noexcept {
+  const glm::dvec3 e1 = glm::dvec3(p[1]) - glm::dvec3(p[0]), e2 = glm::dvec3(p[2]) - glm::dvec3(p[0]);
+  const glm::dvec2 d1 = glm::dvec2(uv[1]) - glm::dvec2(uv[0]), d2 = glm::dvec2(uv[2]) - glm::dvec2(uv[0]);
+  const double det = d1.x * d2.y - d2.x * d1.y;
+  const glm::dvec3 nd(n);
+  frame f = make_frame(n);
+  if (!(std::fabs(det) > 0.0) || !std::isfinite(det)) return f;
+  const glm::dvec3 dpdu = (e1 * d2.y - e2 * d1.y) / det, dpdv = (e2 * d1.x - e1 * d2.x) / det;
+  // Projections onto the tangent plane; "nearly along n" = less than 1e-6 of the length left.
+  const glm::dvec3 tu = dpdu - nd * glm::dot(nd, dpdu), tv = dpdv - nd * glm::dot(nd, dpdv);
+  const double lu = glm::length(tu), lv = glm::length(tv);
+  glm::dvec3 t, b;
+  if (lu > 1e-6 * glm::length(dpdu) && lu > 0.0) {
+    t = tu / lu;
+    b = glm::cross(nd, t);
+    if (glm::dot(b, dpdv) < 0.0) b = -b;
+  } else if (lv > 1e-6 * glm::length(dpdv) && lv > 0.0) {
+    b = tv / lv;
+    t = glm::cross(b, nd);  // right-handed: the sign of u is unknown when dP/du is along n
+  } else {
+    return f;
+  }
+  f.t = glm::vec3(t);
+  f.b = glm::vec3(b);
+  return f;
+}
+
+std::vector<std::string> write_bake_exrs(const bake_result& r, const std::string& prefix, exr_pixel_type type) {
+  std::vector<std::string> written;
+  const auto put = [&](const std::string& suffix, const image& img) {
+    write_exr(prefix + suffix, img, type);
+    written.push_back(prefix + suffix);
+  };
+  put("_irradiance.exr", r.irradiance);
+  put("_mask.exr", bake_mask_image(r));
+  for (std::size_t k = 0; k < r.sh_l1.size(); ++k)
+    if (r.sh_l1[k].width > 0) put("_sh_l1_" + std::to_string(k) + ".exr", r.sh_l1[k]);
+  for (std::size_t k = 0; k < r.hl2.size(); ++k)
+    if (r.hl2[k].width > 0) put("_hl2_" + std::to_string(k) + ".exr", r.hl2[k]);
+  return written;
+}
+
 lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height) {
   const char* who = "compute_lightmap_samples";
   check_size(who, width, height);
@@ -268,6 +327,8 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
   s.position.assign(texels, glm::vec3(0.0f));
   s.normal.assign(texels, glm::vec3(0.0f, 0.0f, 1.0f));
   s.texel_world_size.assign(texels, 0.0f);
+  s.tangent.assign(texels, glm::vec3(1.0f, 0.0f, 0.0f));
+  s.bitangent.assign(texels, glm::vec3(0.0f, 1.0f, 0.0f));
   for (std::size_t k = 0; k < texels; ++k) {
     if (owner[k] == none) continue;
     s.coverage[k] = float(std::min(1.0, sum_area[k]));
@@ -300,6 +361,11 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
     s.position[k] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
     s.normal[k] = glm::vec3(n);
     s.texel_world_size[k] = float(std::sqrt(t.area3 / t.uv_area));
+    const glm::vec3 tp[3] = {d.positions[idx[0]], d.positions[idx[1]], d.positions[idx[2]]};
+    const glm::vec2 tuv[3] = {d.lightmap_uvs[idx[0]], d.lightmap_uvs[idx[1]], d.lightmap_uvs[idx[2]]};
+    const frame f = lightmap_tangent_frame(tp, tuv, s.normal[k]);
+    s.tangent[k] = f.t;
+    s.bitangent[k] = f.b;
   }
   return s;
 }
@@ -348,6 +414,13 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   check_options(o);
   check_input("bake_lightmap", input);
   const std::shared_ptr<const scene> sc = scene::create(input.scene);
+  if (o.environment) {
+    try {
+      o.environment->validate();
+    } catch (const error& e) {
+      throw_invalid_argument(std::string("bake_lightmap: environment: ") + e.what());
+    }
+  }
 
   bake_result r;
   r.stats.texels = std::size_t(o.width) * std::size_t(o.height);
@@ -378,9 +451,15 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     throw_invalid_argument("bake_lightmap: no texel is covered by a triangle (coverage >= min_coverage): nothing to bake");
 
   const int workers = resolve_thread_count(o.thread_count);
+  const bool directional = o.output_sh_l1 || o.output_hl2;
   cache_options co = o.cache;
   co.thread_count = o.thread_count;
   std::vector<glm::vec3> e(count), e_first;
+  // L1 SH per sample, coefficient-major (sh[k][i]); only with directional outputs.
+  using sh_planes = std::array<std::vector<glm::vec3>, 4>;
+  sh_planes sh, sh_first;
+  // HL2 cones per sample, reference make_frame(normal).t (as cache_result::cone); only with output_hl2.
+  std::vector<hl2_cone> cone, cone_first;
   std::vector<std::uint8_t> valid(count, 1);
   image texture;
   radiance_texture texture_view;
@@ -395,9 +474,16 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   for (int pass = 0; pass < o.bounces; ++pass) {
     if (o.progress && !report(float(pass) / float(o.bounces)))
       throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+    // Directional integration only where its result is used: the last pass, and the first
+    // when the indirect part is wanted (last minus first).
+    const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
     hemicube_sampler_options so;
     so.resolution = o.resolution;
     so.roll = true;
+    so.raster.sky = o.environment;
+    so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
+    so.hl2_cone = pass_directional && o.output_hl2;
+    co.directional = pass_directional;
     if (pass > 0) {
       // Radiance texture of this pass: emission + albedo E_{k-1} / pi of each texel's owner.
       texture = image::make(o.width, o.height, 3);
@@ -418,12 +504,20 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     }
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
+    if (pass_directional) {
+      for (auto& plane : sh) plane.assign(count, glm::vec3(0.0f));
+      cone.assign(count, hl2_cone{});
+    }
     if (o.use_cache) {
       if (o.progress) co.progress = [&](float f) { return report(base + span * f); };
       cache_result cr = cache_irradiance(positions.data(), normals.data(), count, sampler, co);
       for (std::size_t i = 0; i < count; ++i) {
         e[i] = cr.irradiance[i];
         valid[i] = std::uint8_t(valid[i] & cr.valid[i]);
+        if (pass_directional) {
+          for (std::size_t c = 0; c < 4; ++c) sh[c][i] = cr.sh_l1[i][c];
+          cone[i] = cr.cone[i];
+        }
       }
       r.stats.hemicubes += cr.stats.hemicubes;
       r.stats.records += cr.stats.records;
@@ -439,21 +533,20 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
         const std::size_t end = std::min(count, b + block);
         parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
           for (std::size_t i = b + lo; i < b + hi; ++i) {
-            const irradiance_sample smp = sampler(worker, positions[i], normals[i]);
+            const cache_sample smp = sampler(worker, positions[i], normals[i]);
             e[i] = smp.irradiance;
             backface[i] = smp.backface_fraction;
+            if (pass_directional) {
+              for (std::size_t c = 0; c < 4; ++c) sh[c][i] = smp.sh_l1[c];
+              cone[i] = rotate_hl2_cone(smp.cone, normals[i], make_frame(normals[i]).t);
+            }
           }
         });
       }
       // Invalid samples (inside geometry) are filled from valid texel neighbours by dilation.
-      image tmp = image::make(o.width, o.height, 3);
       std::vector<std::uint8_t> filled(texels, 0);
       std::size_t invalid = 0;
       for (std::size_t i = 0; i < count; ++i) {
-        float* p = tmp.pixels.data() + 3 * texel_of[i];
-        p[0] = e[i].x;
-        p[1] = e[i].y;
-        p[2] = e[i].z;
         if (backface[i] > co.invalid_backface_fraction) {
           valid[i] = 0;
           ++invalid;
@@ -462,12 +555,26 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
         }
       }
       if (invalid > 0) {
-        dilate(tmp, filled, -1);
-        for (std::size_t i = 0; i < count; ++i)
-          if (backface[i] > co.invalid_backface_fraction) {
-            const float* p = tmp.pixels.data() + 3 * texel_of[i];
-            e[i] = glm::vec3(p[0], p[1], p[2]);
+        const auto fill = [&](std::vector<glm::vec3>& values) {
+          image tmp = image::make(o.width, o.height, 3);
+          for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * texel_of[i], &values[i], sizeof(glm::vec3));
+          std::vector<std::uint8_t> f = filled;
+          dilate(tmp, f, -1);
+          for (std::size_t i = 0; i < count; ++i)
+            if (backface[i] > co.invalid_backface_fraction) std::memcpy(&values[i], tmp.pixels.data() + 3 * texel_of[i], sizeof(glm::vec3));
+        };
+        fill(e);
+        if (pass_directional) {
+          for (auto& plane : sh) fill(plane);
+          // Cone coefficients term by term (neighbours on a chart share the normal and so the
+          // reference tangent).
+          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) {
+            std::vector<glm::vec3> plane(count);
+            for (std::size_t i = 0; i < count; ++i) plane[i] = cone[i].coefficients[t];
+            fill(plane);
+            for (std::size_t i = 0; i < count; ++i) cone[i].coefficients[t] = plane[i];
           }
+        }
       }
       cache_stats cs;
       cs.hemicubes = count;
@@ -479,7 +586,13 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
       r.stats.records += count;
       r.stats.passes.push_back(cs);
     }
-    if (pass == 0 && o.indirect_only) e_first = e;
+    if (pass == 0 && o.indirect_only) {
+      e_first = e;
+      if (pass_directional) {
+        sh_first = sh;
+        cone_first = cone;
+      }
+    }
   }
   if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
 
@@ -497,6 +610,37 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     filled[k] = 1;
     r.valid[k] = valid[i];
     if (!valid[i]) ++r.stats.invalid_texels;
+  }
+  if (directional) {
+    // Per-sample values written into images, each dilated from the same mask as the irradiance.
+    const auto to_image = [&](const auto& value_of) {
+      image img = image::make(o.width, o.height, 3);
+      for (std::size_t i = 0; i < count; ++i) {
+        const glm::vec3 v = value_of(i);
+        std::memcpy(img.pixels.data() + 3 * texel_of[i], &v, sizeof v);
+      }
+      std::vector<std::uint8_t> f = filled;
+      dilate(img, f, o.dilation);
+      return img;
+    };
+    const auto coefficients = [&](std::size_t i) {
+      std::array<glm::vec3, 4> c;
+      for (std::size_t j = 0; j < 4; ++j) c[j] = o.indirect_only ? sh[j][i] - sh_first[j][i] : sh[j][i];
+      return c;
+    };
+    if (o.output_sh_l1)
+      for (std::size_t j = 0; j < 4; ++j) r.sh_l1[j] = to_image([&](std::size_t i) { return coefficients(i)[j]; });
+    if (o.output_hl2) {
+      std::vector<std::array<glm::vec3, 3>> h(count);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t k = texel_of[i];
+        hl2_cone c = cone[i];
+        if (o.indirect_only)
+          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= cone_first[i].coefficients[t];
+        h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
+      }
+      for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = to_image([&](std::size_t i) { return h[i][j]; });
+    }
   }
   r.stats.dilated_texels = dilate(r.irradiance, filled, o.dilation);
   r.stats.seconds = seconds_since(t0);

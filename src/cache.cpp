@@ -9,11 +9,16 @@
 #include <chrono>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <string>
 #include <unordered_map>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace hemilight {
 
@@ -135,10 +140,14 @@ class record_bvh {
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
+// `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered).
 float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
-                  bool* own = nullptr) {
+                  bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr) {
   glm::vec3 sum(0.0f);
+  std::array<glm::vec3, 4> sh_sum{};
+  hl2_cone cone_sum;
+  if (cone) cone_sum.reference = make_frame(n).t;
   float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   bvh.query(x, [&](std::uint32_t i) {
@@ -148,12 +157,25 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
     const glm::vec3 e = extrapolate(r, x, n, o.use_gradients);
     sum += w * e;
     wsum += w;
+    if (sh)
+      for (std::size_t k = 0; k < 4; ++k) sh_sum[k] += w * r.sh_l1[k];
+    if (cone) {
+      const hl2_cone c = rotate_hl2_cone(r.cone, r.normal, cone_sum.reference);
+      for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * c.coefficients[k];
+    }
     const float l = luminance(e);
     lo = std::min(lo, l);
     hi = std::max(hi, l);
     at_record = at_record || r.position == x;
   });
   out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+  if (sh)
+    for (std::size_t k = 0; k < 4; ++k) (*sh)[k] = wsum > 0.0f ? sh_sum[k] / wsum : glm::vec3(0.0f);
+  if (cone) {
+    if (wsum > 0.0f)
+      for (glm::vec3& c : cone_sum.coefficients) c /= wsum;
+    *cone = cone_sum;
+  }
   if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
   if (own) *own = at_record;
   return wsum;
@@ -233,7 +255,150 @@ std::uint64_t mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// Per-texel weights of the HL2 cone series (cache.hpp, hl2_cone): w[term][texel] such that
+// coefficient term = sum_i L_i w[term][i], in the hemicube's local frame (reference = +x).
+struct cone_weights {
+  std::array<std::vector<float>, hl2_cone_terms> w;
+};
+
+// Fourier cosine coefficients c_0..c_M of g(theta) = max(0, A + B cos theta), B >= 0, A >= 0.
+void clamped_cosine_series(double a, double b, double (&c)[hl2_cone_order + 1]) {
+  constexpr double pi = 3.14159265358979323846;
+  for (double& v : c) v = 0.0;
+  if (b <= a) {  // never clamped: the series is A + B cos theta
+    c[0] = a;
+    c[1] = b;
+    return;
+  }
+  const double t0 = std::acos(-a / b);  // g > 0 for |theta| < t0
+  c[0] = (a * t0 + b * std::sin(t0)) / pi;
+  c[1] = 2.0 / pi * (a * std::sin(t0) + 0.5 * b * (t0 + 0.5 * std::sin(2.0 * t0)));
+  for (int m = 2; m <= hl2_cone_order; ++m)
+    c[m] = 2.0 / pi *
+           (a * std::sin(m * t0) / m + 0.5 * b * (std::sin((m - 1) * t0) / (m - 1) + std::sin((m + 1) * t0) / (m + 1)));
+}
+
+std::shared_ptr<const cone_weights> build_cone_weights(int n) {
+  const double cos_a = 1.0 / std::sqrt(3.0), sin_a = std::sqrt(2.0 / 3.0);
+  auto out = std::make_shared<cone_weights>();
+  const std::size_t count = hemicube_texel_count(n);
+  for (auto& v : out->w) v.assign(count, 0.0f);
+  const auto table = integration_table::get(n);
+  constexpr int sub = 8;
+  const double step = 2.0 / n / sub;
+  for (std::size_t i = 0; i < count; ++i) {
+    double acc[hl2_cone_terms] = {};
+    // Within 35.26 degrees of the normal (z >= sqrt2 |xy|) every b(phi) sees the whole texel:
+    // integral of w . b(phi) over the texel = V . b(phi) exactly (V = vector solid angle).
+    bool linear = true;
+    for (const glm::dvec3& c : hemicube_texel_corners(n, i)) {
+      const glm::dvec3 d = glm::normalize(c);
+      linear = linear && d.z >= std::sqrt(2.0) * std::hypot(d.x, d.y);
+    }
+    if (linear) {
+      acc[0] = cos_a * table->vz[i];
+      acc[1] = sin_a * table->vx[i];
+      acc[2] = sin_a * table->vy[i];
+    } else {
+      const hemicube_texel t = hemicube_texel_from_index(n, i);
+      const glm::dvec2 lo = hemicube_texel_min_corner(n, t);
+      for (int sy = 0; sy < sub; ++sy)
+        for (int sx = 0; sx < sub; ++sx) {
+          const double u0 = lo.x + sx * step, v0 = lo.y + sy * step;
+          const double omega = std::fabs(rectangle_solid_angle(u0, v0, u0 + step, v0 + step));
+          const glm::dvec3 d = glm::normalize(hemicube_face_point(t.face, u0 + 0.5 * step, v0 + 0.5 * step));
+          double c[hl2_cone_order + 1];
+          clamped_cosine_series(cos_a * std::max(d.z, 0.0), sin_a * std::hypot(d.x, d.y), c);
+          const double psi = std::atan2(d.y, d.x);
+          acc[0] += omega * c[0];
+          for (int m = 1; m <= hl2_cone_order; ++m) {
+            acc[2 * m - 1] += omega * c[m] * std::cos(m * psi);
+            acc[2 * m] += omega * c[m] * std::sin(m * psi);
+          }
+        }
+    }
+    for (int k = 0; k < hl2_cone_terms; ++k) out->w[std::size_t(k)][i] = float(acc[k]);
+  }
+  return out;
+}
+
+// The table of resolution n, built once per process for n <= 512 (like integration_table::get).
+std::shared_ptr<const cone_weights> make_cone_weights(int n) {
+  static std::mutex mutex;
+  static std::unordered_map<int, std::shared_ptr<const cone_weights>> cache;
+  if (n > 512) return build_cone_weights(n);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[n];
+  if (!slot) slot = build_cone_weights(n);
+  return slot;
+}
+
+// out[c] += sum_i plane_c[i] w[i] for the three planes r, g, b of `count` texels (a multiple of
+// 4): four lanes of float partial sums per block of 1024 texels, each block's lanes summed in a
+// fixed order into double. SSE2 where available; the scalar path does the same operations in the
+// same order.
+void weighted_sums(const float* r, const float* g, const float* b, const float* w, std::size_t count, double (&out)[3]) {
+  for (std::size_t b0 = 0; b0 < count; b0 += 1024) {
+    const std::size_t b1 = std::min(count, b0 + 1024);
+    float lanes[3][4];
+#if defined(__SSE2__)
+    __m128 ar = _mm_setzero_ps(), ag = _mm_setzero_ps(), ab = _mm_setzero_ps();
+    for (std::size_t i = b0; i < b1; i += 4) {
+      const __m128 wv = _mm_loadu_ps(w + i);
+      ar = _mm_add_ps(ar, _mm_mul_ps(_mm_loadu_ps(r + i), wv));
+      ag = _mm_add_ps(ag, _mm_mul_ps(_mm_loadu_ps(g + i), wv));
+      ab = _mm_add_ps(ab, _mm_mul_ps(_mm_loadu_ps(b + i), wv));
+    }
+    _mm_storeu_ps(lanes[0], ar);
+    _mm_storeu_ps(lanes[1], ag);
+    _mm_storeu_ps(lanes[2], ab);
+#else
+    for (auto& lane : lanes)
+      for (float& v : lane) v = 0.0f;
+    for (std::size_t i = b0; i < b1; i += 4)
+      for (std::size_t j = 0; j < 4; ++j) {
+        lanes[0][j] += r[i + j] * w[i + j];
+        lanes[1][j] += g[i + j] * w[i + j];
+        lanes[2][j] += b[i + j] * w[i + j];
+      }
+#endif
+    for (int c = 0; c < 3; ++c) out[c] += double((lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]));
+  }
+}
+
 }  // namespace
+
+hl2_cone rotate_hl2_cone(const hl2_cone& c, const glm::vec3& normal, const glm::vec3& reference) noexcept {
+  const glm::vec3 r = reference - normal * glm::dot(normal, reference);
+  const float delta = std::atan2(glm::dot(r, glm::cross(normal, c.reference)), glm::dot(r, c.reference));
+  hl2_cone out;
+  out.reference = reference;
+  out.coefficients[0] = c.coefficients[0];
+  for (int m = 1; m <= hl2_cone_order; ++m) {
+    const float cm = std::cos(float(m) * delta), sm = std::sin(float(m) * delta);
+    const glm::vec3 a = c.coefficients[std::size_t(2 * m - 1)], b = c.coefficients[std::size_t(2 * m)];
+    out.coefficients[std::size_t(2 * m - 1)] = a * cm + b * sm;
+    out.coefficients[std::size_t(2 * m)] = b * cm - a * sm;
+  }
+  return out;
+}
+
+glm::vec3 evaluate_hl2_cone(const hl2_cone& c, float phi) noexcept {
+  glm::vec3 e = c.coefficients[0];
+  for (int m = 1; m <= hl2_cone_order; ++m)
+    e += c.coefficients[std::size_t(2 * m - 1)] * std::cos(float(m) * phi) + c.coefficients[std::size_t(2 * m)] * std::sin(float(m) * phi);
+  return e;
+}
+
+std::array<glm::vec3, 3> hl2_from_cone(const hl2_cone& c, const frame& f) noexcept {
+  const float two_thirds_pi = 2.09439510f;
+  const float phi_t = std::atan2(glm::dot(f.t, glm::cross(f.n, c.reference)), glm::dot(f.t, c.reference));
+  const float s = glm::dot(glm::cross(f.t, f.b), f.n) >= 0.0f ? 1.0f : -1.0f;
+  const float beta[3] = {two_thirds_pi, -two_thirds_pi, 0.0f};  // azimuths of hl2 basis 0, 1, 2 in (t, b)
+  std::array<glm::vec3, 3> out;
+  for (std::size_t k = 0; k < 3; ++k) out[k] = glm::max(evaluate_hl2_cone(c, phi_t + s * beta[k]), glm::vec3(0.0f));
+  return out;
+}
 
 float record_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
   const float d = glm::length(x - r.position);
@@ -264,6 +429,21 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
   }
   if (weight_sum) *weight_sum = wsum;
   return wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+}
+
+std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_record>& records, const glm::vec3& x,
+                                                   const glm::vec3& n, const cache_options& o) {
+  std::array<glm::vec3, 4> sum{};
+  float wsum = 0.0f;
+  for (const cache_record& r : records) {
+    const float w = record_weight(r, x, n, o);
+    if (w <= 0.0f || record_is_behind(r, x, n)) continue;
+    for (std::size_t k = 0; k < 4; ++k) sum[k] += w * r.sh_l1[k];
+    wsum += w;
+  }
+  if (wsum > 0.0f)
+    for (glm::vec3& c : sum) c /= wsum;
+  return sum;
 }
 
 cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
@@ -371,7 +551,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
     }
 
     // 3. Render the seeds in parallel; results land in per-seed slots (deterministic).
-    std::vector<irradiance_sample> samples(seeds.size());
+    std::vector<cache_sample> samples(seeds.size());
     std::atomic<bool> cancel{false};
     std::atomic<std::size_t> done{0};
     const float covered_fraction = 1.0f - float(open) / float(count);
@@ -393,7 +573,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
     const std::size_t first_new = records.size();
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
-      const irradiance_sample& s = samples[k];
+      const cache_sample& s = samples[k];
       if (s.backface_fraction > o.invalid_backface_fraction) {
         ++stats.invalid_samples;
         inside[i] = 1;
@@ -410,6 +590,10 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       r.rotation_gradient = s.rotation_gradient;
       r.translation_gradient = s.translation_gradient;
       r.harmonic_distance = s.harmonic_mean_distance;
+      if (o.directional) {
+        r.sh_l1 = s.sh_l1;
+        r.cone = s.cone;
+      }
       float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o.max_radius;
       if (o.gradient_radius_limit) {
         const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
@@ -480,12 +664,23 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   cache_result result;
   result.irradiance.assign(count, glm::vec3(0.0f));
   result.valid.assign(count, 0);
+  if (o.directional) {
+    result.sh_l1.assign(count, std::array<glm::vec3, 4>{});
+    result.cone.assign(count, hl2_cone{});
+  }
   parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       glm::vec3 v;
-      if (!inside[i] && interpolate(records, bvh, positions[i], normals[i], o, v) > 0.0f) {
+      std::array<glm::vec3, 4> sh{};
+      hl2_cone cone;
+      if (!inside[i] && interpolate(records, bvh, positions[i], normals[i], o, v, nullptr, nullptr, o.directional ? &sh : nullptr,
+                                    o.directional ? &cone : nullptr) > 0.0f) {
         result.irradiance[i] = v;
         result.valid[i] = 1;
+        if (o.directional) {
+          result.sh_l1[i] = sh;
+          result.cone[i] = cone;
+        }
       }
     }
   });
@@ -511,13 +706,27 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
           }
         }
         glm::vec3 sum(0.0f);
+        std::array<glm::vec3, 4> sh{};
+        hl2_cone cone;
+        cone.reference = make_frame(normals[i]).t;
         float wsum = 0.0f;
         for (const auto& bw : best)
           if (bw.first > 0.0f) {
-            sum += bw.first * records[bw.second].irradiance;
+            const cache_record& rec = records[bw.second];
+            sum += bw.first * rec.irradiance;
+            if (o.directional) {
+              for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
+              const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
+              for (std::size_t c = 0; c < std::size_t(hl2_cone_terms); ++c) cone.coefficients[c] += bw.first * rc.coefficients[c];
+            }
             wsum += bw.first;
           }
         result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+        if (o.directional && wsum > 0.0f) {
+          for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
+          for (glm::vec3& c : cone.coefficients) c /= wsum;
+          result.cone[i] = cone;
+        }
       }
     });
   }
@@ -534,6 +743,10 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
   if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");
   if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
+  if (o.sh_l1 && !o.integrate.rotation_gradient)
+    throw_invalid_argument("make_hemicube_sampler: sh_l1 needs integrate.rotation_gradient (band 1 comes from it)");
+  std::shared_ptr<const hemicube_table> table = o.sh_l1 ? hemicube_table::get(o.resolution) : nullptr;
+  std::shared_ptr<const cone_weights> cone_table = o.hl2_cone ? make_cone_weights(o.resolution) : nullptr;
   struct context {
     hemicube_rasterizer raster;
     hemicube_integrator integrator;
@@ -543,7 +756,7 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
   for (int w = 0; w < workers; ++w)
     contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
                                                           hemicube_integrator(o.resolution, o.integrate), {}}));
-  return [contexts, o](int worker, const glm::vec3& x, const glm::vec3& n) {
+  return [contexts, o, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> cache_sample {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
     context& c = *(*contexts)[std::size_t(worker)];
@@ -558,7 +771,35 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
       f.t = t;
     }
     c.raster.render(x, f, o.resolution, c.buffer, o.texture);
-    return c.integrator.integrate(c.buffer);
+    cache_sample out = c.integrator.integrate(c.buffer);
+    const std::size_t count = c.buffer.texel_count();
+    const hemicube_buffer& cb = c.buffer;
+    const float* pr = cb.channel(0);  // the buffer's radiance is planar (hemicube.hpp)
+    const float* pg = cb.channel(1);
+    const float* pb = cb.channel(2);
+    if (cone_table) {
+      // 7 terms x 3 channels over the planes (weighted_sums: deterministic order).
+      double total[hl2_cone_terms][3] = {};
+      for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) weighted_sums(pr, pg, pb, cone_table->w[k].data(), count, total[k]);
+      out.cone.reference = f.t;
+      for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k)
+        out.cone.coefficients[k] = glm::vec3(float(total[k][0]), float(total[k][1]), float(total[k][2]));
+    }
+    if (o.sh_l1) {
+      // Band 0: solid-angle-weighted radiance; band 1: Y1 times Phi = E n + g_r x n (per channel).
+      constexpr double y00 = 0.282094791773878143, y1 = 0.488602511902919921;
+      double s0[3] = {0.0, 0.0, 0.0};
+      weighted_sums(pr, pg, pb, table->solid_angle(), count, s0);
+      for (int ch = 0; ch < 3; ++ch) {
+        const glm::dvec3 phi = double(out.irradiance[ch]) * glm::dvec3(f.n) +
+                               glm::cross(glm::dvec3(out.rotation_gradient[std::size_t(ch)]), glm::dvec3(f.n));
+        out.sh_l1[0][ch] = float(y00 * s0[ch]);
+        out.sh_l1[1][ch] = float(y1 * phi.y);
+        out.sh_l1[2][ch] = float(y1 * phi.z);
+        out.sh_l1[3][ch] = float(y1 * phi.x);
+      }
+    }
+    return out;
   };
 }
 

@@ -6,6 +6,7 @@
 #include "hemilight/reference_scenes.hpp"
 
 #include "raycast_reference.hpp"
+#include "test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -443,4 +444,367 @@ TEST_CASE("Bad input to the baker names the problem", "[bake]") {
   uv_mesh degenerate = m;
   degenerate.add({0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0.5f, 0.5f}, {0.5f, 0.5f}, {0.5f, 0.5f});
   CHECK_NOTHROW(bake_lightmap(degenerate.input(), o));
+}
+
+// ---- directional lightmaps and the environment sky -------------------------------------------
+
+namespace {
+
+// The world directions of the HL2 basis in frame (t, b, n), written out from integrate.hpp's
+// definition (not from bake.hpp's table).
+std::array<glm::dvec3, 3> hl2_world(const glm::dvec3& t, const glm::dvec3& b, const glm::dvec3& n) {
+  const double s6 = 1.0 / std::sqrt(6.0), s2 = 1.0 / std::sqrt(2.0), s3 = 1.0 / std::sqrt(3.0);
+  return {-s6 * t + s2 * b + s3 * n, -s6 * t - s2 * b + s3 * n, std::sqrt(2.0 / 3.0) * t + s3 * n};
+}
+
+// Solid angle of a triangle seen from p (Van Oosterom & Strackee 1983).
+double triangle_solid_angle(const glm::dvec3& p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+  a -= p;
+  b -= p;
+  c -= p;
+  const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+  const double num = std::fabs(glm::dot(a, glm::cross(b, c)));
+  const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
+}
+
+}  // namespace
+
+TEST_CASE("Directional maps under a uniform sky match the closed forms in right- and left-handed charts", "[bake]") {
+  // Two unoccluded quads under a uniform sky L = (1, 0.5, 2): a floor (normal +y) whose u runs
+  // along +z and v along +x (tangent frame (+z, +x, +y), right-handed), and a quad tilted 45
+  // degrees (normal (1, 1, 0)/sqrt 2) whose v runs along -z (a mirrored chart: left-handed).
+  // Closed forms from integrate.hpp's definitions: c_00 = sqrt(pi) L, band 1 = (sqrt(3 pi)/2) L
+  // (n_y, n_z, n_x); a plane tilted by beta under a uniform sky hemisphere receives
+  // pi L (1 + cos beta) / 2, and every HL2 vector is at cos beta = 1/sqrt 3 from n.
+  uv_mesh m;
+  const glm::vec3 f0(0, 0, 0), f1(0, 0, 1), f2(1, 0, 1), f3(1, 0, 0);
+  m.add(f0, f1, f2, {0, 0}, {0.5f, 0}, {0.5f, 1});
+  m.add(f0, f2, f3, {0, 0}, {0.5f, 1}, {0, 1});
+  // Tilted quad in the plane x + y = 3 (normal (1,1,0)/sqrt2), u along (-1, 1, 0)/sqrt2, v along
+  // -z, below y = 0 so that neither quad sees the other.
+  const glm::vec3 g0(13, -10, 1), g1(12, -9, 1), g2(12, -9, 0), g3(13, -10, 0);
+  m.add(g0, g2, g1, {0.5f, 0}, {1, 1}, {1, 0});
+  m.add(g0, g3, g2, {0.5f, 0}, {0.5f, 1}, {1, 1});
+  bake_input in = m.input();
+  in.scene.sky_radiance = glm::vec3(1.0f, 0.5f, 2.0f);
+  const lightmap_samples smp = compute_lightmap_samples(in, 16, 8);
+  const glm::vec3 tilt_n = glm::normalize(glm::vec3(1, 1, 0)), tilt_t = glm::normalize(glm::vec3(-1, 1, 0));
+  for (std::size_t k = 0; k < smp.coverage.size(); ++k) {
+    const bool floor = (k % 16) < 8;
+    // The frames as built by hand from the UV layout above (float rounding of normalisation).
+    CHECK(glm::length(smp.tangent[k] - (floor ? glm::vec3(0, 0, 1) : tilt_t)) < 1e-6f);
+    CHECK(glm::length(smp.bitangent[k] - (floor ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, -1))) < 1e-6f);
+    CHECK(glm::dot(glm::cross(smp.tangent[k], smp.bitangent[k]), smp.normal[k]) == Approx(floor ? 1.0 : -1.0).margin(1e-6));
+  }
+  for (bool cache : {true, false}) {
+    bake_options o;
+    o.width = 16;
+    o.height = 8;
+    o.resolution = 16;
+    o.use_cache = cache;
+    o.output_sh_l1 = o.output_hl2 = true;
+    const bake_result r = bake_lightmap(in, o);
+    REQUIRE(r.sh_l1[3].width == 16);
+    REQUIRE(r.hl2[2].height == 8);
+    const double k1 = std::sqrt(3.0 * pi) / 2.0;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < 16 * 8; ++k) {
+      const glm::dvec3 n = (k % 16) < 8 ? glm::dvec3(0, 1, 0) : glm::dvec3(tilt_n);
+      for (int c = 0; c < 3; ++c) {
+        const double l = in.scene.sky_radiance[c];
+        const double sh[4] = {std::sqrt(pi) * l, k1 * l * n.y, k1 * l * n.z, k1 * l * n.x};
+        for (int j = 0; j < 4; ++j) worst = std::max(worst, std::fabs(r.sh_l1[std::size_t(j)].pixels[3 * k + std::size_t(c)] - sh[j]) / l);
+        for (int j = 0; j < 3; ++j)
+          worst = std::max(worst, std::fabs(r.hl2[std::size_t(j)].pixels[3 * k + std::size_t(c)] - pi * l * (1 + 1 / std::sqrt(3.0)) / 2) / l);
+      }
+    }
+    INFO("cache " << cache << ": worst deviation " << worst << " x L");
+    // SH: exact texel weights summed in float/double (sums within 1e-6 of 2 pi and pi). HL2 (cone
+    // series): the uniform sky's cone irradiance is constant, so the series is exact, but its
+    // per-texel weights integrate the clamped cosine by the midpoint rule on 8 x 8 sub-rectangles
+    // where the cone's horizon crosses a texel: measured 1.6e-5 L at N = 16. Bound 1e-4 L.
+    CHECK(worst < 1e-4);
+  }
+}
+
+TEST_CASE("Directional maps against Lambert's closed form and per-texel hemicubes in the texel frame", "[bake]") {
+  // A 1 x 1 m floor (y = 0, u along +z on the left half of a 32 x 16 map, v along +x: tangent frame
+  // (+z, +x, +y)) under a 0.4 x 0.4 m emitter (L = 2) facing down at 1.5 m, centred. From every
+  // floor point the emitter lies within 33.5 degrees of the normal, so it is wholly above the
+  // horizon of the normal and of every HL2 vector (54.7 degrees from n): closed forms, independent
+  // of hemilight: band-1 SH = Y1 Phi (Phi = Lambert's vector irradiance), band 0 = Y00 L Omega
+  // (Van Oosterom-Strackee solid angle), HL2_k = Phi . b_k.
+  const double y00 = 0.28209479177387814, y1 = 0.4886025119029199, radiance = 2.0;
+  uv_mesh m;
+  const glm::vec3 f0(0, 0, 0), f1(0, 0, 1), f2(1, 0, 1), f3(1, 0, 0);
+  m.add(f0, f1, f2, {0, 0}, {0.5f, 0}, {0.5f, 1});
+  m.add(f0, f2, f3, {0, 0}, {0.5f, 1}, {0, 1});
+  material lamp;
+  lamp.emission = glm::vec3(float(radiance));
+  lamp.albedo = glm::vec3(0.0f);
+  const glm::vec3 e0(0.3f, 1.5f, 0.3f), e1(0.7f, 1.5f, 0.3f), e2(0.7f, 1.5f, 0.7f), e3(0.3f, 1.5f, 0.7f);
+  m.add(e0, e1, e2, {0.55f, 0.1f}, {0.95f, 0.1f}, {0.95f, 0.5f}, lamp);  // (v1-v0) x (v2-v0) = -y: faces down
+  m.add(e0, e2, e3, {0.55f, 0.1f}, {0.95f, 0.5f}, {0.55f, 0.5f}, lamp);
+  const bake_input in = m.input();
+  const std::vector<glm::dvec3> poly = {glm::dvec3(e0), glm::dvec3(e1), glm::dvec3(e2), glm::dvec3(e3)};
+  const std::array<glm::dvec3, 3> basis = hl2_world({0, 0, 1}, {1, 0, 0}, {0, 1, 0});
+
+  bake_options o;
+  o.width = 32;
+  o.height = 16;
+  o.resolution = 64;
+  o.output_sh_l1 = o.output_hl2 = true;
+  o.cache.error_threshold = 0.1f;
+  bake_options ref_o = o;
+  ref_o.use_cache = false;
+  const bake_result cached = bake_lightmap(in, o), per_texel = bake_lightmap(in, ref_o);
+
+  // Per-texel reference in the texel's own frame: a hemicube rendered at the sample point with
+  // the tangent frame (+z, +x, +y), integrated with integrate_options::directional, at N = 512 on
+  // every fourth texel of every fourth row (at N = 64 without roll the emitter's edges line up
+  // with the texel grid: 8 texel centres for 8.5 texels across, a 12% error at the centre).
+  auto sc = scene::create(in.scene);
+  hemicube_rasterizer raster(sc);
+  integrate_options io;
+  io.directional = true;
+  hemicube_integrator integrator(512, io);
+  hemicube_buffer buf;
+
+  double sh_err = 0, sh_norm = 0, trunc_err = 0, cache_err = 0, ref_err = 0, ref_norm = 0, hl2_norm = 0, worst_trunc = 0;
+  for (int row = 0; row < 16; ++row)
+    for (int col = 0; col < 16; ++col) {
+      const std::size_t k = std::size_t(row * 32 + col);
+      const glm::dvec3 p(double(row + 0.5) / 16.0, 0.0, double(col + 0.5) / 16.0);  // x = v, z = 2 u
+      const glm::dvec3 phi = test::polygon_vector_irradiance(poly, p, radiance);
+      const double omega = triangle_solid_angle(p, poly[0], poly[1], poly[2]) + triangle_solid_angle(p, poly[0], poly[2], poly[3]);
+      const double sh[4] = {y00 * radiance * omega, y1 * phi.y, y1 * phi.z, y1 * phi.x};
+      for (int j = 0; j < 4; ++j) {
+        sh_err += std::pow(cached.sh_l1[std::size_t(j)].pixels[3 * k] - sh[j], 2.0);
+        sh_norm += sh[j] * sh[j];
+      }
+      // HL2 from the exact L1 SH: the truncation error alone.
+      std::array<glm::vec3, 4> exact_sh;
+      for (std::size_t j = 0; j < 4; ++j) exact_sh[j] = glm::vec3(float(sh[j]));
+      const std::array<glm::vec3, 3> from_exact = hl2_from_sh_l1(exact_sh, frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}});
+      const bool probe = row % 4 == 1 && col % 4 == 1;
+      irradiance_sample ref;
+      if (probe) {
+        raster.render(glm::vec3(p) + glm::vec3(0, 1e-4f, 0), frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, 512, buf);
+        ref = integrator.integrate(buf);
+      }
+      for (std::size_t j = 0; j < 3; ++j) {
+        const double exact = glm::dot(phi, basis[j]);
+        hl2_norm += exact * exact;
+        trunc_err += std::pow(from_exact[j].x - exact, 2.0);
+        cache_err += std::pow(cached.hl2[j].pixels[3 * k] - exact, 2.0);
+        worst_trunc = std::max(worst_trunc, std::fabs(from_exact[j].x - exact) / phi.y);  // relative to E = n . Phi
+        if (probe) {
+          ref_err += std::pow(ref.hl2[j].x - exact, 2.0);
+          ref_norm += exact * exact;
+        }
+      }
+    }
+  const double sh_rms = std::sqrt(sh_err / sh_norm), ref_rms = std::sqrt(ref_err / ref_norm),
+               trunc_rms = std::sqrt(trunc_err / hl2_norm), cache_rms = std::sqrt(cache_err / hl2_norm);
+  INFO("cached SH vs closed form: relative RMS " << sh_rms << "; HL2 relative RMS: N = 512 hemicube in the texel frame "
+                                                  << ref_rms << ", from the exact L1 SH " << trunc_rms << " (worst " << worst_trunc
+                                                  << " of E), baked (cone series, cache) " << cache_rms << "; records "
+                                                  << cached.stats.records);
+  // The N = 512 hemicube in the texel frame agrees with the closed form (texel-centre visibility
+  // of the emitter's outline, 68 texels across: measured 0.8%): the frame convention of the
+  // closed form is the integrator's.
+  CHECK(ref_rms < 0.02);
+  // Baked SH (N = 64, rolled hemicubes, a = 0.1): the emitter is 8.5 top-face texels across, so
+  // texel-centre visibility misses or adds up to a texel row per edge; the per-texel roll turns
+  // that into noise. Measured 2.1% RMS; 3% allowed.
+  CHECK(sh_rms < 0.03);
+  // HL2 through L1 SH (hl2_from_sh_l1 of the exact SH, deterministic): light from near the normal gives
+  // L (1/4 + (1/2) cos 54.7) = 0.539 L instead of cos 54.7 = 0.577 L per unit source (-6.6%), and
+  // off-centre texels see the source tilted towards some basis vectors and away from others.
+  // Measured 13.2% RMS, worst 18.6% of E: the cost of the L1 representation (docs/bake.md), and
+  // why the baker does not use it for HL2. Bounds 14% and 20%.
+  CHECK(trunc_rms < 0.14);
+  CHECK(worst_trunc < 0.20);
+  // The baker does not go through L1 SH for HL2: it interpolates the records' cone series
+  // (cache.hpp, hl2_cone), exact for light within 35.26 degrees of the normal as here, so the
+  // baked HL2 keeps only the hemicube's discretisation error, as the SH above: measured 2.1%;
+  // bound 3%.
+  CHECK(cache_rms < 0.03);
+}
+
+TEST_CASE("Environment sky: an upward and a sideways quad match the cube map's cosine filter", "[bake]") {
+  // Sky L(w) = 1 + 0.5 w_x + 0.3 w_y + 0.2 w_z + 0.4 w_x w_z (> 0) sampled at 64^2 texel centres.
+  // Reference: filter_irradiance (cubemap.hpp) - the cosine-lobe quadrature over the map's own
+  // texels, independent of the rasterizer - at its output texel whose centre is exactly +y (face
+  // +Y) or +x (face +X) (odd output size 5: the central texel). The constant sky (100) must not
+  // be seen. tests/test_cubemap.cpp measured hemicube (N = 64) vs filter ~1e-4; tolerance 1e-3.
+  const int size = 64;
+  cube_image env = cube_image::make(size, 3);
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const glm::vec3 w = cubemap_texel_direction(size, f, x, y, edge_fixup::none);
+        const float l = 1.0f + 0.5f * w.x + 0.3f * w.y + 0.2f * w.z + 0.4f * w.x * w.z;
+        float* p = env.at(f, x, y);
+        p[0] = l;
+        p[1] = 0.5f * l;
+        p[2] = 2.0f * l;
+      }
+  auto map = std::make_shared<const cubemap>(cubemap::from_image(env, false));
+  const cube_image filtered = filter_irradiance(*map, 5);
+  uv_mesh m;
+  // Floor (normal +y) on the left half; on the right half a wall x = 5 facing +x, below y = 0:
+  // neither sees the other.
+  m.add({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {0, 0}, {0.5f, 0}, {0.5f, 1});
+  m.add({0, 0, 0}, {1, 0, 1}, {1, 0, 0}, {0, 0}, {0.5f, 1}, {0, 1});
+  m.add({5, -3, 0}, {5, -2, 0}, {5, -2, 1}, {0.5f, 0}, {1, 0}, {1, 1});
+  m.add({5, -3, 0}, {5, -2, 1}, {5, -3, 1}, {0.5f, 0}, {1, 1}, {0.5f, 1});
+  bake_input in = m.input();
+  in.scene.sky_radiance = glm::vec3(100.0f);
+  bake_options o;
+  o.width = 16;
+  o.height = 8;
+  o.resolution = 64;
+  o.environment = map;
+  o.output_sh_l1 = true;
+  const bake_result r = bake_lightmap(in, o);
+  const float* up = filtered.at(2, 2, 2);    // face +Y, centre: +y
+  const float* side = filtered.at(0, 2, 2);  // face +X, centre: +x
+  double worst = 0.0;
+  for (std::size_t k = 0; k < 16 * 8; ++k) {
+    const float* ref = (k % 16) < 8 ? up : side;
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(r.irradiance.pixels[3 * k + std::size_t(c)] / ref[c] - 1.0));
+  }
+  INFO("worst relative difference to the cosine filter " << worst);
+  CHECK(worst < 1e-3);
+  // The SH band 0 sees the environment too: c_00 = Y00 x the integral of L over the upper
+  // hemisphere, which for this L (the odd terms in x and z cancel over the +y hemisphere) is
+  // 2 pi + 0.3 pi (integral of w_y) = 2.3 pi, times Y00; midpoint sampling of the map: 1e-3.
+  CHECK(r.sh_l1[0].pixels[0] == Approx(0.28209479 * 2.3 * pi).epsilon(1e-3));
+  // Bad maps are refused by name.
+  o.environment = std::make_shared<const cubemap>();
+  test::require_error([&] { bake_lightmap(in, o); }, status::invalid_argument, "environment");
+}
+
+TEST_CASE("write_bake_exrs writes the irradiance, mask and the requested directional maps", "[bake]") {
+  small_cornell c;
+  c.options.bounces = 1;
+  c.options.output_hl2 = true;
+  const bake_result r = bake_lightmap(input_of(c.mesh), c.options);
+  CHECK(r.sh_l1[0].width == 0);  // not requested: empty
+  const std::vector<std::string> files = write_bake_exrs(r, test::tmp_path("cornell_dir"));
+  REQUIRE(files.size() == 5);
+  CHECK(files[2] == test::tmp_path("cornell_dir") + "_hl2_0.exr");
+  const image back = read_exr(files[3]);
+  CHECK(back.pixels == r.hl2[1].pixels);  // float32 round-trips exactly
+}
+
+TEST_CASE("White furnace: directional maps of the full and the indirect-only bake match the uniform closed forms", "[bake]") {
+  // In the closed uniform room (albedo a = 0.5, emission 1) pass k sees a uniform radiance
+  // L = 1 + a + ... + a^(k-1) from every direction, so (integrate.hpp's definitions) the SH is
+  // (sqrt(pi) L, (sqrt(3 pi)/2) L (n_y, n_z, n_x)) and every HL2 value pi L (1 + 1/sqrt3) / 2.
+  // Indirect only: L - 1 (the first pass sees the emission L = 1). Float sums and the cone
+  // weights' midpoint quadrature (previous tests): 1e-4 L.
+  material m;
+  m.albedo = glm::vec3(0.5f);
+  m.emission = glm::vec3(1.0f);
+  scene_mesh room = closed_room(m, m, 2);
+  generate_lightmap_uvs(room, 32, 2);
+  const lightmap_samples smp = compute_lightmap_samples(input_of(room), 32, 32);
+  bake_options o;
+  o.width = o.height = 32;
+  o.resolution = 16;
+  o.bounces = 3;
+  o.output_sh_l1 = o.output_hl2 = true;
+  for (bool indirect : {false, true}) {
+    o.indirect_only = indirect;
+    const bake_result r = bake_lightmap(input_of(room), o);
+    const double l = indirect ? 0.75 : 1.75, k1 = std::sqrt(3.0 * pi) / 2.0;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < r.sampled.size(); ++k) {
+      if (!r.sampled[k]) continue;
+      const glm::dvec3 n(smp.normal[k]);
+      const double sh[4] = {std::sqrt(pi) * l, k1 * l * n.y, k1 * l * n.z, k1 * l * n.x};
+      for (int j = 0; j < 4; ++j) worst = std::max(worst, std::fabs(r.sh_l1[std::size_t(j)].pixels[3 * k + 1] - sh[j]));
+      for (int j = 0; j < 3; ++j)
+        worst = std::max(worst, std::fabs(r.hl2[std::size_t(j)].pixels[3 * k + 1] - pi * l * (1 + 1 / std::sqrt(3.0)) / 2));
+    }
+    INFO((indirect ? "indirect only" : "full") << ": worst deviation " << worst << " for L = " << l);
+    CHECK(worst < 1e-4 * l);
+  }
+}
+
+TEST_CASE("HL2 maps of a grazing side light in right- and left-handed charts against hemicubes in the texel frame", "[bake]") {
+  // Two 1 x 1 m floors, each lit by its own 0.6 x 0.8 m wall emitter (L = 2) standing 0.4 m beyond
+  // its edge, so light arrives 20-80 degrees from the normal: well outside the 35.26-degree cone
+  // where the HL2 cone series is exact, and strongly directional. Floor A's chart is right-handed
+  // (t = +z, b = +x), floor B's mirrored (t = +z, b = -x). Reference, independent of the cache and
+  // of the cone series: at every third texel a hemicube rendered at N = 512 in the texel's frame
+  // and integrated with integrate_options::directional (for B, rendered in the right-handed frame
+  // (t, -b, n), where HL2 vectors 0 and 1 trade places).
+  uv_mesh m;
+  material lamp;
+  lamp.emission = glm::vec3(2.0f);
+  lamp.albedo = glm::vec3(0.0f);
+  m.add({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {0, 0}, {0.25f, 0}, {0.25f, 1});
+  m.add({0, 0, 0}, {1, 0, 1}, {1, 0, 0}, {0, 0}, {0.25f, 1}, {0, 1});
+  m.add({1, 0, 10}, {0, 0, 11}, {1, 0, 11}, {0.25f, 0}, {0.5f, 1}, {0.5f, 0});
+  m.add({1, 0, 10}, {0, 0, 10}, {0, 0, 11}, {0.25f, 0}, {0.25f, 1}, {0.5f, 1});
+  for (float z0 : {0.0f, 10.0f}) {  // wall emitters at x = 1.4 facing -x
+    const float u0 = z0 == 0.0f ? 0.5f : 0.75f;
+    m.add({1.4f, 0.1f, z0 + 0.2f}, {1.4f, 0.1f, z0 + 0.8f}, {1.4f, 0.9f, z0 + 0.8f}, {u0, 0}, {u0 + 0.2f, 0}, {u0 + 0.2f, 0.5f}, lamp);
+    m.add({1.4f, 0.1f, z0 + 0.2f}, {1.4f, 0.9f, z0 + 0.8f}, {1.4f, 0.9f, z0 + 0.2f}, {u0, 0}, {u0 + 0.2f, 0.5f}, {u0, 0.5f}, lamp);
+  }
+  const bake_input in = m.input();
+  bake_options o;
+  o.width = 64;
+  o.height = 16;
+  o.resolution = 64;
+  o.cache.error_threshold = 0.1f;
+  o.output_sh_l1 = o.output_hl2 = true;
+  const bake_result r = bake_lightmap(in, o);
+  const lightmap_samples smp = compute_lightmap_samples(in, 64, 16);
+
+  auto sc = scene::create(in.scene);
+  hemicube_rasterizer raster(sc);
+  integrate_options io;
+  io.directional = true;
+  hemicube_integrator integrator(512, io);
+  hemicube_buffer buf;
+  double cone_err = 0, sh_err = 0, norm = 0;
+  for (int floor_b = 0; floor_b < 2; ++floor_b)
+    for (int row = 1; row < 16; row += 3)
+      for (int col = 1; col < 16; col += 3) {
+        const std::size_t k = std::size_t(row * 64 + col + 16 * floor_b);
+        const double v = (row + 0.5) / 16.0, z = (col + 0.5) / 16.0;
+        const glm::vec3 p = floor_b ? glm::vec3(float(1.0 - v), 1e-4f, float(10.0 + z)) : glm::vec3(float(v), 1e-4f, float(z));
+        // The texel frames as laid out above (not read from the baker).
+        const glm::vec3 b = floor_b ? glm::vec3(-1, 0, 0) : glm::vec3(1, 0, 0);
+        CHECK(glm::length(smp.bitangent[k] - b) < 1e-6f);
+        raster.render(p, frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, 512, buf);
+        const irradiance_sample ref = integrator.integrate(buf);
+        std::array<glm::vec3, 4> sh;
+        for (std::size_t j = 0; j < 4; ++j) {
+          const float* q = &r.sh_l1[j].pixels[3 * k];
+          sh[j] = glm::vec3(q[0], q[1], q[2]);
+        }
+        const std::array<glm::vec3, 3> via_sh = hl2_from_sh_l1(sh, frame{{0, 0, 1}, b, {0, 1, 0}});
+        for (std::size_t j = 0; j < 3; ++j) {
+          const std::size_t rj = floor_b && j < 2 ? 1 - j : j;  // mirrored chart: basis 0 <-> 1
+          const double want = ref.hl2[rj].x;
+          norm += want * want;
+          cone_err += std::pow(r.hl2[j].pixels[3 * k] - want, 2.0);
+          sh_err += std::pow(via_sh[j].x - want, 2.0);
+        }
+      }
+  const double cone_rms = std::sqrt(cone_err / norm), sh_rms = std::sqrt(sh_err / norm);
+  INFO("HL2 relative RMS against N = 512 hemicubes in the texel frame: baked (cone series) " << cone_rms
+                                                                                           << ", from the baked L1 SH " << sh_rms);
+  // Baked HL2 (N = 64 hemicubes, cache a = 0.1, cone series of order 3): the order-3 cut of the
+  // clamped cosine plus the N = 64 texel-centre error of the 0.6 x 0.8 m emitter. Measured 1.7%;
+  // 3% allowed. Through L1 SH instead the same maps would be off by the measured 25%, which is
+  // why the baker uses the cone series.
+  CHECK(cone_rms < 0.03);
+  CHECK(sh_rms > 3 * cone_rms);
 }

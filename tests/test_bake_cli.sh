@@ -49,7 +49,19 @@ done
 grep -q "256 sampled" ok.log || { echo "FAIL: expected 256 sampled texels:"; cat ok.log; fails=$((fails + 1)); }
 "$bake" --help | grep -q "usage: hemilight_bake" || { echo "FAIL: --help"; fails=$((fails + 1)); }
 
+expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --directional both --out dir
+for f in dir/quad_sh_l1_0.exr dir/quad_sh_l1_3.exr dir/quad_hl2_0.exr dir/quad_hl2_2.exr; do
+  [ -s "$f" ] || { echo "FAIL: $f not written"; fails=$((fails + 1)); }
+done
+expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --directional hl2 --out hl2only
+[ -e hl2only/quad_sh_l1_0.exr ] && { echo "FAIL: --directional hl2 wrote SH maps"; fails=$((fails + 1)); }
+[ -s hl2only/quad_hl2_1.exr ] || { echo "FAIL: --directional hl2 wrote no HL2 maps"; fails=$((fails + 1)); }
+
 expect_fail "missing.obj" "no such file" -- missing.obj
+expect_fail "--directional sideways" "sh, hl2 or both" -- quad.obj --directional sideways
+expect_fail "nosky.exr" "no such file" -- quad.obj --environment nosky.exr
+printf 'not an exr' > bad.exr
+expect_fail "bad.exr" -- quad.obj --environment bad.exr
 expect_fail "no texture coordinates" -- nouv.obj
 expect_fail "outside \[0, 1\]" -- outside.obj
 expect_fail "zero area in lightmap UV space" -- flat.obj

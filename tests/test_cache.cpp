@@ -3,6 +3,7 @@
 // and accuracy against closed forms. Hemicubes come from the reference ray caster, so the cache
 // is tested on its own.
 #include "hemilight/cache.hpp"
+#include "hemilight/reference_scenes.hpp"
 
 #include "integrate_scenes.hpp"
 
@@ -298,4 +299,143 @@ TEST_CASE("cache: accuracy against a hemicube at every point, with and without g
   CHECK(rms(a) < rms(b));
   CHECK(rms(a) < 0.02);  // the issue's target is 1% at <= 10% of the points on real scenes (benchmarked)
   CHECK(a.stats.hemicubes < p.size() / 3);
+}
+
+TEST_CASE("cache: directional records carry world-space L1 SH - uniform sky closed form on a curved surface", "[cache]") {
+  // Points on a unit sphere cap (normal = position, polar angle up to 40 degrees around +y) under a
+  // uniform sky L = (1, 2, 3), nothing else in the scene. Closed form from integrate.hpp's
+  // definitions (c = integral over the hemisphere of L Y d omega): Y00 = 1 / (2 sqrt pi) gives
+  // c_00 = 2 pi L Y00 = sqrt(pi) L; Y1 = sqrt(3) / (2 sqrt pi) (y, z, x) and the hemisphere's
+  // integral of w d omega = pi n give (c_1-1, c_10, c_11) = (sqrt(3 pi) / 2) L (n_y, n_z, n_x).
+  closed_form_scene s;
+  s.sky = glm::vec3(1.0f, 2.0f, 3.0f);
+  integrate_options io;
+  io.directional = true;
+  const irradiance_sampler sampler = [&s, io](int, const glm::vec3& x, const glm::vec3& normal) {
+    return integrate(raycast_hemicube(s.tris, s.sky, glm::dvec3(x), rolled_frame(glm::dvec3(normal), 0.3), 16), io);
+  };
+  std::vector<glm::vec3> p, n;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double theta = 0.6981 * i / 20.0, phi = 2.0 * 3.14159265358979 * j / 40.0;
+      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)), float(std::sin(theta) * std::sin(phi)));
+      p.push_back(glm::normalize(d));
+      n.push_back(glm::normalize(d));
+    }
+  const double sqrt_pi = std::sqrt(3.14159265358979), k1 = std::sqrt(3.0 * 3.14159265358979) / 2.0;
+  const auto closed = [&](const glm::vec3& nn, int c) {
+    const double l = s.sky[c];
+    return std::array<double, 4>{sqrt_pi * l, k1 * l * nn.y, k1 * l * nn.z, k1 * l * nn.x};
+  };
+  cache_options o;
+  o.error_threshold = 0.2f;
+  o.directional = true;
+  const cache_result r = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
+  REQUIRE(r.sh_l1.size() == p.size());
+  double worst0 = 0.0, worst1 = 0.0, worst_record = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const std::array<double, 4> ref = closed(n[i], c);
+      worst0 = std::max(worst0, std::fabs(r.sh_l1[i][0][c] - ref[0]) / ref[0]);
+      for (int k = 1; k < 4; ++k) worst1 = std::max(worst1, std::fabs(r.sh_l1[i][std::size_t(k)][c] - ref[std::size_t(k)]) / (k1 * s.sky[c]));
+    }
+  for (const cache_record& rec : r.records)
+    for (int c = 0; c < 3; ++c) {
+      const std::array<double, 4> ref = closed(rec.normal, c);
+      for (int k = 0; k < 4; ++k) worst_record = std::max(worst_record, std::fabs(rec.sh_l1[std::size_t(k)][c] - ref[std::size_t(k)]) / (k1 * s.sky[c]));
+    }
+  INFO("records " << r.records.size() << ": band 0 worst " << worst0 << ", band 1 worst " << worst1 << " (of |c_1|), at records "
+                  << worst_record);
+  // At the records: the exact texel weights of a ray-cast hemicube sum to 2 pi and (0, 0, pi) to
+  // float rounding (geometry.hpp, < 1e-6 relative); 1e-5 leaves room for the float SH constants.
+  CHECK(worst_record < 1e-5);
+  // Band 0 is the same at every record: interpolation keeps it exactly (weighted mean, 1e-5).
+  CHECK(worst0 < 1e-5);
+  // Band 1 is a weighted mean of sqrt(3 pi)/2 L n_i over records with Ward weight > 1/a, i.e.
+  // sqrt(1 - n.n_i) < a, so |n_i - n| = sqrt(2 (1 - n.n_i)) < sqrt(2) a: the documented cost of
+  // not rotating the coefficients (error relative to |c_1|). a = 0.2: 0.283.
+  CHECK(worst1 < std::sqrt(2.0) * 0.2);
+  CHECK(worst1 > 1e-4);  // and it is a real error here (the surface curves), not zero by accident
+  // The brute-force interpolation gives the same coefficients at a point.
+  const std::array<glm::vec3, 4> b = interpolate_records_sh_l1(r.records, p[5], n[5], o);
+  for (int k = 0; k < 4; ++k) CHECK(glm::length(b[std::size_t(k)] - r.sh_l1[5][std::size_t(k)]) < 1e-4f);
+
+  // Off (the default): no coefficients anywhere.
+  cache_options plain = o;
+  plain.directional = false;
+  const cache_result q = cache_irradiance(p.data(), n.data(), p.size(), sampler, plain);
+  CHECK(q.sh_l1.empty());
+  for (const cache_record& rec : q.records) CHECK(rec.sh_l1[0] == glm::vec3(0.0f));
+  CHECK(q.irradiance == r.irradiance);  // E does not depend on the option
+}
+
+TEST_CASE("cache: the sampler's cheap L1 SH equals the integrator's directional SH", "[cache]") {
+  // hemicube_sampler_options::sh_l1 derives band 1 from the rotation gradient (Phi = E n + g_r x n)
+  // and band 0 from one solid-angle sum; integrate_options::directional sums both directly. Same
+  // hemicubes (same roll), so they must agree to float rounding of 12k-texel sums: 1e-5 of c_00.
+  auto sc = scene::create(cornell_box().desc());
+  hemicube_sampler_options cheap;
+  cheap.resolution = 32;
+  cheap.sh_l1 = true;
+  hemicube_sampler_options full = cheap;
+  full.sh_l1 = false;
+  full.integrate.directional = true;
+  const irradiance_sampler a = make_hemicube_sampler(sc, cheap, 1), b = make_hemicube_sampler(sc, full, 1);
+  const glm::vec3 points[][2] = {{{0.28f, 0.01f, 0.28f}, {0, 1, 0}},
+                                 {{0.01f, 0.3f, 0.2f}, {1, 0, 0}},
+                                 {{0.3f, 0.54f, 0.1f}, {0, -1, 0}},
+                                 {{0.2f, 0.2f, 0.55f}, {0, 0, -1}}};
+  int lit = 0;
+  for (const auto& pn : points) {
+    const irradiance_sample sa = a(0, pn[0], pn[1]), sb = b(0, pn[0], pn[1]);
+    lit += sa.sh_l1[0].x > 0.0f ? 1 : 0;
+    for (std::size_t k = 0; k < 4; ++k)
+      for (int c = 0; c < 3; ++c) {
+        INFO("point " << pn[0].x << " " << pn[0].y << " " << pn[0].z << ", coefficient " << k << ", channel " << c);
+        CHECK(std::fabs(sa.sh_l1[k][c] - sb.sh_l1[k][c]) <= 1e-5f * sb.sh_l1[0][c]);
+      }
+    CHECK(sa.irradiance == sb.irradiance);
+  }
+  CHECK(lit >= 3);  // all but the point under the ceiling facing down see the lamp (emission only)
+  hemicube_sampler_options bad = cheap;
+  bad.integrate.rotation_gradient = false;
+  CHECK_THROWS_WITH(make_hemicube_sampler(sc, bad, 1), Catch::Contains("rotation_gradient"));
+}
+
+TEST_CASE("cache: HL2 cone series - uniform sky closed form and exact rotation", "[cache]") {
+  // Under a uniform sky L every direction b on the HL2 cone (54.74 degrees from n) is a plane
+  // tilted by that angle under the sky hemisphere: E = pi L (1 + 1/sqrt3) / 2, the same for all
+  // azimuths, so a_0 is that and every other coefficient 0. The per-texel weights integrate the
+  // clamped cosine by the midpoint rule on 8 x 8 sub-rectangles (N = 32 here): 1e-4 relative.
+  scene_mesh empty;
+  empty.sky_radiance = glm::vec3(1.0f, 2.0f, 0.5f);
+  hemicube_sampler_options so;
+  so.resolution = 32;
+  so.hl2_cone = true;
+  const irradiance_sampler sampler = make_hemicube_sampler(scene::create(empty.desc()), so, 1);
+  const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.8f, -0.5f));
+  const cache_sample s = sampler(0, glm::vec3(1.0f, 2.0f, 3.0f), n);
+  const double closed = 3.14159265358979 * (1.0 + 1.0 / std::sqrt(3.0)) / 2.0;
+  for (int c = 0; c < 3; ++c) {
+    CHECK(s.cone.coefficients[0][c] == Approx(closed * empty.sky_radiance[c]).epsilon(1e-4));
+    for (std::size_t k = 1; k < std::size_t(hl2_cone_terms); ++k) CHECK(std::fabs(s.cone.coefficients[k][c]) < 1e-4 * closed * empty.sky_radiance[c]);
+  }
+  CHECK(std::fabs(glm::dot(s.cone.reference, n)) < 1e-6f);  // the reference is a tangent
+  // Rotation is exact: a cone re-referenced to another tangent gives the same value in every
+  // world direction (azimuth shifted by the angle between the references). Hand-made series.
+  hl2_cone c;
+  const frame f = make_frame(n);
+  c.reference = f.t;
+  for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) c.coefficients[k] = glm::vec3(1.0f / float(k + 1), -0.3f * float(k), 0.1f);
+  const glm::vec3 other = std::cos(0.7f) * f.t + std::sin(0.7f) * f.b;  // azimuth 0.7 in c's frame
+  const hl2_cone r = rotate_hl2_cone(c, n, other);
+  for (float phi : {0.0f, 1.0f, 2.5f, -2.0f}) CHECK(glm::length(evaluate_hl2_cone(r, phi) - evaluate_hl2_cone(c, phi + 0.7f)) < 1e-5f);
+  // hl2_from_cone reads the series at the basis azimuths (120, -120, 0 degrees from t; mirrored
+  // for a left-handed frame).
+  const frame right{other, glm::cross(n, other), n}, left{other, -glm::cross(n, other), n};
+  const std::array<glm::vec3, 3> hr = hl2_from_cone(c, right), hl = hl2_from_cone(c, left);
+  const float third = 2.0943951f;
+  CHECK(glm::length(hr[0] - glm::max(evaluate_hl2_cone(c, 0.7f + third), glm::vec3(0.0f))) < 1e-5f);
+  CHECK(glm::length(hl[0] - glm::max(evaluate_hl2_cone(c, 0.7f - third), glm::vec3(0.0f))) < 1e-5f);
+  CHECK(glm::length(hl[2] - hr[2]) < 1e-6f);
 }

@@ -13,6 +13,8 @@
 #define H 8
 static float out[3 * W * H];
 static uint8_t valid[W * H];
+static float sh[12 * W * H], hl2[9 * W * H];
+static float env[6 * 2 * 2 * 3];
 
 static void fill_sentinel(void) {
   int i;
@@ -62,6 +64,7 @@ int main(void) {
   hemilight_bake_options_init(&o);
   hemilight_bake_options_init(NULL); /* ignored */
   CHECK(o.width == 256 && o.resolution == 64 && o.bounces == 1 && o.use_cache == 1 && o.progress == NULL);
+  CHECK(o.environment_rgb == NULL && o.environment_size == 0);
   o.width = W;
   o.height = H;
   o.resolution = 16;
@@ -80,6 +83,55 @@ int main(void) {
   CHECK(stats.sampled_texels == W * H && stats.hemicubes > 0 && stats.invalid_texels == 0 && stats.seconds >= 0.0);
   /* valid may be NULL, stats too. */
   CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL) == HEMILIGHT_OK);
+
+  /* Directional maps (same scene: unoccluded up-facing quads under a uniform sky L = 1). From the
+   * header's definitions: c_0 = sqrt(pi) L, (c_1, c_2, c_3) = (sqrt(3 pi)/2) L (n_y, n_z, n_x) with
+   * n = +y; each HL2 vector is 54.7 degrees from n, and a plane tilted by beta under a uniform sky
+   * hemisphere receives pi L (1 + cos beta) / 2 with cos beta = 1/sqrt 3. Float sums of exact
+   * weights: 1e-4. */
+  for (i = 0; i < 12 * W * H; ++i) sh[i] = -7.0f;
+  for (i = 0; i < 9 * W * H; ++i) hl2[i] = -7.0f;
+  CHECK(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, valid, W * H, sh, 12 * W * H, hl2, 9 * W * H, NULL) ==
+        HEMILIGHT_OK);
+  ok = 1;
+  for (i = 0; i < 3 * W * H; ++i) {
+    if (fabs(sh[i] - 1.7724539) > 1e-4 || fabs(sh[3 * W * H + i] - 1.5349901) > 1e-4) ok = 0;
+    if (fabs(sh[6 * W * H + i]) > 1e-4 || fabs(sh[9 * W * H + i]) > 1e-4) ok = 0;
+    if (fabs(hl2[i] - 2.4776960) > 1e-4 || fabs(hl2[3 * W * H + i] - 2.4776960) > 1e-4 || fabs(hl2[6 * W * H + i] - 2.4776960) > 1e-4)
+      ok = 0;
+  }
+  CHECK(ok);
+  /* One kind only: the other buffer is not touched. */
+  for (i = 0; i < 9 * W * H; ++i) hl2[i] = -7.0f;
+  CHECK(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, NULL, 0, sh, 12 * W * H, NULL, 0, NULL) == HEMILIGHT_OK);
+  CHECK(hl2[0] == -7.0f && hl2[9 * W * H - 1] == -7.0f);
+
+  /* Environment sky: a 2 x 2 cube map of radiance 2 except the -Y face (100, below every quad's
+   * horizon). Seamless bilinear lookups above the horizon only mix texels of value 2 (the horizon
+   * runs between the side faces' two texel rows), so E = 2 pi exactly, not pi (the constant sky). */
+  for (i = 0; i < 6 * 2 * 2 * 3; ++i) env[i] = i / 12 == 3 ? 100.0f : 2.0f;
+  o.environment_rgb = env;
+  o.environment_size = 2;
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL) == HEMILIGHT_OK);
+  ok = 1;
+  for (i = 0; i < 3 * W * H; ++i)
+    if (fabs(out[i] - 2 * 3.14159265) > 2e-4) ok = 0;
+  CHECK(ok);
+  fill_sentinel();
+  o.environment_size = 0;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "environment_size 0");
+  o.environment_size = 2;
+  env[5] = -1.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "environment_rgb[5]");
+  env[5] = 2.0f;
+  o.environment_rgb = NULL;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "environment_rgb is NULL");
+  o.environment_size = 0;
+  CHECK_FAILS(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, valid, W * H, sh, 12 * W * H - 1, NULL, 0, NULL),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "sh_l1_capacity");
+  CHECK_FAILS(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL, 0, hl2, 9 * W * H - 1, NULL),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hl2_capacity");
+  CHECK(untouched());
 
   /* Bad input: a clear message, nothing written. */
   fill_sentinel();

@@ -33,6 +33,18 @@
 //      empty texel with a filled 8-neighbour gets the mean of its filled 8-neighbours), so
 //      bilinear lookups at chart borders do not pull in black.
 //
+//   6. Directional lightmaps (optional, bake_options::output_sh_l1 / output_hl2). In the last pass
+//      (and, with indirect_only, the first) the hemicube sampler also computes the world-space L1
+//      SH of the incoming radiance and/or the irradiance on the cone of HL2 directions (54.74
+//      degrees from the normal) as a Fourier series in azimuth (cache.hpp, hl2_cone); cache
+//      records carry both and each texel gets their Ward-weighted average (cones rotated to a
+//      common reference tangent first). SH maps are those coefficients. HL2 maps are the cone
+//      series read at the azimuths of the three basis vectors of the texel's lightmap tangent
+//      frame (lightmap_tangent_frame, hl2_from_cone): frame-correct for any tangent, exact for
+//      light within 35.26 degrees of the normal, otherwise cut at azimuthal order 3 (measured 1.7%
+//      RMS for a grazing side light, where going through L1 SH would give 25%; docs/bake.md).
+//      All of them are dilated like the irradiance.
+//
 // UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
 // its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
 // Row 0 (v near 0) is the first row in memory and the first (top) scanline of the EXR files.
@@ -45,9 +57,11 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/scene.hpp"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -81,6 +95,20 @@ struct bake_options {
   /// error is measured against.
   bool use_cache = true;
   int thread_count = 0;  ///< 0 = all cores
+  /// Output the L1 SH lightmaps (bake_result::sh_l1): world-space coefficients of the incoming
+  /// radiance. Costs 3 multiply-adds per hemicube texel in the last pass (and the first with
+  /// indirect_only): a few percent of the bake; off by default.
+  bool output_sh_l1 = false;
+  /// Output the Half-Life 2 basis lightmaps (bake_result::hl2), in each texel's lightmap tangent
+  /// frame, from the interpolated HL2 cone series (top of this header). Costs 21 multiply-adds per
+  /// hemicube texel in the directional passes, 96 bytes per record, and once per process a weight
+  /// table (~0.25 s at N = 64); off by default.
+  bool output_hl2 = false;
+  /// Optional environment sky: hemicube texels that hit nothing see this cube map's radiance along
+  /// their world direction (raster_options::sky; seamless bilinear, directions = the scene's world
+  /// axes, OpenGL face table) instead of scene_desc::sky_radiance. Build it with
+  /// cubemap::from_image (which checks every value). null: the constant sky.
+  std::shared_ptr<const cubemap> environment;
   /// Called from the calling thread with the fraction of the whole bake done, in [0, 1] and never
   /// decreasing; return
   /// false to cancel (error(status::cancelled) is thrown, nothing is returned). May be empty.
@@ -110,6 +138,18 @@ struct bake_result {
   /// pass (not inside geometry), else 0. Dilated texels are 0.
   std::vector<std::uint8_t> valid;
   std::vector<std::uint8_t> sampled;  ///< per texel: 1 if a sample was placed (coverage >= min_coverage)
+  /// With output_sh_l1 (else four empty images): the L1 SH of the incoming radiance per texel,
+  /// one W x H RGB image per coefficient, world space, in integrate.hpp's order and
+  /// normalisation: sh_l1[0] = Y00 (0.282095), sh_l1[1] = Y1-1 (0.488603 y), sh_l1[2] = Y10
+  /// (0.488603 z), sh_l1[3] = Y11 (0.488603 x); coefficient = integral over the texel's upper
+  /// hemisphere of L Y d omega. A uniform sky L over a plane of normal n gives (sqrt(pi) L,
+  /// (sqrt(3 pi)/2) L (n_y, n_z, n_x)). With indirect_only: last pass minus first pass. Dilated.
+  std::array<image, 4> sh_l1;
+  /// With output_hl2 (else three empty images): irradiance through the Half-Life 2 basis vectors
+  /// hl2_basis[k] of each texel's lightmap tangent frame (lightmap_tangent_frame), >= 0, from the
+  /// interpolated HL2 cone series (top of this header). A uniform sky L gives pi L (1 + 1/sqrt 3) / 2
+  /// in all three. With indirect_only: last pass minus first pass. Dilated.
+  std::array<image, 3> hl2;
   bake_stats stats;
 };
 
@@ -146,6 +186,10 @@ struct lightmap_samples {
   std::vector<glm::vec3> position;          ///< sample point in 3D, on sample_triangle
   std::vector<glm::vec3> normal;            ///< unit normal at the sample
   std::vector<float> texel_world_size;      ///< sqrt(3D area / UV area in texels) of sample_triangle
+  /// Lightmap tangent frame at the sample (lightmap_tangent_frame of sample_triangle with the
+  /// sample's normal): unit tangent along +u and bitangent along +v, both orthogonal to `normal`.
+  /// (tangent, bitangent, normal) is left-handed on mirrored charts.
+  std::vector<glm::vec3> tangent, bitangent;
   std::size_t overlapping_texels = 0;       ///< texels whose covered areas sum to more than 1.001
 
   static constexpr std::uint32_t no_triangle = 0xffffffffu;
@@ -180,6 +224,49 @@ std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings);
 /// built-in scenes (boxes, rooms), not as a general unwrapper. Throws error(invalid_argument)
 /// for size < 8, padding < 0 or 4 padding >= size. Cost: O(T log T) plus a few packings.
 void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding = 2);
+
+// ---- directional lightmaps ------------------------------------------------------------------
+
+/// The Half-Life 2 basis in a tangent frame (t, b, n): local coordinates of its three unit
+/// vectors, the same as integrate.hpp's irradiance_sample::hl2: (-1/sqrt6, 1/sqrt2, 1/sqrt3),
+/// (-1/sqrt6, -1/sqrt2, 1/sqrt3), (sqrt(2/3), 0, 1/sqrt3). They are mutually orthogonal and each
+/// is 54.7 degrees from n.
+inline constexpr float hl2_basis[3][3] = {
+    {-0.408248290f, 0.707106781f, 0.577350269f},
+    {-0.408248290f, -0.707106781f, 0.577350269f},
+    {0.816496581f, 0.0f, 0.577350269f},
+};
+
+/// Irradiance of a plane of unit normal d from L1 SH coefficients of incoming radiance
+/// (integrate.hpp's order and normalisation, world space): the clamped-cosine convolution of the
+/// L1 radiance, (sqrt(pi)/2) c_00 + sqrt(pi/3) (c_11 d.x + c_1-1 d.y + c_10 d.z), per channel,
+/// clamped at 0. Exact for radiance fields in SH bands 0 and 1 and for a uniform sky over any
+/// hemisphere; otherwise the band-2 part of the true irradiance is missing. Cost: O(1).
+glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept;
+
+/// The three Half-Life 2 values of a texel from L1 SH alone: sh_l1_irradiance along the world
+/// directions of hl2_basis in frame f (f.t, f.b, f.n unit and orthogonal; left-handed frames are
+/// fine: the basis follows the frame). For engines that keep only the SH maps. L1 loses the
+/// band >= 2 part of the clamped cosine: 13% RMS for a small overhead lamp, 25% for a grazing side
+/// light (docs/bake.md); the baker's own HL2 maps use the cone series instead. Cost: O(1).
+std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, const frame& f) noexcept;
+
+/// The lightmap tangent frame of a triangle (positions p, lightmap UVs uv) at a point of unit
+/// shading normal n: t = dP/du projected onto the tangent plane and normalised (Gram-Schmidt);
+/// b = +-(n x t), the sign that makes b . dP/dv >= 0 (so (t, b, n) is left-handed on mirrored
+/// charts, as in tangent-space normal mapping); f.n = n. Engines that shade with the HL2 maps must
+/// build the same frame from the lightmap UVs. Degenerate cases: when dP/du is (nearly) along n
+/// or the UV triangle has no area, t comes from dP/dv (t = b x n) or, failing that,
+/// make_frame(n). Never NaN for a unit n and finite input. Cost: O(1).
+frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], const glm::vec3& n) noexcept;
+
+/// Writes the bake's EXR files (write_exr, image_io.hpp) with names prefix + suffix:
+/// "_irradiance.exr", "_mask.exr" (bake_mask_image), and when present "_sh_l1_0.exr" ..
+/// "_sh_l1_3.exr" (coefficients Y00, Y1-1, Y10, Y11) and "_hl2_0.exr" .. "_hl2_2.exr". Returns
+/// the paths written, in that order. Errors: as write_exr (error(io) naming the file; files
+/// written before the failure stay).
+std::vector<std::string> write_bake_exrs(const bake_result& result, const std::string& prefix,
+                                         exr_pixel_type type = exr_pixel_type::float32);
 
 /// Mask image of a bake: R = coverage, G = valid, B = 1 where a sample was placed (covered
 /// >= min_coverage), for writing with write_exr.

@@ -35,6 +35,41 @@
 
 namespace hemilight {
 
+/// Order of the azimuthal Fourier series of hl2_cone.
+inline constexpr int hl2_cone_order = 3;
+/// Number of its coefficients: a_0, then a_m, b_m for m = 1..hl2_cone_order.
+inline constexpr int hl2_cone_terms = 2 * hl2_cone_order + 1;
+
+/// The irradiance through every direction on the cone of Half-Life 2 basis vectors at a point:
+/// b(phi) = n / sqrt3 + sqrt(2/3) (cos phi r + sin phi (n x r)), 54.74 degrees from the normal n,
+/// phi the azimuth from the unit tangent `reference` r towards n x r. As a Fourier series
+///     E(b(phi)) ~= a_0 + sum_{m=1..3} (a_m cos(m phi) + b_m sin(m phi)),   per channel,
+/// coefficients = {a_0, a_1, b_1, a_2, b_2, a_3, b_3}. The three HL2 values of any tangent frame
+/// are this function at three azimuths 120 degrees apart (hl2_from_cone), so a cone describes the
+/// HL2 lighting of every frame about n. Exact (to quadrature) while the incoming radiance only comes
+/// from within 35.26 degrees of n (then E(b(phi)) is a first-order series); otherwise the
+/// harmonics above 3 of the clamped cosine are cut (docs/bake.md measures it).
+struct hl2_cone {
+  glm::vec3 reference{1.0f, 0.0f, 0.0f};  ///< unit tangent (world space) at phi = 0
+  std::array<glm::vec3, hl2_cone_terms> coefficients{};  ///< [term][channel], see above
+};
+
+/// The same cone with its azimuth measured from `reference` (a unit tangent of `normal`, the cone's
+/// normal) instead: phi' = phi - delta with delta the azimuth of `reference` in the cone's frame;
+/// exact rotation of the series. When `reference` is not in the cone's tangent plane it is projected
+/// onto it (used when records of neighbouring normals are averaged). Cost: one atan2 and 3 sincos.
+hl2_cone rotate_hl2_cone(const hl2_cone& cone, const glm::vec3& normal, const glm::vec3& reference) noexcept;
+
+/// E(b(phi)) of the series at azimuth phi (radians, from cone.reference towards n x reference),
+/// per channel, not clamped. Cost: O(hl2_cone_order).
+glm::vec3 evaluate_hl2_cone(const hl2_cone& cone, float phi) noexcept;
+
+/// The three HL2 values (integrate.hpp's basis, hl2_basis of bake.hpp) of the tangent frame f
+/// (f.n = the cone's normal; f may be left-handed, the basis follows it) from a cone, clamped at 0:
+/// the series at phi_t + s (120, -120, 0) degrees, phi_t = azimuth of f.t, s = +1 for right-handed
+/// frames and -1 for left-handed ones. Cost: 3 evaluations.
+std::array<glm::vec3, 3> hl2_from_cone(const hl2_cone& cone, const frame& f) noexcept;
+
 /// One cache record (all vectors world space).
 struct cache_record {
   glm::vec3 position{0.0f};
@@ -44,6 +79,12 @@ struct cache_record {
   std::array<glm::vec3, 3> translation_gradient{};
   float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
   float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
+  /// L1 spherical harmonics of the incoming radiance, world space, the sample's
+  /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
+  /// channel c: sh_l1[k][c]). Zero unless cache_options::directional.
+  std::array<glm::vec3, 4> sh_l1{};
+  /// Irradiance on the HL2 cone (hl2_cone), the sample's cone. Zero unless directional.
+  hl2_cone cone;
 };
 
 /// Weighting of records.
@@ -75,6 +116,15 @@ struct cache_options {
   bool refine_disagreement = true;
   cache_weight weight = cache_weight::ward;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
+  /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
+  /// sh_l1; the sampler must compute it: make_hemicube_sampler with sh_l1 or
+  /// integrate.directional) and its HL2 cone (cache_sample::cone, hemicube_sampler_options::hl2_cone;
+  /// interpolated into cache_result::cone),
+  /// and cache_result::sh_l1 gets, per point, the plain weighted average of the covering records'
+  /// coefficients with the same weights as E (no gradients: SH coefficients are not extrapolated,
+  /// and not rotated towards the point's normal). Off: records carry zeros and the interpolation
+  /// costs nothing extra.
+  bool directional = false;
   int thread_count = 0;                    ///< 0 = all cores
   /// Called from the calling thread between rounds and during rendering with the fraction of
   /// points covered so far, in [0, 1]; return false to cancel (error(status::cancelled) is thrown
@@ -96,7 +146,14 @@ struct cache_stats {
 /// Renders and integrates one hemicube at (position, unit normal). `worker` is in
 /// [0, thread count): use it to pick a per-thread rasterizer/integrator. Must be deterministic
 /// in its arguments (apart from worker) and thread-safe across different workers.
-using irradiance_sampler = std::function<irradiance_sample(int worker, const glm::vec3& position, const glm::vec3& normal)>;
+/// What a sampler returns: integrate()'s sample plus, optionally, the irradiance on the HL2 cone
+/// (zero when not computed). Implicitly made from an irradiance_sample, so a sampler may return one.
+struct cache_sample : irradiance_sample {
+  hl2_cone cone;
+  cache_sample() = default;
+  cache_sample(const irradiance_sample& s) : irradiance_sample(s) {}  // NOLINT: implicit on purpose
+};
+using irradiance_sampler = std::function<cache_sample(int worker, const glm::vec3& position, const glm::vec3& normal)>;
 
 /// How make_hemicube_sampler renders and integrates.
 struct hemicube_sampler_options {
@@ -107,12 +164,28 @@ struct hemicube_sampler_options {
   /// deterministic, and it turns the texel grid's aliasing into fine noise instead of bands.
   bool roll = true;
   const radiance_texture* texture = nullptr;  ///< optional radiance texture (bounce passes); must outlive the sampler
+  /// Fill irradiance_sample::sh_l1 (world-space L1 SH, integrate.hpp) cheaply, without
+  /// integrate.directional: band 1 = Y1 Phi with the vector irradiance Phi = E n + g_r x n that
+  /// the rotation gradient already holds (g_r = n x Phi, integrate.hpp), band 0 = Y00 sum_i L_i
+  /// Omega_i over the buffer (exact texel solid angles, summed in double). The same values as the
+  /// integrator's directional SH to float rounding, for one extra pass of 3 multiply-adds per
+  /// texel instead of 15 double ones; irradiance_sample::hl2 stays zero. Needs
+  /// integrate.rotation_gradient (make_hemicube_sampler throws error(invalid_argument) otherwise).
+  bool sh_l1 = false;
+  /// Fill cache_sample::cone: the irradiance on the HL2 cone of directions as a Fourier series in
+  /// azimuth (hl2_cone), reference = the hemicube's (rolled) tangent. Per texel weights from the
+  /// closed-form Fourier series of the clamped cosine max(0, w . b(phi)), integrated over 8 x 8
+  /// sub-rectangles of each texel with exact solid angles, or exactly (the texel's vector solid
+  /// angle) where the whole texel is within 35.26 degrees of the normal. Cost: one table per
+  /// resolution (28 bytes per texel; built once per process up to N = 512: ~0.1 s at N = 64) and
+  /// 21 multiply-adds per texel.
+  bool hl2_cone = false;
 };
 
 /// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
 /// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache). Throws
 /// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
-/// options. The sampler throws error(invalid_argument) for a worker index out of range.
+/// options, or sh_l1 without integrate.rotation_gradient. The sampler throws error(invalid_argument) for a worker index out of range.
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
                                          int workers);
 
@@ -120,6 +193,13 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, con
 struct cache_result {
   std::vector<glm::vec3> irradiance;  ///< per point, RGB, >= 0
   std::vector<std::uint8_t> valid;    ///< per point: 1 = interpolated from covering records, 0 = filled (inside geometry or uncovered)
+  /// Per point with options.directional (else empty): the Ward-weighted average of the covering
+  /// records' world-space L1 SH (filled points: of the same nearest records as their E). Not
+  /// clamped: band-1 coefficients are signed.
+  std::vector<std::array<glm::vec3, 4>> sh_l1;
+  /// Per point with options.directional (else empty): the records' cones rotated to the
+  /// reference make_frame(normal).t of the point (rotate_hl2_cone) and averaged with the weights of E.
+  std::vector<hl2_cone> cone;
   std::vector<cache_record> records;
   cache_stats stats;
 };
@@ -139,6 +219,12 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 /// *weight_sum if given (0 when no record covers the point: the result is then 0).
 glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& position,
                               const glm::vec3& normal, const cache_options& options, float* weight_sum = nullptr);
+
+/// Interpolates the records' L1 SH at one point with the weights of interpolate_records (plain
+/// weighted average, no gradients, not clamped); zero when no record covers the point. Brute
+/// force over all records: for tests and tools.
+std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_record>& records, const glm::vec3& position,
+                                                   const glm::vec3& normal, const cache_options& options);
 
 /// The weight of one record at (position, normal) under options.weight and error_threshold,
 /// before the behind test: Ward's w when w > 1/a, the Tabellion-Lamorlette w when w > 0, else 0.
