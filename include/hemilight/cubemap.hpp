@@ -184,6 +184,12 @@ struct filter_options {
   /// Input mip size the irradiance (cosine-lobe) filter reads (clamped to the input's size):
   /// 16 keeps irradiance under 0.4% from brute force on the test sky at ~10 ms for 32^2 out.
   int irradiance_input_size = 16;
+  /// true (default): the lobe weights are computed once per call, in double, for the output
+  /// texels of one eighth of one face, and applied to all 48 symmetric images of them (the cube's
+  /// symmetries map both texel grids onto themselves), so each tap is a multiply-add. false: the
+  /// lobe is evaluated per tap (a 1024-step table for p >= 8), the previous method, kept for
+  /// comparison. Both read the same input mip and cut the lobe at the same extent.
+  bool precomputed_weights = true;
 };
 
 /// Filters `input` with the normalised cosine-power lobe: each output texel with direction d
