@@ -440,9 +440,15 @@ struct stencil_run {
   std::int32_t face, y, x0, count;
 };
 
+// The runs of one canonical face: runs[begin, end).
+struct stencil_face {
+  std::int32_t face, begin, end;
+};
+
 // The normalised weights of one output texel of the fundamental domain.
 struct stencil {
   std::vector<stencil_run> runs;
+  std::vector<stencil_face> faces;
   std::vector<float> weights;  // run after run
   double norm = 1;             // 1 / (sum of the float weights): constant input stays constant
 };
@@ -465,9 +471,37 @@ struct double_table {
 };
 
 // Builds the stencil of unit direction d (face-local frames of the canonical faces) over `level`.
-void build_stencil(const double_table& tab, int n, double power, double cos_max, bool cosine, const glm::dvec3& d,
+// dot^p for dot in (cos_max, 1]: std::pow for p < 8, else a table of (1 - x)^p over
+// x = 1 - dot in [0, 1 - cos_max] with linear interpolation in double. The log of the weight
+// changes by ln(1/cutoff)/steps per step, so the relative interpolation error is below
+// (ln(1/cutoff)/steps)^2/8: 2e-7 for the cutoff 1e-4 (3e-7 for 1e-5), far below float rounding
+// of the sums that use it, and 1/20 of the cost of std::pow.
+struct lobe_power {
+  static constexpr int steps = 8192;
+  double power, inv_step = 0;
+  bool cosine, tabulated;
+  std::vector<double> table;
+  lobe_power(double p, double cos_max) : power(p), cosine(p == 1.0), tabulated(p >= 8.0) {
+    if (!tabulated) return;
+    const double range = 1.0 - cos_max;
+    table.resize(steps + 2);
+    for (int i = 0; i <= steps + 1; ++i) table[std::size_t(i)] = std::pow(std::max(0.0, 1.0 - range * i / steps), p);
+    inv_step = steps / range;
+  }
+  double operator()(double dot) const noexcept {
+    if (cosine) return dot;
+    if (!tabulated) return std::pow(dot, power);
+    const double f = std::min((1.0 - dot) * inv_step, static_cast<double>(steps));
+    const int i = static_cast<int>(f);
+    const double t = f - i;
+    return table[std::size_t(i)] + t * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
+  }
+};
+
+void build_stencil(const double_table& tab, int n, const lobe_power& lobe, double cos_max, const glm::dvec3& d,
                    stencil& s) {
   s.runs.clear();
+  s.faces.clear();
   s.weights.clear();
   const double s2 = std::max(0.0, 1.0 - cos_max * cos_max);
   const double rho = std::sqrt(std::max(0.0, 2.0 - 2.0 * cos_max));
@@ -511,17 +545,26 @@ void build_stencil(const double_table& tab, int n, double power, double cos_max,
         const glm::dvec3& w = tab.dir[row + std::size_t(x)];
         const double dot = dl.x * w.x + dl.y * w.y + dl.z * w.z;
         if (!(dot > cos_max) || !(dot > 0.0)) continue;
-        const double wt = tab.omega[row + std::size_t(x)] * (cosine ? dot : std::pow(dot, power));
+        const double wt = tab.omega[row + std::size_t(x)] * lobe(dot);
         if (!(wt > 0.0)) continue;
         row_w[std::size_t(x - xa)] = wt;
         if (first < 0) first = x;
         last = x;
       }
       if (first < 0) continue;
-      s.runs.push_back({f, y, first, last - first + 1});
-      for (int x = first; x <= last; ++x) {
-        s.weights.push_back(static_cast<float>(row_w[std::size_t(x - xa)]));
-        total += row_w[std::size_t(x - xa)];
+      // Pad the run with zero weights to a multiple of four texels, inside the face's row, so the
+      // SIMD loop has no tail (a zero weight times a finite texel adds nothing).
+      int lo = first, hi = last;
+      const int padded = (last - first + 4) / 4 * 4;
+      if (padded <= n) {
+        hi = std::min(n - 1, first + padded - 1);
+        lo = hi - padded + 1;
+      }
+      s.runs.push_back({f, y, lo, hi - lo + 1});
+      for (int x = lo; x <= hi; ++x) {
+        const double wt = x >= first && x <= last ? row_w[std::size_t(x - xa)] : 0.0;
+        s.weights.push_back(static_cast<float>(wt));
+        total += wt;
       }
     }
   }
@@ -535,9 +578,15 @@ void build_stencil(const double_table& tab, int n, double power, double cos_max,
     const int x = std::clamp(static_cast<int>(cc.s * static_cast<float>(n)), 0, n - 1);
     const int y = std::clamp(static_cast<int>(cc.t * static_cast<float>(n)), 0, n - 1);
     s.runs.push_back({static_cast<std::int32_t>(cc.face), y, x, 1});
+    s.faces.push_back({static_cast<std::int32_t>(cc.face), 0, 1});
     s.weights.push_back(1.0f);
     s.norm = 1.0;
     return;
+  }
+  for (std::size_t i = 0; i < s.runs.size(); ++i) {
+    if (s.faces.empty() || s.faces.back().face != s.runs[i].face)
+      s.faces.push_back({s.runs[i].face, static_cast<std::int32_t>(i), static_cast<std::int32_t>(i)});
+    s.faces.back().end = static_cast<std::int32_t>(i + 1);
   }
   // Normalise in double, then make the float weights' own sum exactly what the output divides by.
   double fsum = 0;
@@ -550,68 +599,72 @@ void build_stencil(const double_table& tab, int n, double power, double cos_max,
 
 // Applies a stencil to the image of its output texel under one symmetry (`maps`: the symmetry's
 // map of each canonical input face) on four-float texels `px4` (RGBA, or RGB and a zero). Float
-// sums within a run (at most one row of a face), double across runs. A run's texels are
-// consecutive in memory or one row apart, depending on the symmetry.
+// sums within a face, double across faces. A run's texels are consecutive in memory or one row
+// apart, depending on the symmetry; runs are padded to multiples of four texels where the face
+// is wide enough.
 void apply_stencil_portable(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
-#if defined(__SSE2__)
-  __m128d lo = _mm_setzero_pd(), hi = _mm_setzero_pd();
-  for (const stencil_run& r : s.runs) {
-    const face_map& m = maps[r.face];
-    const std::ptrdiff_t step = m.dx * 4;
-    const float* p = px4 + (m.origin + std::ptrdiff_t(r.x0) * m.dx + std::ptrdiff_t(r.y) * m.dy) * 4;
-    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps();
-    int k = 0;
-    for (; k + 1 < r.count; k += 2, p += 2 * step) {
-      a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
-      a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(w[k + 1]), _mm_loadu_ps(p + step)));
-    }
-    if (k < r.count) a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
-    a0 = _mm_add_ps(a0, a1);
-    lo = _mm_add_pd(lo, _mm_cvtps_pd(a0));
-    hi = _mm_add_pd(hi, _mm_cvtps_pd(_mm_movehl_ps(a0, a0)));
-    w += r.count;
-  }
-  _mm_storeu_pd(out, lo);
-  _mm_storeu_pd(out + 2, hi);
-#else
   for (int c = 0; c < 4; ++c) out[c] = 0.0;
-  for (const stencil_run& r : s.runs) {
-    const face_map& m = maps[r.face];
-    const std::ptrdiff_t step = m.dx * 4;
-    const float* p = px4 + (m.origin + std::ptrdiff_t(r.x0) * m.dx + std::ptrdiff_t(r.y) * m.dy) * 4;
+  for (const stencil_face& sf : s.faces) {
+    const face_map& m = maps[sf.face];
+    const float* base = px4 + m.origin * 4;
+    const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
+#if defined(__SSE2__)
+    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps();
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      int k = 0;
+      for (; k + 1 < r.count; k += 2, p += 2 * step) {
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(w[k + 1]), _mm_loadu_ps(p + step)));
+      }
+      if (k < r.count) a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
+      w += r.count;
+    }
+    alignas(16) float a[4];
+    _mm_store_ps(a, _mm_add_ps(a0, a1));
+#else
     float a[4] = {0, 0, 0, 0};
-    for (int k = 0; k < r.count; ++k, p += step)
-      for (int c = 0; c < 4; ++c) a[c] += w[k] * p[c];
-    w += r.count;
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      for (int k = 0; k < r.count; ++k, p += step)
+        for (int c = 0; c < 4; ++c) a[c] += w[k] * p[c];
+      w += r.count;
+    }
+#endif
     for (int c = 0; c < 4; ++c) out[c] += static_cast<double>(a[c]);
   }
-#endif
 }
 
 #if HEMILIGHT_CUBEMAP_AVX2
 // The same with AVX2 + FMA (picked at run time when the CPU has them): one broadcast and one
 // fused multiply-add per tap, four partial sums. Sums differ from the portable path only in
-// float rounding (fused multiply-adds, another order inside a run).
+// float rounding (fused multiply-adds, another order of the additions).
 __attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* px4,
                                                              double out[4]) noexcept {
   const float* w = s.weights.data();
   __m256d acc = _mm256_setzero_pd();
-  for (const stencil_run& r : s.runs) {
-    const face_map& m = maps[r.face];
-    const std::ptrdiff_t step = m.dx * 4;
-    const float* p = px4 + (m.origin + std::ptrdiff_t(r.x0) * m.dx + std::ptrdiff_t(r.y) * m.dy) * 4;
+  for (const stencil_face& sf : s.faces) {
+    const face_map& m = maps[sf.face];
+    const float* base = px4 + m.origin * 4;
+    const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
     __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps(), a3 = _mm_setzero_ps();
-    int k = 0;
-    for (; k + 3 < r.count; k += 4, p += 4 * step) {
-      a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
-      a1 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 1), _mm_loadu_ps(p + step), a1);
-      a2 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 2), _mm_loadu_ps(p + 2 * step), a2);
-      a3 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 3), _mm_loadu_ps(p + 3 * step), a3);
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      int k = 0;
+      for (; k + 3 < r.count; k += 4, p += 4 * step) {
+        a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
+        a1 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 1), _mm_loadu_ps(p + step), a1);
+        a2 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 2), _mm_loadu_ps(p + 2 * step), a2);
+        a3 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 3), _mm_loadu_ps(p + 3 * step), a3);
+      }
+      for (; k < r.count; ++k, p += step) a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
+      w += r.count;
     }
-    for (; k < r.count; ++k, p += step) a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
     acc = _mm256_add_pd(acc, _mm256_cvtps_pd(_mm_add_ps(_mm_add_ps(a0, a1), _mm_add_ps(a2, a3))));
-    w += r.count;
   }
   _mm256_storeu_pd(out, acc);
 }
@@ -663,7 +716,7 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
   const double cutoff = irradiance ? 1e-30 : static_cast<double>(o.cutoff);
   // the same extent as the direct path's lobe (float cos_max), so both cut the same texels
   const double cos_max = static_cast<double>(static_cast<float>(std::pow(cutoff, 1.0 / static_cast<double>(power))));
-  const bool cosine = power == 1.0f;
+  const lobe_power lobe(static_cast<double>(power), cos_max);
   const double_table tab(*level.centres);
   cube_image out = cube_image::make(out_size, ch);
   // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth).
@@ -713,7 +766,7 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
         const auto [x, y] = domain[begin + i];
         const glm::dvec3 d = glm::normalize(face_point_d(4, cubemap_texel_coordinate(out_size, x, o.fixup),
                                                          cubemap_texel_coordinate(out_size, y, o.fixup)));
-        build_stencil(tab, n, static_cast<double>(power), cos_max, cosine, d, stencils[i]);
+        build_stencil(tab, n, lobe, cos_max, d, stencils[i]);
       }
     });
     tasks.clear();
