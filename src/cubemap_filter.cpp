@@ -771,14 +771,19 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
     });
     tasks.clear();
     task_g.clear();
-    for (std::size_t g = 0; g < 48; ++g)
-      for (std::size_t i = begin; i < end; ++i) {
-        const face_map& m = out_maps[g];
-        const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
-        if (owner[t] != static_cast<std::int32_t>(g * domain.size() + i)) continue;
-        tasks.emplace_back(static_cast<std::uint32_t>(i - begin), static_cast<std::uint32_t>(t));
-        task_g.push_back(static_cast<std::uint8_t>(g));
-      }
+    // Order: blocks of neighbouring stencils (~128 KB of weights, so they stay in cache), then
+    // symmetry, then stencil: a block's weights are read 48 times from cache, and within one
+    // symmetry neighbouring output texels read neighbouring input texels.
+    const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1, chunk);
+    for (std::size_t b0 = begin; b0 < end; b0 += block)
+      for (std::size_t g = 0; g < 48; ++g)
+        for (std::size_t i = b0; i < std::min(end, b0 + block); ++i) {
+          const face_map& m = out_maps[g];
+          const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
+          if (owner[t] != static_cast<std::int32_t>(g * domain.size() + i)) continue;
+          tasks.emplace_back(static_cast<std::uint32_t>(i - begin), static_cast<std::uint32_t>(t));
+          task_g.push_back(static_cast<std::uint8_t>(g));
+        }
     parallel_for(tasks.size(), o.thread_count, 32, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         const stencil& s = stencils[tasks[k].first];
@@ -919,6 +924,26 @@ cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_opt
     const int size = std::max(1, output_size >> l);
     out.levels.push_back(filter_chain(chain, gloss_power(output_size, l, lobe_texels), false, size, options));
   }
+  return out;
+}
+
+cubemap filter_mip_chain_powers(const cubemap& input, int output_size, const std::vector<float>& powers,
+                                const filter_options& options) {
+  const char* fn = "filter_mip_chain_powers";
+  if (input.levels.empty()) throw_invalid_argument(std::string(fn) + ": the input cube map has no levels");
+  validate_level(fn, input.levels[0]);
+  check_output_size(fn, output_size);
+  check_options(fn, options);
+  int full = 1;
+  while ((output_size >> full) >= 1 && full < 31) ++full;
+  if (powers.empty() || powers.size() > std::size_t(full))
+    throw_invalid_argument(std::string(fn) + ": " + std::to_string(powers.size()) + " powers for a chain of " +
+                           std::to_string(full) + " levels; give 1 to " + std::to_string(full));
+  for (float p : powers) check_power(fn, p);
+  const input_chain chain(input.levels[0]);
+  cubemap out;
+  for (std::size_t l = 0; l < powers.size(); ++l)
+    out.levels.push_back(filter_chain(chain, powers[l], false, std::max(1, output_size >> l), options));
   return out;
 }
 

@@ -617,6 +617,14 @@ TEST_CASE("mip chain: sizes and the gloss mapping", "[cubemap]") {
   const cube_image direct = filter_cosine_power(in, gloss_power(8, 1), 4);
   CHECK(direct.pixels == chain.levels[1].pixels);
   CHECK(filter_mip_chain(in, 8, {}, 1.0f, 2).level_count() == 2);
+  // a power per level: the same as filter_cosine_power level by level (same input mips, same path)
+  const cubemap custom = filter_mip_chain_powers(in, 8, {300.0f, 40.0f, 2.0f});
+  REQUIRE(custom.level_count() == 3);
+  CHECK(custom.levels[2].size == 2);
+  CHECK(custom.levels[1].pixels == filter_cosine_power(in, 40.0f, 4).pixels);
+  require_error([&] { (void)filter_mip_chain_powers(in, 8, {}); }, status::invalid_argument, "0 powers");
+  require_error([&] { (void)filter_mip_chain_powers(in, 8, {1, 1, 1, 1, 1}); }, status::invalid_argument, "5 powers");
+  require_error([&] { (void)filter_mip_chain_powers(in, 8, {1.0f, -2.0f}); }, status::invalid_argument, "power");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -236,6 +236,15 @@ float gloss_power(int top_size, int level, float texels = 1.0f) noexcept;
 cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_options& options = {},
                          float lobe_texels = 1.0f, int levels = 0);
 
+/// A radiance mip chain with a specular power per level: level i (size max(1, output_size >> i))
+/// is filter_cosine_power of `input` with powers[i], for every entry of `powers` (at most the
+/// number of levels down to 1 x 1). The same as calling filter_cosine_power per level, but the
+/// input's mips are built once. Use it for another gloss mapping, e.g. cmft's
+/// p_i = 2^(10 (1 - i / 8) + 1). Errors as filter_cosine_power; an empty `powers`, too many
+/// entries or an invalid power throws error(invalid_argument).
+cubemap filter_mip_chain_powers(const cubemap& input, int output_size, const std::vector<float>& powers,
+                                const filter_options& options = {});
+
 // ---------------------------------------------------------------------------------------------
 // Spherical harmonics (bands 0-2)
 // ---------------------------------------------------------------------------------------------
