@@ -18,11 +18,17 @@
 #include <emmintrin.h>
 #include <xmmintrin.h>
 #endif
+// The AVX2 + FMA stencil kernel (run-time dispatch); define HEMILIGHT_CUBEMAP_AVX2=0 to build
+// only the portable one (how the SSE2 path is tested on AVX2 machines).
+#if !defined(HEMILIGHT_CUBEMAP_AVX2)
 #if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
 #define HEMILIGHT_CUBEMAP_AVX2 1
-#include <immintrin.h>
 #else
 #define HEMILIGHT_CUBEMAP_AVX2 0
+#endif
+#endif
+#if HEMILIGHT_CUBEMAP_AVX2
+#include <immintrin.h>
 #endif
 
 namespace hemilight {
