@@ -190,6 +190,14 @@ struct filter_options {
   /// lobe is evaluated per tap (a 1024-step table for p >= 8), the previous method, kept for
   /// comparison. Both read the same input mip and cut the lobe at the same extent.
   bool precomputed_weights = true;
+  /// Mip chains only (filter_mip_chain, filter_mip_chain_powers), texel-centre outputs only
+  /// (fixup none; ignored otherwise): a level whose lobe is wider than the previous level's is
+  /// filtered from that previous output level with the differential lobe 1/q = 1/p_k - 1/p_(k-1)
+  /// (cos^p composes like a Gaussian for large p), so it reads a narrower lobe; only for levels
+  /// with p >= 256 (below, the composition is measurably not a cos^p lobe) whose previous level
+  /// has at least 2 texels_per_sigma sqrt(q) texels (it must resolve the lobe). Off by default;
+  /// docs/cubemap.md has the measured speed and error against brute force.
+  bool cascade = false;
 };
 
 /// Filters `input` with the normalised cosine-power lobe: each output texel with direction d
