@@ -213,8 +213,10 @@ struct filter_options {
 /// 6 out^2 * 6 (4.3 r)^2 taps for narrow lobes, r the lobe's width in texels of the input mip
 /// read (texels_per_sigma to twice that, or less when the input's top level is coarser), the
 /// whole input mip for wide lobes; with precomputed_weights a tap is a multiply-add (~1 ns on
-/// one core) and 1/48 of them also cost a weight evaluation; memory for the weights is bounded
-/// (~16 MB). Per-tap weights: ~5-7 ns per tap. 256^2 chain (gloss mapping): ~0.2 s on two cores.
+/// one core) and 1/48 of them also cost a weight evaluation. Extra memory with precomputed
+/// weights: the weights and runs of at most ~2M taps at a time (~16 MB), 4 bytes per output
+/// texel, and for RGB input a four-float copy of the input mip read (16 bytes per texel).
+/// Per-tap weights: ~5-7 ns per tap. 256^2 chain (gloss mapping): ~0.2 s on two cores.
 cube_image filter_cosine_power(const cubemap& input, float power, int output_size, const filter_options& options = {});
 
 /// Irradiance E(n) = integral of L(w) max(0, n.w) dw (W/m^2 for L in W/m^2/sr; a uniform sky L
