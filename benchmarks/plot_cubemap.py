@@ -21,6 +21,7 @@ if os.path.exists(f"{out}/cubemap.csv"):
     rows = [  # (label, benchmark name with {t} = threads, cmft's time in ms or None)
         ("radiance chain 256\n(gloss mapping)", "radiance_chain/{t}/iterations:3/real_time", 3400.0),
         ("radiance chain 256\ntexels_per_sigma 1.5", "radiance_chain_fast/{t}/iterations:3/real_time", 3400.0),
+        ("radiance chain 256\nper-tap weights\n(previous method)", "radiance_chain_per_tap/{t}/iterations:3/real_time", 3400.0),
         ("radiance chain 256\n(cmft lobes)", "radiance_chain_cmft_lobes/{t}/iterations:2/real_time", 3400.0),
         ("irradiance SH\n256 in, 256 out", "irradiance_sh/{t}/256/real_time", 180.0),
         ("irradiance SH\n256 in, 32 out", "irradiance_sh/{t}/32/real_time", 180.0),

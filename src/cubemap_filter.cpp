@@ -6,8 +6,10 @@
 #include "cubemap_internal.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <mutex>
 #include <string>
@@ -15,6 +17,18 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #include <xmmintrin.h>
+#endif
+// The AVX2 + FMA stencil kernel (run-time dispatch); define HEMILIGHT_CUBEMAP_AVX2=0 to build
+// only the portable one (how the SSE2 path is tested on AVX2 machines).
+#if !defined(HEMILIGHT_CUBEMAP_AVX2)
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+#define HEMILIGHT_CUBEMAP_AVX2 1
+#else
+#define HEMILIGHT_CUBEMAP_AVX2 0
+#endif
+#endif
+#if HEMILIGHT_CUBEMAP_AVX2
+#include <immintrin.h>
 #endif
 
 namespace hemilight {
@@ -365,8 +379,436 @@ const chain_level& pick_level(const input_chain& chain, float power, bool irradi
   return *best;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Precomputed weight stencils (the default path of filter_chain).
+//
+// The weight of input texel w for output texel d, solid_angle(w) max(0, d.w)^p, depends only on
+// the two texels' places on their grids. The cube has 48 symmetries (signed permutations of the
+// axes: 6 faces x 8 in-face symmetries) that map the input grid onto itself and, for every
+// mapping (texel centres, stretch, warp: all mirror-symmetric and the same along u and v), the
+// output grid onto itself. So the weights are computed once, in double with std::pow, for the
+// output texels of one eighth of one face (the fundamental domain) and applied to all 48 images
+// of it: out(M d) = sum_w W(d, w) L(M w). What is left per tap is a load and a multiply-add.
+
+// (M w)_i = sign_i w_perm(i): one of the 48 symmetries of the cube.
+struct axis_symmetry {
+  int perm[3];
+  float sign[3];
+  glm::vec3 apply(const glm::vec3& w) const noexcept {
+    return {sign[0] * w[perm[0]], sign[1] * w[perm[1]], sign[2] * w[perm[2]]};
+  }
+};
+
+const std::array<axis_symmetry, 48>& cube_symmetries() {
+  static const std::array<axis_symmetry, 48> all = [] {
+    std::array<axis_symmetry, 48> s{};
+    static constexpr int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int k = 0;
+    for (const auto& p : perms)
+      for (int signs = 0; signs < 8; ++signs) {
+        axis_symmetry& m = s[std::size_t(k++)];
+        for (int i = 0; i < 3; ++i) {
+          m.perm[i] = p[i];
+          m.sign[i] = (signs >> i) & 1 ? -1.0f : 1.0f;
+        }
+      }
+    return s;
+  }();
+  return all;
+}
+
+// Where texel (x, y) of face f of an n x n cube grid goes under a symmetry: texel index (face-major,
+// rows, columns) origin + x dx + y dy.
+struct face_map {
+  std::ptrdiff_t origin = 0, dx = 0, dy = 0;
+};
+
+face_map map_face(const axis_symmetry& m, int f, int n) {
+  const face_frame& fr = frame_of(f);
+  const glm::vec3 a = m.apply(fr.axis), c = m.apply(fr.column), r = m.apply(fr.row);
+  int f2 = 0;
+  while (f2 < 5 && frame_of(f2).axis != a) ++f2;  // exact: the frames' components are 0 and +-1
+  const face_frame& g = frame_of(f2);
+  // u' = cu u + ru v, v' = cv u + rv v; each coefficient is 0 or +-1, and u -> -u is x -> n - 1 - x
+  // for every mapping (cubemap_texel_coordinate mirrors the upper half).
+  const int cu = static_cast<int>(glm::dot(c, g.column)), ru = static_cast<int>(glm::dot(r, g.column));
+  const int cv = static_cast<int>(glm::dot(c, g.row)), rv = static_cast<int>(glm::dot(r, g.row));
+  const std::ptrdiff_t nn = n, ox = (cu < 0 || ru < 0) ? nn - 1 : 0, oy = (cv < 0 || rv < 0) ? nn - 1 : 0;
+  face_map fm;
+  fm.origin = std::ptrdiff_t(f2) * nn * nn + oy * nn + ox;
+  fm.dx = cv * nn + cu;
+  fm.dy = rv * nn + ru;
+  return fm;
+}
+
+// One run of consecutive texels along a row of a canonical input face, and its weights.
+struct stencil_run {
+  std::int32_t face, y, x0, count;
+};
+
+// The runs of one canonical face: runs[begin, end).
+struct stencil_face {
+  std::int32_t face, begin, end;
+};
+
+// The normalised weights of one output texel of the fundamental domain.
+struct stencil {
+  std::vector<stencil_run> runs;
+  std::vector<stencil_face> faces;
+  std::vector<float> weights;  // run after run
+  double norm = 1;             // 1 / (sum of the float weights): constant input stays constant
+};
+
+// Input texel directions (face-local) and exact solid angles in double, per size.
+struct double_table {
+  std::vector<glm::dvec3> dir;
+  std::vector<double> omega;
+  explicit double_table(const face_table& t) : dir(t.texels.size()), omega(t.texels.size()) {
+    const int n = t.n;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const std::size_t i = std::size_t(y) * std::size_t(n) + std::size_t(x);
+        const double u = cubemap_texel_coordinate(n, x, edge_fixup::none);
+        const double v = cubemap_texel_coordinate(n, y, edge_fixup::none);
+        dir[i] = glm::normalize(glm::dvec3(u, v, 1.0));
+        omega[i] = static_cast<double>(t.texels[i].w);
+      }
+  }
+};
+
+// Builds the stencil of unit direction d (face-local frames of the canonical faces) over `level`.
+// dot^p for dot in (cos_max, 1]: std::pow for p < 8, else a table of (1 - x)^p over
+// x = 1 - dot in [0, 1 - cos_max] with linear interpolation in double. The log of the weight
+// changes by ln(1/cutoff)/steps per step, so the relative interpolation error is below
+// (ln(1/cutoff)/steps)^2/8: 2e-7 for the cutoff 1e-4 (3e-7 for 1e-5), far below float rounding
+// of the sums that use it, and 1/20 of the cost of std::pow.
+struct lobe_power {
+  static constexpr int steps = 8192;
+  double power, inv_step = 0;
+  bool cosine, tabulated;
+  std::vector<double> table;
+  lobe_power(double p, double cos_max) : power(p), cosine(p == 1.0), tabulated(p >= 8.0) {
+    if (!tabulated) return;
+    const double range = 1.0 - cos_max;
+    table.resize(steps + 2);
+    for (int i = 0; i <= steps + 1; ++i) table[std::size_t(i)] = std::pow(std::max(0.0, 1.0 - range * i / steps), p);
+    inv_step = steps / range;
+  }
+  double operator()(double dot) const noexcept {
+    if (cosine) return dot;
+    if (!tabulated) return std::pow(dot, power);
+    const double f = std::min((1.0 - dot) * inv_step, static_cast<double>(steps));
+    const int i = static_cast<int>(f);
+    const double t = f - i;
+    return table[std::size_t(i)] + t * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
+  }
+};
+
+void build_stencil(const double_table& tab, int n, const lobe_power& lobe, double cos_max, const glm::dvec3& d,
+                   stencil& s) {
+  s.runs.clear();
+  s.faces.clear();
+  s.weights.clear();
+  const double s2 = std::max(0.0, 1.0 - cos_max * cos_max);
+  const double rho = std::sqrt(std::max(0.0, 2.0 - 2.0 * cos_max));
+  const double k = cos_max * cos_max;
+  const double h = 0.5 * n;
+  double total = 0;
+  std::vector<double> row_w;
+  for (int f = 0; f < 6; ++f) {
+    const face_frame& fr = frame_of(f);
+    const glm::dvec3 dl(glm::dot(d, glm::dvec3(fr.column)), glm::dot(d, glm::dvec3(fr.row)),
+                        glm::dot(d, glm::dvec3(fr.axis)));
+    double u0, u1, v0, v1;
+    if (!cap_range(dl.x, dl.z, s2, rho, u0, u1) || !cap_range(dl.y, dl.z, s2, rho, v0, v1)) continue;
+    const int x0 = std::clamp(static_cast<int>(std::floor((u0 + 1.0) * h)) - 1, 0, n - 1);
+    const int x1 = std::clamp(static_cast<int>(std::floor((u1 + 1.0) * h)) + 1, 0, n - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor((v0 + 1.0) * h)) - 1, 0, n - 1);
+    const int y1 = std::clamp(static_cast<int>(std::floor((v1 + 1.0) * h)) + 1, 0, n - 1);
+    const bool ellipse = dl.z > 0.0 && dl.z * dl.z > s2;
+    const double qa = dl.x * dl.x - k;
+    for (int y = y0; y <= y1; ++y) {
+      int xa = x0, xb = x1;
+      if (ellipse && qa < 0.0) {
+        // the row's span of the cap (as filter_direction), widened by one texel each side: the
+        // weights below decide exactly which texels count
+        const double v = (2.0 * y + 1.0) / n - 1.0;
+        const double e = dl.z + v * dl.y;
+        const double qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
+        const double disc = qb * qb - 4.0 * qa * qc;
+        if (disc < 0.0) continue;
+        const double root = std::sqrt(disc);
+        const double r_lo = std::clamp((-qb + root) * (0.5 / qa), -2.0, 2.0);
+        const double r_hi = std::clamp((-qb - root) * (0.5 / qa), -2.0, 2.0);
+        xa = std::max(x0, fast_floor((r_lo + 1.0) * h - 0.5));
+        xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5) + 1);
+        if (xb < xa) continue;
+      }
+      row_w.assign(std::size_t(xb - xa + 1), 0.0);
+      int first = -1, last = -1;
+      const std::size_t row = std::size_t(y) * std::size_t(n);
+      for (int x = xa; x <= xb; ++x) {
+        const glm::dvec3& w = tab.dir[row + std::size_t(x)];
+        const double dot = dl.x * w.x + dl.y * w.y + dl.z * w.z;
+        if (!(dot > cos_max) || !(dot > 0.0)) continue;
+        const double wt = tab.omega[row + std::size_t(x)] * lobe(dot);
+        if (!(wt > 0.0)) continue;
+        row_w[std::size_t(x - xa)] = wt;
+        if (first < 0) first = x;
+        last = x;
+      }
+      if (first < 0) continue;
+      // Pad the run with zero weights to a multiple of four texels, inside the face's row, so the
+      // SIMD loop has no tail (a zero weight times a finite texel adds nothing).
+      int lo = first, hi = last;
+      const int padded = (last - first + 4) / 4 * 4;
+      if (padded <= n) {
+        hi = std::min(n - 1, first + padded - 1);
+        lo = hi - padded + 1;
+      }
+      s.runs.push_back({f, y, lo, hi - lo + 1});
+      for (int x = lo; x <= hi; ++x) {
+        const double wt = x >= first && x <= last ? row_w[std::size_t(x - xa)] : 0.0;
+        s.weights.push_back(static_cast<float>(wt));
+        total += wt;
+      }
+    }
+  }
+  if (!(total > 0.0)) {
+    // The lobe is narrower than the input's texels and no texel centre falls inside it: the
+    // texel that contains d (as filter_direction).
+    s.runs.clear();
+    s.weights.clear();
+    const glm::vec3 df(d);
+    const cube_coord cc = cube_face_from_direction(df);
+    const int x = std::clamp(static_cast<int>(cc.s * static_cast<float>(n)), 0, n - 1);
+    const int y = std::clamp(static_cast<int>(cc.t * static_cast<float>(n)), 0, n - 1);
+    s.runs.push_back({static_cast<std::int32_t>(cc.face), y, x, 1});
+    s.faces.push_back({static_cast<std::int32_t>(cc.face), 0, 1});
+    s.weights.push_back(1.0f);
+    s.norm = 1.0;
+    return;
+  }
+  for (std::size_t i = 0; i < s.runs.size(); ++i) {
+    if (s.faces.empty() || s.faces.back().face != s.runs[i].face)
+      s.faces.push_back({s.runs[i].face, static_cast<std::int32_t>(i), static_cast<std::int32_t>(i)});
+    s.faces.back().end = static_cast<std::int32_t>(i + 1);
+  }
+  // Normalise in double, then make the float weights' own sum exactly what the output divides by.
+  double fsum = 0;
+  for (float& w : s.weights) {
+    w = static_cast<float>(static_cast<double>(w) / total);
+    fsum += static_cast<double>(w);
+  }
+  s.norm = 1.0 / fsum;
+}
+
+// Applies a stencil to the image of its output texel under one symmetry (`maps`: the symmetry's
+// map of each canonical input face) on four-float texels `px4` (RGBA, or RGB and a zero). Float
+// sums within a face, double across faces. A run's texels are consecutive in memory or one row
+// apart, depending on the symmetry; runs are padded to multiples of four texels where the face
+// is wide enough.
+void apply_stencil_portable(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+  const float* w = s.weights.data();
+  for (int c = 0; c < 4; ++c) out[c] = 0.0;
+  for (const stencil_face& sf : s.faces) {
+    const face_map& m = maps[sf.face];
+    const float* base = px4 + m.origin * 4;
+    const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
+#if defined(__SSE2__)
+    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps();
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      int k = 0;
+      for (; k + 1 < r.count; k += 2, p += 2 * step) {
+        a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
+        a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_set1_ps(w[k + 1]), _mm_loadu_ps(p + step)));
+      }
+      if (k < r.count) a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_set1_ps(w[k]), _mm_loadu_ps(p)));
+      w += r.count;
+    }
+    alignas(16) float a[4];
+    _mm_store_ps(a, _mm_add_ps(a0, a1));
+#else
+    float a[4] = {0, 0, 0, 0};
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      for (int k = 0; k < r.count; ++k, p += step)
+        for (int c = 0; c < 4; ++c) a[c] += w[k] * p[c];
+      w += r.count;
+    }
+#endif
+    for (int c = 0; c < 4; ++c) out[c] += static_cast<double>(a[c]);
+  }
+}
+
+#if HEMILIGHT_CUBEMAP_AVX2
+// The same with AVX2 + FMA (picked at run time when the CPU has them): one broadcast and one
+// fused multiply-add per tap, four partial sums. Sums differ from the portable path only in
+// float rounding (fused multiply-adds, another order of the additions).
+__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* px4,
+                                                             double out[4]) noexcept {
+  const float* w = s.weights.data();
+  __m256d acc = _mm256_setzero_pd();
+  for (const stencil_face& sf : s.faces) {
+    const face_map& m = maps[sf.face];
+    const float* base = px4 + m.origin * 4;
+    const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
+    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps(), a3 = _mm_setzero_ps();
+    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+      const stencil_run& r = s.runs[std::size_t(i)];
+      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+      int k = 0;
+      for (; k + 3 < r.count; k += 4, p += 4 * step) {
+        a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
+        a1 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 1), _mm_loadu_ps(p + step), a1);
+        a2 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 2), _mm_loadu_ps(p + 2 * step), a2);
+        a3 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 3), _mm_loadu_ps(p + 3 * step), a3);
+      }
+      for (; k < r.count; ++k, p += step) a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
+      w += r.count;
+    }
+    acc = _mm256_add_pd(acc, _mm256_cvtps_pd(_mm_add_ps(_mm_add_ps(a0, a1), _mm_add_ps(a2, a3))));
+  }
+  _mm256_storeu_pd(out, acc);
+}
+#endif
+
+void apply_stencil(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+#if HEMILIGHT_CUBEMAP_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (avx2) return apply_stencil_avx2(s, maps, px4, out);
+#endif
+  apply_stencil_portable(s, maps, px4, out);
+}
+
+// Stretch and warp put the edge texels of adjacent faces on the same direction. The filter
+// computes each from its own (symmetry, stencil) pair, so the float sums can differ in the last
+// bits; copy the first one (face-major order) to the others so that they are bitwise identical,
+// as a per-direction filter makes them.
+void share_edge_texels(cube_image& out, edge_fixup fixup) {
+  const int n = out.size;
+  struct entry {
+    glm::vec3 d;
+    std::size_t texel;
+  };
+  std::vector<entry> edge;
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        if (x == 0 || y == 0 || x == n - 1 || y == n - 1)
+          edge.push_back({cubemap_texel_direction(n, f, x, y, fixup),
+                          (std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)});
+  const auto less = [](const entry& a, const entry& b) {
+    if (a.d.x != b.d.x) return a.d.x < b.d.x;
+    if (a.d.y != b.d.y) return a.d.y < b.d.y;
+    if (a.d.z != b.d.z) return a.d.z < b.d.z;
+    return a.texel < b.texel;
+  };
+  std::sort(edge.begin(), edge.end(), less);
+  const std::size_t ch = std::size_t(out.channels);
+  for (std::size_t i = 0, j; i < edge.size(); i = j) {
+    for (j = i + 1; j < edge.size() && edge[j].d == edge[i].d; ++j)
+      std::copy_n(out.pixels.data() + edge[i].texel * ch, ch, out.pixels.data() + edge[j].texel * ch);
+  }
+}
+
+cube_image filter_chain_stencils(const chain_level& level, float power, bool irradiance, int out_size,
+                                 const filter_options& o) {
+  const cube_image& in = *level.image;
+  const int n = in.size, ch = in.channels;
+  const double cutoff = irradiance ? 1e-30 : static_cast<double>(o.cutoff);
+  // the same extent as the direct path's lobe (float cos_max), so both cut the same texels
+  const double cos_max = static_cast<double>(static_cast<float>(std::pow(cutoff, 1.0 / static_cast<double>(power))));
+  const lobe_power lobe(static_cast<double>(power), cos_max);
+  const double_table tab(*level.centres);
+  cube_image out = cube_image::make(out_size, ch);
+  // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth).
+  std::vector<float> rgba;
+  const float* px4 = in.pixels.data();
+  if (ch == 3) {
+    const std::size_t count = 6u * std::size_t(n) * std::size_t(n);
+    rgba.assign(count * 4, 0.0f);
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t c = 0; c < 3; ++c) rgba[i * 4 + c] = in.pixels[i * 3 + c];
+    px4 = rgba.data();
+  }
+  const auto& sym = cube_symmetries();
+  // Maps of the canonical faces under each symmetry, for the input and for the output grid.
+  std::vector<face_map> in_maps(48 * 6), out_maps(48);
+  for (std::size_t g = 0; g < 48; ++g) {
+    for (int f = 0; f < 6; ++f) in_maps[g * 6 + std::size_t(f)] = map_face(sym[g], f, n);
+    out_maps[g] = map_face(sym[g], 4, out_size);  // the fundamental domain lies on +Z (face 4)
+  }
+  // The fundamental domain: texels (x, y) of face +Z with x <= y <= (n - 1) / 2. Every output
+  // texel is the image of one of them; it is computed once, for the first (symmetry, texel) pair
+  // (in this fixed order) that reaches it.
+  std::vector<std::pair<int, int>> domain;
+  for (int y = 0; 2 * y <= out_size - 1; ++y)
+    for (int x = 0; x <= y; ++x) domain.emplace_back(x, y);
+  const std::size_t out_count = 6u * std::size_t(out_size) * std::size_t(out_size);
+  std::vector<std::int32_t> owner(out_count, -1);  // g * domain size + domain index
+  for (std::size_t g = 0; g < 48; ++g)
+    for (std::size_t i = 0; i < domain.size(); ++i) {
+      const face_map& m = out_maps[g];
+      const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
+      assert(t < out_count);
+      if (owner[t] < 0) owner[t] = static_cast<std::int32_t>(g * domain.size() + i);
+    }
+  // Chunks of the domain bounded by their number of taps (~16 MB of weights and runs).
+  const double cap = 2.0 * pi * (1.0 - std::max(cos_max, 0.0));
+  const double taps = std::min(6.0 * n * n, 1.5 * cap / (4.0 * pi / (6.0 * n * n)) + 8.0);
+  const std::size_t chunk = std::clamp<std::size_t>(static_cast<std::size_t>(2.0e6 / taps), 1, domain.size());
+  const double scale = irradiance ? pi : 1.0;
+  std::vector<stencil> stencils(chunk);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> tasks;  // (stencil in chunk, output texel)
+  std::vector<std::uint8_t> task_g;
+  for (std::size_t begin = 0; begin < domain.size(); begin += chunk) {
+    const std::size_t end = std::min(domain.size(), begin + chunk);
+    parallel_for(end - begin, o.thread_count, 8, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const auto [x, y] = domain[begin + i];
+        const glm::dvec3 d = glm::normalize(face_point_d(4, cubemap_texel_coordinate(out_size, x, o.fixup),
+                                                         cubemap_texel_coordinate(out_size, y, o.fixup)));
+        build_stencil(tab, n, lobe, cos_max, d, stencils[i]);
+      }
+    });
+    tasks.clear();
+    task_g.clear();
+    // Order: blocks of neighbouring stencils (~128 KB of weights, so they stay in cache), then
+    // symmetry, then stencil: a block's weights are read 48 times from cache, and within one
+    // symmetry neighbouring output texels read neighbouring input texels.
+    const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1, chunk);
+    for (std::size_t b0 = begin; b0 < end; b0 += block)
+      for (std::size_t g = 0; g < 48; ++g)
+        for (std::size_t i = b0; i < std::min(end, b0 + block); ++i) {
+          const face_map& m = out_maps[g];
+          const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
+          if (owner[t] != static_cast<std::int32_t>(g * domain.size() + i)) continue;
+          tasks.emplace_back(static_cast<std::uint32_t>(i - begin), static_cast<std::uint32_t>(t));
+          task_g.push_back(static_cast<std::uint8_t>(g));
+        }
+    parallel_for(tasks.size(), o.thread_count, 32, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const stencil& s = stencils[tasks[k].first];
+        const face_map* maps = in_maps.data() + std::size_t(task_g[k]) * 6;
+        float* dst = out.pixels.data() + std::size_t(tasks[k].second) * std::size_t(ch);
+        double v[4];
+        apply_stencil(s, maps, px4, v);
+        for (int c = 0; c < ch; ++c)  // alpha: the mean, not scaled
+          dst[c] = static_cast<float>(v[c] * s.norm * (c < 3 ? scale : 1.0));
+      }
+    });
+  }
+  if (o.fixup != edge_fixup::none) share_edge_texels(out, o.fixup);
+  return out;
+}
+
 cube_image filter_chain(const input_chain& chain, float power, bool irradiance, int out_size, const filter_options& o) {
   const chain_level& level = pick_level(chain, power, irradiance, o);
+  if (o.precomputed_weights) return filter_chain_stencils(level, power, irradiance, out_size, o);
   const cube_image& in = *level.image;
   const lobe lb(power, irradiance ? 1e-30f : o.cutoff);  // the cosine lobe: the whole hemisphere
   cube_image out = cube_image::make(out_size, in.channels);
@@ -469,6 +911,39 @@ float gloss_power(int top_size, int level, float texels) noexcept {
   return half * half;
 }
 
+namespace {
+
+// The levels of a chain, one power each; with options.cascade (texel-centre outputs only) a
+// level whose lobe is wider than the previous one's is filtered from that previous output level
+// with the differential lobe 1/q = 1/p_k - 1/p_(k-1) (cos^p composes like a Gaussian for large p).
+// Only where the previous level resolves the differential lobe (its size >= 2 texels_per_sigma
+// sqrt(q), the rule of the input mip choice) and p_k >= 256: below, cos^p is too far from a
+// Gaussian (measured on the 256^2 sky, cmft's lobes: p = 64 from 152 adds 1.2%, p = 2 from 4.8
+// 45%).
+constexpr float cascade_min_power = 256.0f;
+cubemap chain_levels(const cube_image& top, int output_size, const std::vector<float>& powers, const filter_options& o) {
+  const input_chain chain(top);
+  cubemap out;
+  for (std::size_t l = 0; l < powers.size(); ++l) {
+    const int size = std::max(1, output_size >> l);
+    const double q = l > 0 && powers[l] < powers[l - 1]
+                         ? 1.0 / (1.0 / static_cast<double>(powers[l]) - 1.0 / static_cast<double>(powers[l - 1]))
+                         : 0.0;
+    // the previous level must resolve the differential lobe as finely as texels_per_sigma asks
+    const bool resolved =
+        q > 0.0 && out.levels[l - 1].size >= 2.0 * static_cast<double>(o.texels_per_sigma) * std::sqrt(q);
+    if (o.cascade && o.fixup == edge_fixup::none && resolved && powers[l] >= cascade_min_power) {
+      const input_chain previous(out.levels[l - 1]);
+      out.levels.push_back(filter_chain(previous, static_cast<float>(q), false, size, o));
+    } else {
+      out.levels.push_back(filter_chain(chain, powers[l], false, size, o));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_options& options, float lobe_texels,
                          int levels) {
   const char* fn = "filter_mip_chain";
@@ -482,13 +957,25 @@ cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_opt
   int full = 1;
   while ((output_size >> full) >= 1 && full < 31) ++full;
   const int count = levels == 0 ? full : std::min(levels, full);
-  const input_chain chain(input.levels[0]);
-  cubemap out;
-  for (int l = 0; l < count; ++l) {
-    const int size = std::max(1, output_size >> l);
-    out.levels.push_back(filter_chain(chain, gloss_power(output_size, l, lobe_texels), false, size, options));
-  }
-  return out;
+  std::vector<float> powers;
+  for (int l = 0; l < count; ++l) powers.push_back(gloss_power(output_size, l, lobe_texels));
+  return chain_levels(input.levels[0], output_size, powers, options);
+}
+
+cubemap filter_mip_chain_powers(const cubemap& input, int output_size, const std::vector<float>& powers,
+                                const filter_options& options) {
+  const char* fn = "filter_mip_chain_powers";
+  if (input.levels.empty()) throw_invalid_argument(std::string(fn) + ": the input cube map has no levels");
+  validate_level(fn, input.levels[0]);
+  check_output_size(fn, output_size);
+  check_options(fn, options);
+  int full = 1;
+  while ((output_size >> full) >= 1 && full < 31) ++full;
+  if (powers.empty() || powers.size() > std::size_t(full))
+    throw_invalid_argument(std::string(fn) + ": " + std::to_string(powers.size()) + " powers for a chain of " +
+                           std::to_string(full) + " levels; give 1 to " + std::to_string(full));
+  for (float p : powers) check_power(fn, p);
+  return chain_levels(input.levels[0], output_size, powers, options);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -184,6 +184,20 @@ struct filter_options {
   /// Input mip size the irradiance (cosine-lobe) filter reads (clamped to the input's size):
   /// 16 keeps irradiance under 0.4% from brute force on the test sky at ~10 ms for 32^2 out.
   int irradiance_input_size = 16;
+  /// true (default): the lobe weights are computed once per call, in double, for the output
+  /// texels of one eighth of one face, and applied to all 48 symmetric images of them (the cube's
+  /// symmetries map both texel grids onto themselves), so each tap is a multiply-add. false: the
+  /// lobe is evaluated per tap (a 1024-step table for p >= 8), the previous method, kept for
+  /// comparison. Both read the same input mip and cut the lobe at the same extent.
+  bool precomputed_weights = true;
+  /// Mip chains only (filter_mip_chain, filter_mip_chain_powers), texel-centre outputs only
+  /// (fixup none; ignored otherwise): a level whose lobe is wider than the previous level's is
+  /// filtered from that previous output level with the differential lobe 1/q = 1/p_k - 1/p_(k-1)
+  /// (cos^p composes like a Gaussian for large p), so it reads a narrower lobe; only for levels
+  /// with p >= 256 (below, the composition is measurably not a cos^p lobe) whose previous level
+  /// has at least 2 texels_per_sigma sqrt(q) texels (it must resolve the lobe). Off by default;
+  /// docs/cubemap.md has the measured speed and error against brute force.
+  bool cascade = false;
 };
 
 /// Filters `input` with the normalised cosine-power lobe: each output texel with direction d
@@ -196,9 +210,13 @@ struct filter_options {
 /// it, the output is the input texel that contains d (the limit of a very narrow lobe).
 /// Throws error(invalid_argument) for an invalid input (cubemap::validate), p not finite and
 /// > 0, output_size outside [1, cubemap_max_size], or bad options. Cost: about
-/// 6 out^2 * 6 (4.3 r)^2 weight evaluations (~5-7 ns each on one core) for narrow lobes, r the lobe's
-/// width in texels of the input mip read (texels_per_sigma to twice that, or less when the
-/// input's top level is coarser); the whole input mip for wide lobes. 256^2 chain: ~0.5-1 s.
+/// 6 out^2 * 6 (4.3 r)^2 taps for narrow lobes, r the lobe's width in texels of the input mip
+/// read (texels_per_sigma to twice that, or less when the input's top level is coarser), the
+/// whole input mip for wide lobes; with precomputed_weights a tap is a multiply-add (~1 ns on
+/// one core) and 1/48 of them also cost a weight evaluation. Extra memory with precomputed
+/// weights: the weights and runs of at most ~2M taps at a time (~16 MB), 4 bytes per output
+/// texel, and for RGB input a four-float copy of the input mip read (16 bytes per texel).
+/// Per-tap weights: ~5-7 ns per tap. 256^2 chain (gloss mapping): ~0.2 s on two cores.
 cube_image filter_cosine_power(const cubemap& input, float power, int output_size, const filter_options& options = {});
 
 /// Irradiance E(n) = integral of L(w) max(0, n.w) dw (W/m^2 for L in W/m^2/sr; a uniform sky L
@@ -229,6 +247,15 @@ float gloss_power(int top_size, int level, float texels = 1.0f) noexcept;
 /// `levels` > 0 to stop earlier). Errors as filter_cosine_power.
 cubemap filter_mip_chain(const cubemap& input, int output_size, const filter_options& options = {},
                          float lobe_texels = 1.0f, int levels = 0);
+
+/// A radiance mip chain with a specular power per level: level i (size max(1, output_size >> i))
+/// is filter_cosine_power of `input` with powers[i], for every entry of `powers` (at most the
+/// number of levels down to 1 x 1). The same as calling filter_cosine_power per level, but the
+/// input's mips are built once. Use it for another gloss mapping, e.g. cmft's
+/// p_i = 2^(10 (1 - i / 8) + 1). Errors as filter_cosine_power; an empty `powers`, too many
+/// entries or an invalid power throws error(invalid_argument).
+cubemap filter_mip_chain_powers(const cubemap& input, int output_size, const std::vector<float>& powers,
+                                const filter_options& options = {});
 
 // ---------------------------------------------------------------------------------------------
 // Spherical harmonics (bands 0-2)
