@@ -363,7 +363,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3],
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
 // texels are left to the caller. Runs are found by shade key (keys[id]: the first record with
 // the same shade), so the two triangles of a quad, or all black surfaces, make one run.
-HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* __restrict depth,
+HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
                                                const hemicube_rasterizer::shade* __restrict shades,
                                                const std::uint32_t* __restrict keys, float* __restrict distance,
@@ -377,6 +377,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* _
   std::uint64_t run_flags = 0;
   for (std::size_t i = 0; i + 8 <= count; i += 8) {
     const __m256 d = _mm256_loadu_ps(depth + i);
+    _mm256_storeu_ps(depth + i, zero);  // cleared for the next render
     _mm256_storeu_ps(distance + i, _mm256_div_ps(_mm256_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
     const __m256i id = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ids + i)),
                                         _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
@@ -426,7 +427,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, const float* _
 // The resolve loops, with restrict pointers so that the byte stores of the flags do not force
 // reloads (char stores may alias anything). Texels never written have depth 0 (their id is
 // stale): they are set to record 0, the sky. The radiance is planar (hemicube_buffer).
-void resolve_texels(std::size_t count, const float* __restrict depth, const float* __restrict lengths,
+void resolve_texels(std::size_t count, float* __restrict depth, const float* __restrict lengths,
                     std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
                     float* __restrict distance, float* __restrict red, float* __restrict green,
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
@@ -443,6 +444,7 @@ void resolve_texels(std::size_t count, const float* __restrict depth, const floa
     std::uint32_t run_flags = 0;
     for (; i + 4 <= count; i += 4) {
       const __m128 d = _mm_loadu_ps(depth + i);
+      _mm_storeu_ps(depth + i, zero);  // cleared for the next render
       _mm_storeu_ps(distance + i, _mm_div_ps(_mm_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
       const __m128i id = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)),
                                        _mm_castps_si128(_mm_cmpgt_ps(d, zero)));
@@ -485,6 +487,7 @@ void resolve_texels(std::size_t count, const float* __restrict depth, const floa
   for (; i < count; ++i) {
     distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
     ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
+    depth[i] = 0.0f;                         // cleared for the next render
     const hemicube_rasterizer::shade& sh = shades[ids[i]];
     red[i] = sh.r;
     green[i] = sh.g;
@@ -599,8 +602,12 @@ void hemicube_rasterizer::prepare(int resolution) {
     n_ = resolution;
   }
   // Padded by 8 texels: the AVX2 kernels may load and store back up to 7 texels past a row's end.
-  depth_.resize(count + 8);
-  std::memset(depth_.data(), 0, depth_.size() * sizeof(float));  // 0.0f is all zero bits
+  // The resolve clears what it reads, so after a render the buffer is already zero.
+  if (!depth_clear_ || depth_.size() != count + 8) {
+    depth_.resize(count + 8);
+    std::memset(depth_.data(), 0, depth_.size() * sizeof(float));  // 0.0f is all zero bits
+  }
+  depth_clear_ = false;  // drawing is about to write it
   ids_.resize(count + 8);  // stale ids are masked by depth 0 (never written)
   // Record 0 stands for "nothing hit" (the sky): texels start there.
   draws_.clear();
@@ -1042,7 +1049,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   out.position = position;
   out.basis = basis;
   const std::size_t count = hemicube_texel_count(resolution);
-  const float* depth = depth_.data();
+  float* depth = depth_.data();
   const float* lengths = lengths_.data();
   std::uint32_t* ids = ids_.data();
   const shade* shades = shades_.data();
@@ -1060,6 +1067,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   } else
 #endif
     resolve_texels(count, depth, lengths, ids, shades, distance, red, green, blue, flags, simd_);
+  depth_clear_ = true;  // every path of the resolve zeroed the depths it read (the padding stays 0)
   if (sky_) {
     // Misses see the environment along the texel's world direction.
     for (std::size_t i = 0; i < count; ++i) {

@@ -223,6 +223,7 @@ class alignas(64) hemicube_rasterizer {
   float near_ = 0.0f;
   bool simd_ = true;
   bool avx2_ = false;  // simd_ and the CPU has AVX2
+  bool depth_clear_ = false;  // depth_ is all zero (the last render's resolve cleared it)
   std::shared_ptr<const cubemap> sky_;
   int n_ = 0;
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
