@@ -225,12 +225,8 @@ inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const 
       a4 += db * wx;
       a5 += db * wy;
     }
-    acc[0] += double(a0);
-    acc[1] += double(a1);
-    acc[2] += double(a2);
-    acc[3] += double(a3);
-    acc[4] += double(a4);
-    acc[5] += double(a5);
+    const Inner sums[6] = {a0, a1, a2, a3, a4, a5};
+    for (int k = 0; k < 6; ++k) acc[k] += double(sums[k]);
   }
 }
 
@@ -259,12 +255,8 @@ inline __attribute__((always_inline)) float texel_sums_impl(const float* r, cons
       hs += p * Inner(inv[i]);
       bk += p * Inner((flags[i] >> 1) & 1u);  // texel_back_face is bit 1
     }
-    s1[0] += double(e0);
-    s1[1] += double(e1);
-    s1[2] += double(e2);
-    s1[3] += double(pt);
-    s1[4] += double(hs);
-    s1[5] += double(bk);
+    const Inner sums[6] = {e0, e1, e2, pt, hs, bk};
+    for (int k = 0; k < 6; ++k) s1[k] += double(sums[k]);
   }
   return min_d;
 }
@@ -318,12 +310,8 @@ inline __attribute__((always_inline)) void vector_sums_impl(const float* r, cons
       a4 += Inner(b[i]) * x;
       a5 += Inner(b[i]) * y;
     }
-    phi[0] += double(a0);
-    phi[1] += double(a1);
-    phi[2] += double(a2);
-    phi[3] += double(a3);
-    phi[4] += double(a4);
-    phi[5] += double(a5);
+    const Inner sums[6] = {a0, a1, a2, a3, a4, a5};
+    for (int k = 0; k < 6; ++k) phi[k] += double(sums[k]);
   }
 }
 
@@ -379,7 +367,8 @@ HEMILIGHT_TARGET_AVX2_FMA inline double hsum(__m256 v) noexcept {
 }
 
 // Pass 1 with the vector sums: inv[i] = 1 / dist[i]; s1 = (E_r, E_g, E_b, sum P, sum P / r,
-// sum P back); phi = per channel (sum L x, sum L y); returns min dist. `vector` = false skips phi.
+// sum P back); phi = per channel (sum L x, sum L y), always (six FMAs per step; the caller
+// ignores them without g_r or directional outputs); returns min dist.
 HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, const float* b, const float* dist,
                                                 const std::uint8_t* flags, const float* vx, const float* vy,
                                                 const float* vz, float* inv, std::size_t count, double* s1,
@@ -418,18 +407,9 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
       a4 = _mm256_fmadd_ps(l, x, a4);
       a5 = _mm256_fmadd_ps(l, y, a5);
     }
-    s1[0] += hsum(e0);
-    s1[1] += hsum(e1);
-    s1[2] += hsum(e2);
-    s1[3] += hsum(pt);
-    s1[4] += hsum(hs);
-    s1[5] += hsum(bk);
-    phi[0] += hsum(a0);
-    phi[1] += hsum(a1);
-    phi[2] += hsum(a2);
-    phi[3] += hsum(a3);
-    phi[4] += hsum(a4);
-    phi[5] += hsum(a5);
+    const __m256 sums[12] = {e0, e1, e2, pt, hs, bk, a0, a1, a2, a3, a4, a5};
+    for (int k = 0; k < 6; ++k) s1[k] += hsum(sums[k]);
+    for (int k = 0; k < 6; ++k) phi[k] += hsum(sums[6 + k]);
   }
   alignas(32) float m[8];
   _mm256_store_ps(m, min_d);
@@ -488,12 +468,8 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
       a4 = _mm256_fmadd_ps(du, wux, _mm256_fmadd_ps(dr, wrx, a4));
       a5 = _mm256_fmadd_ps(du, wuy, _mm256_fmadd_ps(dr, wry, a5));
     }
-    acc[0] += hsum(a0);
-    acc[1] += hsum(a1);
-    acc[2] += hsum(a2);
-    acc[3] += hsum(a3);
-    acc[4] += hsum(a4);
-    acc[5] += hsum(a5);
+    const __m256 sums[6] = {a0, a1, a2, a3, a4, a5};
+    for (int k = 0; k < 6; ++k) acc[k] += hsum(sums[k]);
   }
   // Tails: the rest of the texels with both walls, then the right walls of the last row.
   const auto wall = [&](std::size_t k, std::size_t step, float cx, float cy) {

@@ -265,6 +265,17 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 // They may read and write back up to 7 texels past the last one they own (the rows are contiguous
 // and the visibility buffers are padded by 8): masked lanes store the values they loaded.
 
+// Depth test of the eight texels at depth / ids: where `mask` is set and z is nearer (a larger
+// 1/w), z and `id` win. The common tail of the AVX2 kernels.
+HEMILIGHT_TARGET_AVX2 inline void depth_test8(float* depth, std::uint32_t* ids, __m256 z, __m256 mask,
+                                              __m256 id) noexcept {
+  const __m256 old = _mm256_loadu_ps(depth);
+  const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
+  _mm256_storeu_ps(depth, _mm256_blendv_ps(old, z, closer));
+  float* ip = reinterpret_cast<float*>(ids);
+  _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+}
+
 // Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
 HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
                                      std::uint32_t draw) noexcept {
@@ -274,11 +285,7 @@ HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, i
   for (int x = lo; x <= hi; x += 8) {
     const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
     const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-    const __m256 old = _mm256_loadu_ps(drow + x);
-    const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)));
-    _mm256_storeu_ps(drow + x, _mm256_blendv_ps(old, z, closer));
-    float* ip = reinterpret_cast<float*>(irow + x);
-    _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+    depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
   }
 }
 
@@ -319,12 +326,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3],
       if (_mm256_movemask_ps(mask) == 0) continue;
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
       const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
-      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
-      const __m256 old = _mm256_loadu_ps(depth + i);
-      const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
-      _mm256_storeu_ps(depth + i, _mm256_blendv_ps(old, z, closer));
-      float* ip = reinterpret_cast<float*>(ids + i);
-      _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+      depth_test8(depth + i, ids + i, _mm256_max_ps(_mm256_add_ps(zr, zx), zmin), mask, id);
     }
     return;
   }
@@ -348,11 +350,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3],
         continue;
       }
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-      const __m256 old = _mm256_loadu_ps(depth + i);
-      const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
-      _mm256_storeu_ps(depth + i, _mm256_blendv_ps(old, z, closer));
-      float* ip = reinterpret_cast<float*>(ids + i);
-      _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
+      depth_test8(depth + i, ids + i, z, mask, id);
     }
     row[0] = _mm256_add_epi32(row[0], dy[0]);
     row[1] = _mm256_add_epi32(row[1], dy[1]);
@@ -385,36 +383,33 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
     if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) != -1) {
       const __m256i key = _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
       if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1) {
-        run_id = _mm256_set1_epi32(-1);  // same shade, other records
-        _mm256_storeu_ps(red + i, run_r);
-        _mm256_storeu_ps(green + i, run_g);
-        _mm256_storeu_ps(blue + i, run_b);
-        std::memcpy(flags + i, &run_flags, 8);
-        continue;
-      }
-      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
-      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
-        run_id = run_key = _mm256_set1_epi32(-1);
-        alignas(32) std::uint32_t lane[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
-        for (std::size_t k = 0; k < 8; ++k) {
-          const hemicube_rasterizer::shade& sh = shades[lane[k]];
-          red[i + k] = sh.r;
-          green[i + k] = sh.g;
-          blue[i + k] = sh.b;
-          flags[i + k] = static_cast<std::uint8_t>(sh.flags);
+        run_id = _mm256_set1_epi32(-1);  // same shade, other records: the run goes on
+      } else {
+        const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
+        if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
+          // Mixed shades: texel by texel.
+          run_id = run_key = _mm256_set1_epi32(-1);
+          alignas(32) std::uint32_t lane[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
+          for (std::size_t k = 0; k < 8; ++k) {
+            const hemicube_rasterizer::shade& sh = shades[lane[k]];
+            red[i + k] = sh.r;
+            green[i + k] = sh.g;
+            blue[i + k] = sh.b;
+            flags[i + k] = static_cast<std::uint8_t>(sh.flags);
+          }
+          continue;
         }
-        continue;
+        // A new run of shade key `first`.
+        run_key = first;
+        const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
+        run_id = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1 ? id0 : _mm256_set1_epi32(-1);
+        const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+        run_r = _mm256_set1_ps(sh.r);
+        run_g = _mm256_set1_ps(sh.g);
+        run_b = _mm256_set1_ps(sh.b);
+        run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
       }
-      // A new run of shade key `first`.
-      run_key = first;
-      const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
-      run_id = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1 ? id0 : _mm256_set1_epi32(-1);
-      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-      run_r = _mm256_set1_ps(sh.r);
-      run_g = _mm256_set1_ps(sh.g);
-      run_b = _mm256_set1_ps(sh.b);
-      run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
     }
     _mm256_storeu_ps(red + i, run_r);
     _mm256_storeu_ps(green + i, run_g);
