@@ -153,37 +153,21 @@ int main(int argc, char** argv) {
         o.thread_count = 2;
         o.use_cache = false;
         const bake_result ref = bake_lightmap(in, o);
-        double mean_ref = 0.0;
-        std::size_t n = 0;
-        for (std::size_t k = 0; k < ref.valid.size(); ++k)
-          if (ref.valid[k]) {
-            mean_ref += luminance(ref.irradiance.pixels.data() + 3 * k);
-            ++n;
-          }
-        mean_ref /= double(std::max<std::size_t>(n, 1));
         o.use_cache = true;
         for (int threads : {1, 2}) {
           o.thread_count = threads;
           const bake_result r = bake_lightmap(in, o);
-          double num = 0, den = 0, rel = 0;
-          std::size_t cnt = 0;
-          for (std::size_t k = 0; k < ref.valid.size(); ++k)
-            if (ref.valid[k] && r.valid[k]) {
-              const double a = luminance(r.irradiance.pixels.data() + 3 * k), b = luminance(ref.irradiance.pixels.data() + 3 * k);
-              num += (a - b) * (a - b);
-              den += b * b;
-              rel += std::fabs(a - b) / std::max(b, 0.05 * mean_ref);
-              ++cnt;
-            }
+          double rms = 0.0, mean = 0.0;
+          compare(r, ref, rms, mean);
           const bake_stats& s = r.stats;
           std::fprintf(f, "%s,%zu,%d,%d,%d,%.4f,%.4f,%zu,%zu,%.4f,%.4f,%.5f,%.5f\n", sc.name, m.triangle_count(), size, bounces,
                        threads, s.seconds, s.coverage_seconds, s.sampled_texels, s.hemicubes,
-                       double(s.hemicubes) / double(s.sampled_texels * std::size_t(bounces)), ref.stats.seconds,
-                       std::sqrt(num / den), rel / double(cnt));
+                       double(s.hemicubes) / double(s.sampled_texels * std::size_t(bounces)), ref.stats.seconds, rms,
+                       mean);
           std::fflush(f);
           std::printf("%s %d^2 %d bounce(s) %d thread(s): %.2f s, %.1f%% hemicubes, rms %.4f (reference %.1f s)\n", sc.name,
                       size, bounces, threads, s.seconds, 100.0 * double(s.hemicubes) / double(s.sampled_texels * std::size_t(bounces)),
-                      std::sqrt(num / den), ref.stats.seconds);
+                      rms, ref.stats.seconds);
           std::fflush(stdout);
         }
       }
