@@ -290,21 +290,21 @@ HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, i
 }
 
 // The small-triangle path of small_triangle_sse2_impl, eight texels per step.
+// base, sx, sy: the 32-bit edge values at the box's first texel (x_begin, y_begin) and their
+// steps per texel in x and y (the caller checks they fit, see avx2_extent).
 template <bool count_mode>
-HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3],
-                                                    const std::int64_t (&e0)[3], std::int64_t x_begin, std::int64_t x_end,
-                                                    std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
-                                                    std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
-                                                    float dzdx, std::uint32_t draw) noexcept {
+HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, const std::int32_t* sx,
+                                                    const std::int32_t* sy, std::int64_t x_begin,
+                                                    std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
+                                                    float* depth, std::uint32_t* ids, std::uint32_t* counts,
+                                                    double z00, double dzdy, float dzdx, std::uint32_t draw) noexcept {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   __m256i step[3], row[3], dy[3];
   for (int k = 0; k < 3; ++k) {
-    // Values at (x_begin + lane, y_begin): exact in int64, small enough for int32 here.
-    const auto base = static_cast<std::int32_t>(ex[k] * x_begin + ey[k] * y_begin + e0[k]);
-    const auto ek = static_cast<std::int32_t>(ex[k]);
-    row[k] = _mm256_add_epi32(_mm256_set1_epi32(base), _mm256_mullo_epi32(_mm256_set1_epi32(ek), lane));
-    step[k] = _mm256_set1_epi32(8 * ek);
-    dy[k] = _mm256_set1_epi32(static_cast<std::int32_t>(ey[k]));
+    // Values at (x_begin + lane, y_begin).
+    row[k] = _mm256_add_epi32(_mm256_set1_epi32(base[k]), _mm256_mullo_epi32(_mm256_set1_epi32(sx[k]), lane));
+    step[k] = _mm256_set1_epi32(8 * sx[k]);
+    dy[k] = _mm256_set1_epi32(sy[k]);
   }
   const __m256 dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
   const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
@@ -669,11 +669,51 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
   return mask;
 }
 
+// The depth plane of one (triangle, face) pair, computed when the pair first covers a texel.
+struct hemicube_rasterizer::face_setup {
+  bool ready = false;
+  double z00 = 0.0, dzdy = 0.0;
+  float dzdx = 0.0f;
+
+  void prepare(int face, int n, const draw_record& rec) noexcept {
+    if (ready) return;
+    // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
+    // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
+    // Evaluated per row in double, then per texel in float.
+    const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
+    const double inv_k = 1.0 / static_cast<double>(rec.plane);
+    const double step = 2.0 / n;
+    const double u0 = 1.0 / n - 1.0, v0 = face == 0 ? 1.0 / n - 1.0 : 1.0 / n;
+    dzdx = static_cast<float>(nm.u * step * inv_k);
+    dzdy = nm.v * step * inv_k;
+    z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
+    ready = true;
+  }
+};
+
+#if HEMILIGHT_RASTER_AVX2
+// The position and the frame's axes, broadcast once per render for draw_triangle_avx2.
+struct hemicube_rasterizer::simd_frame {
+  __m128 p;                 // (x, y, z, 0)
+  __m128 t[3], b[3], n[3];  // each component of t, b, n in all four lanes
+};
+
+#endif
+
 template <hemicube_rasterizer::mode M>
 void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
   if (nodes.empty()) return;
   const std::vector<scene::triangle>& tris = scene_->triangles();
+#if HEMILIGHT_RASTER_AVX2
+  simd_frame sf;
+  sf.p = _mm_setr_ps(position.x, position.y, position.z, 0.0f);
+  for (int k = 0; k < 3; ++k) {
+    sf.t[k] = _mm_set1_ps(basis.t[k]);
+    sf.b[k] = _mm_set1_ps(basis.b[k]);
+    sf.n[k] = _mm_set1_ps(basis.n[k]);
+  }
+#endif
   // Stack entries: node index (low 27 bits are plenty: 2^31 triangles need < 2^29 nodes, so the
   // face mask travels in a second word).
   stack_.clear();
@@ -696,6 +736,12 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
       stack_.push_back(mask);
       continue;
     }
+#if HEMILIGHT_RASTER_AVX2
+    if (avx2_) {
+      for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle_avx2<M>(tris[node.first + k], mask, sf, basis, texture);
+      continue;
+    }
+#endif
     for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis, texture);
   }
 }
@@ -730,6 +776,170 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
       raster_face<M>(f, local, rec, draw, basis, tri, texture);
     }
 }
+
+#if HEMILIGHT_RASTER_AVX2
+// draw_triangle for the AVX2 path: the same results, bit for bit (the same float operations on
+// the same values, in the same order; tested against the scalar path), computed for the three
+// vertices at once. Lanes 0-2 hold the vertices, lane 3 the triangle's normal: moved to the
+// local frame together, and the normal's face coordinates come with every face's swizzle.
+template <hemicube_rasterizer::mode M>
+HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_triangle_avx2(const scene::triangle& tri, unsigned face_mask,
+                                                                   const simd_frame& sf, const frame& basis,
+                                                                   const radiance_texture* texture) {
+  ++stats_.triangles_tested;
+  // v0, v1, v2 are 9 consecutive floats (then the index): three overlapping loads, lane 3 cleared.
+  const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+  const float* v = &tri.v0.x;
+  const __m128 a0 = _mm_and_ps(_mm_loadu_ps(v), xyz), a1 = _mm_and_ps(_mm_loadu_ps(v + 3), xyz);
+  const __m128 a2 = _mm_and_ps(_mm_loadu_ps(v + 6), xyz);
+  // World edges and their cross product (glm::cross's operations: x.y y.z - y.y x.z, ...).
+  const __m128 e1 = _mm_sub_ps(a1, a0), e2 = _mm_sub_ps(a2, a0);
+  const __m128 c = _mm_sub_ps(
+      _mm_mul_ps(_mm_shuffle_ps(e1, e1, _MM_SHUFFLE(3, 0, 2, 1)), _mm_shuffle_ps(e2, e2, _MM_SHUFFLE(3, 1, 0, 2))),
+      _mm_mul_ps(_mm_shuffle_ps(e2, e2, _MM_SHUFFLE(3, 0, 2, 1)), _mm_shuffle_ps(e1, e1, _MM_SHUFFLE(3, 1, 0, 2))));
+  __m128 d0 = _mm_sub_ps(a0, sf.p), d1 = _mm_sub_ps(a1, sf.p), d2 = _mm_sub_ps(a2, sf.p), d3 = c;
+  _MM_TRANSPOSE4_PS(d0, d1, d2, d3);  // d0 = x of (v0, v1, v2, normal), d1 = y, d2 = z
+  // frame::to_local: dot(w, t) = (w.x t.x + w.y t.y) + w.z t.z.
+  const auto dot = [&](const __m128 (&axis)[3]) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, axis[0]), _mm_mul_ps(d1, axis[1])), _mm_mul_ps(d2, axis[2]));
+  };
+  const __m128 lx = dot(sf.t), ly = dot(sf.b), lz = dot(sf.n);
+  const __m128 sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps();
+  // The face coordinates (u, v, w) of to_clip, per face (negation is exact).
+  const auto swizzle = [&](int f, __m128& u, __m128& vv, __m128& w) {
+    switch (f) {
+      case 0: u = lx; vv = ly; w = lz; break;
+      case 1: u = ly; vv = lz; w = lx; break;
+      case 2: u = _mm_xor_ps(ly, sign); vv = lz; w = _mm_xor_ps(lx, sign); break;
+      case 3: u = _mm_xor_ps(lx, sign); vv = lz; w = ly; break;
+      default: u = lx; vv = lz; w = _mm_xor_ps(ly, sign); break;
+    }
+  };
+  // Faces: rejected when all three vertices lie outside one of the face's frustum planes. The
+  // face_planes tests of outcode() in face coordinates: w - u, w + u, w - v < 0, and w + v < 0
+  // (top) or v < 0 (sides, below the tangent plane). Each is the scalar test's sum up to an
+  // exact negation or swapped operands, so the decisions are the same.
+  unsigned faces = 0;
+  for (int f = 0; f < 5; ++f) {
+    if (!(face_mask >> f & 1u)) continue;
+    __m128 u, vv, w;
+    swizzle(f, u, vv, w);
+    const int m1 = _mm_movemask_ps(_mm_cmplt_ps(_mm_sub_ps(w, u), zero));
+    const int m2 = _mm_movemask_ps(_mm_cmplt_ps(_mm_add_ps(w, u), zero));
+    const int m3 = _mm_movemask_ps(_mm_cmplt_ps(_mm_sub_ps(w, vv), zero));
+    const int m4 = _mm_movemask_ps(_mm_cmplt_ps(f == 0 ? _mm_add_ps(w, vv) : vv, zero));
+    const int bits = m1 | m2 << 4 | m3 << 8 | m4 << 12;
+    if (!(bits & bits >> 1 & bits >> 2 & 0x1111)) faces |= 1u << f;
+  }
+  if (!faces) return;
+
+  alignas(16) float x4[4], y4[4], z4[4];
+  _mm_store_ps(x4, lx);
+  _mm_store_ps(y4, ly);
+  _mm_store_ps(z4, lz);
+  draw_record rec;
+  rec.normal = glm::vec3(x4[3], y4[3], z4[3]);
+  rec.v0 = glm::vec3(x4[0], y4[0], z4[0]);
+  rec.plane = glm::dot(rec.normal, rec.v0);
+  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
+  rec.index = tri.index;
+  const glm::vec3 local[3] = {rec.v0, glm::vec3(x4[1], y4[1], z4[1]), glm::vec3(x4[2], y4[2], z4[2])};
+
+  const double scale = 0.5 * n_ * static_cast<double>(sub_one);
+  const __m256d dscale = _mm256_set1_pd(scale), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
+  const __m128 near4 = _mm_set1_ps(near_), band = _mm_set1_ps(guard_band);
+  std::uint32_t draw = 0;
+  for (int f = 0; f < 5; ++f) {
+    if (!(faces >> f & 1u)) continue;
+    ++stats_.face_triangles;
+    __m128 u, vv, w;
+    swizzle(f, u, vv, w);
+    // raster_face's clip codes; with any vertex outside a clip plane, raster_face clips.
+    const __m128 gw = _mm_mul_ps(band, w);
+    const __m128 out = _mm_or_ps(
+        _mm_or_ps(_mm_cmplt_ps(_mm_sub_ps(w, near4), zero), _mm_cmplt_ps(_mm_sub_ps(gw, u), zero)),
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(_mm_add_ps(gw, u), zero), _mm_cmplt_ps(_mm_sub_ps(gw, vv), zero)),
+                  _mm_cmplt_ps(_mm_add_ps(gw, vv), zero)));
+    if (_mm_movemask_ps(out) & 7) {
+      raster_face<M>(f, local, rec, draw, basis, tri, texture);
+      continue;
+    }
+    // raster_face's projection and snapping, four lanes of double: iw = 1 / w,
+    // round((u iw + 1) scale), round((v iw + v_offset) scale), halves away from zero.
+    const __m256d iw = _mm256_div_pd(one, _mm256_cvtps_pd(w));
+    const __m256d xs = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(u), iw), one), dscale);
+    const __m256d ys = _mm256_mul_pd(
+        _mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(vv), iw), _mm256_set1_pd(f == 0 ? 1.0 : 0.0)), dscale);
+    const __m256d zero_d = _mm256_setzero_pd();
+    const __m256d hx = _mm256_blendv_pd(_mm256_xor_pd(half, _mm256_set1_pd(-0.0)), half,
+                                        _mm256_cmp_pd(xs, zero_d, _CMP_GE_OQ));
+    const __m256d hy = _mm256_blendv_pd(_mm256_xor_pd(half, _mm256_set1_pd(-0.0)), half,
+                                        _mm256_cmp_pd(ys, zero_d, _CMP_GE_OQ));
+    // Vertices (x0, x1, x2, x0): lane 3 repeats vertex 0, so four-lane minima are three-lane ones.
+    __m128i X = _mm_shuffle_epi32(_mm256_cvttpd_epi32(_mm256_add_pd(xs, hx)), _MM_SHUFFLE(0, 2, 1, 0));
+    __m128i Y = _mm_shuffle_epi32(_mm256_cvttpd_epi32(_mm256_add_pd(ys, hy)), _MM_SHUFFLE(0, 2, 1, 0));
+    face_setup fs;
+    // The bounding box, all four bounds at once: lanes 0-3 (min x, min y, -max x, -max y).
+    __m128i lo = _mm_min_epi32(_mm_unpacklo_epi64(X, Y), _mm_unpackhi_epi64(X, Y));  // (x0|x2, x1|x0, y0|y2, y1|y0)
+    __m128i hi = _mm_max_epi32(_mm_unpacklo_epi64(X, Y), _mm_unpackhi_epi64(X, Y));
+    lo = _mm_min_epi32(lo, _mm_shuffle_epi32(lo, _MM_SHUFFLE(2, 3, 0, 1)));            // (min x, min x, min y, min y)
+    hi = _mm_max_epi32(hi, _mm_shuffle_epi32(hi, _MM_SHUFFLE(2, 3, 0, 1)));
+    const std::int64_t min_x = _mm_cvtsi128_si32(lo), min_y = _mm_extract_epi32(lo, 2);
+    const std::int64_t max_x = _mm_cvtsi128_si32(hi), max_y = _mm_extract_epi32(hi, 2);
+    if (max_x - min_x > avx2_extent || max_y - min_y > avx2_extent) {
+      // Big: draw_fixed's exact paths (64-bit edge functions).
+      alignas(16) std::int32_t ix[4], iy[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(ix), X);
+      _mm_store_si128(reinterpret_cast<__m128i*>(iy), Y);
+      const std::int64_t px[3] = {ix[0], ix[1], ix[2]}, py[3] = {iy[0], iy[1], iy[2]};
+      draw_fixed<M>(f, px, py, fs, rec, draw, basis, tri, texture);
+      continue;
+    }
+    // Small (up to 64 texels across): draw_fixed's AVX2 path with the set-up in 32-bit lanes,
+    // lane k = edge k from vertex k to vertex k + 1 (all values below 2^30, see avx2_extent).
+    const int n = n_, rows = f == 0 ? n : n / 2;
+    const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
+    const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
+    const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
+    const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
+    if (x_begin > x_end || y_begin > y_end) continue;
+    __m128i dx = _mm_sub_epi32(_mm_shuffle_epi32(X, _MM_SHUFFLE(0, 0, 2, 1)), X);
+    __m128i dy = _mm_sub_epi32(_mm_shuffle_epi32(Y, _MM_SHUFFLE(0, 0, 2, 1)), Y);
+    // Twice the signed area, (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) = dy0 dx2 - dx0 dy2.
+    const std::int32_t area = _mm_cvtsi128_si32(
+        _mm_sub_epi32(_mm_mullo_epi32(dy, _mm_shuffle_epi32(dx, _MM_SHUFFLE(2, 2, 2, 2))),
+                      _mm_mullo_epi32(dx, _mm_shuffle_epi32(dy, _MM_SHUFFLE(2, 2, 2, 2)))));
+    if (area == 0) continue;
+    if (area < 0) {
+      // Clockwise: swap vertices 1 and 2; the edges become (-dx2, -dx1, -dx0).
+      X = _mm_shuffle_epi32(X, _MM_SHUFFLE(0, 1, 2, 0));
+      Y = _mm_shuffle_epi32(Y, _MM_SHUFFLE(0, 1, 2, 0));
+      dx = _mm_sub_epi32(_mm_setzero_si128(), _mm_shuffle_epi32(dx, _MM_SHUFFLE(3, 0, 1, 2)));
+      dy = _mm_sub_epi32(_mm_setzero_si128(), _mm_shuffle_epi32(dy, _MM_SHUFFLE(3, 0, 1, 2)));
+    }
+    if (draw == 0) draw = commit_record(rec, basis, tri, texture);
+    // Owned edges (dy > 0, or dy = 0 and dx < 0) keep their ties; the others get bias 1.
+    const __m128i zero_i = _mm_setzero_si128();
+    const __m128i owned = _mm_or_si128(_mm_cmpgt_epi32(dy, zero_i),
+                                       _mm_and_si128(_mm_cmpeq_epi32(dy, zero_i), _mm_cmplt_epi32(dx, zero_i)));
+    const __m128i ox = _mm_set1_epi32(static_cast<std::int32_t>(x_begin * sub_one + sub_half));
+    const __m128i oy = _mm_set1_epi32(static_cast<std::int32_t>(y_begin * sub_one + sub_half));
+    alignas(16) std::int32_t base[4], sx[4], sy[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(base),
+                    _mm_add_epi32(_mm_sub_epi32(_mm_mullo_epi32(dx, _mm_sub_epi32(oy, Y)),
+                                                _mm_mullo_epi32(dy, _mm_sub_epi32(ox, X))),
+                                  _mm_xor_si128(owned, _mm_set1_epi32(-1))));  // -(owned ? 0 : 1)
+    _mm_store_si128(reinterpret_cast<__m128i*>(sx), _mm_slli_epi32(_mm_sub_epi32(zero_i, dy), sub_bits));
+    _mm_store_si128(reinterpret_cast<__m128i*>(sy), _mm_slli_epi32(dx, sub_bits));
+    fs.prepare(f, n, rec);
+    const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(f));
+    small_triangle_avx2_impl<M == mode::count>(base, sx, sy, x_begin, x_end, y_begin, y_end, n,
+                                               depth_.data() + face_offset, ids_.data() + face_offset,
+                                               M == mode::count ? counts_->data() + face_offset : nullptr, fs.z00,
+                                               fs.dzdy, fs.dzdx, draw);
+  }
+}
+#endif
 
 std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
                                                  const radiance_texture* texture) {
@@ -767,7 +977,6 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
                                       const frame& basis, const scene::triangle& tri,
                                       const radiance_texture* texture) {
   const int n = n_;
-  const int rows = face == 0 ? n : n / 2;
   const float near = near_;
 
   // Clip in homogeneous coordinates.
@@ -819,16 +1028,37 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
     fx[i] = {round_to_int((poly[i].u * iw + 1.0) * scale), round_to_int((poly[i].v * iw + v_offset) * scale)};
   }
 
-  // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
-  // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
-  // Evaluated per row in double, then per texel in float.
-  const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
-  const double inv_k = 1.0 / static_cast<double>(rec.plane);
-  const double step = 2.0 / n;
-  const double u0 = 1.0 / n - 1.0, v0 = face == 0 ? 1.0 / n - 1.0 : 1.0 / n;
-  const auto dzdx = static_cast<float>(nm.u * step * inv_k);
-  const double dzdy = nm.v * step * inv_k;
-  const double z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
+  face_setup fs;
+  // Fan of the clipped polygon.
+  for (int i = 1; i + 1 < count; ++i) {
+    const std::int64_t x[3] = {fx[0].x, fx[i].x, fx[i + 1].x}, y[3] = {fx[0].y, fx[i].y, fx[i + 1].y};
+    draw_fixed<M>(face, x, y, fs, rec, draw, basis, tri, texture);
+  }
+}
+
+template <hemicube_rasterizer::mode M>
+void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
+                                     face_setup& fs, draw_record& rec, std::uint32_t& draw, const frame& basis,
+                                     const scene::triangle& tri, const radiance_texture* texture) {
+  const int n = n_;
+  const int rows = face == 0 ? n : n / 2;
+  fixed_point p[3] = {{px[0], py[0]}, {px[1], py[1]}, {px[2], py[2]}};
+  const std::int64_t area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+  if (area == 0) return;
+  if (area < 0) std::swap(p[1], p[2]);
+  const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
+  const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
+  // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
+  const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
+  const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
+  const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
+  const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
+  if (x_begin > x_end || y_begin > y_end) return;
+  if (draw == 0) draw = commit_record(rec, basis, tri, texture);
+
+  fs.prepare(face, n, rec);
+  const double z00 = fs.z00, dzdy = fs.dzdy;
+  const float dzdx = fs.dzdx;
 
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   float* depth = depth_.data() + face_offset;
@@ -887,143 +1117,141 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
     }
   };
 
-  // Fan of the clipped polygon.
-  for (int i = 1; i + 1 < count; ++i) {
-    fixed_point p[3] = {fx[0], fx[i], fx[i + 1]};
-    std::int64_t area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
-    if (area == 0) continue;
-    if (area < 0) std::swap(p[1], p[2]);
-    const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
-    const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
-    // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
-    const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
-    const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
-    const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
-    const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
-    if (x_begin > x_end || y_begin > y_end) continue;
-    if (draw == 0) draw = commit_record(rec, basis, tri, texture);
-
-    // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
-    // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
-    // d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
-    // texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
-    std::int64_t ex[3], ey[3], e0[3];
-    for (int k = 0; k < 3; ++k) {
-      const fixed_point& a = p[k];
-      const fixed_point& b = p[(k + 1) % 3];
-      const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
-      const bool owned = dy > 0 || (dy == 0 && dx < 0);
-      ex[k] = -dy * sub_one;
-      ey[k] = dx * sub_one;
-      e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
-    }
 
 #if HEMILIGHT_RASTER_AVX2
-    if (avx2_ && max_x - min_x <= avx2_extent && max_y - min_y <= avx2_extent) {
-      // Triangles up to 64 texels across, AVX2: the box is scanned eight texels per step with
-      // 32-bit edge values (see avx2_extent), the coverage mask going straight into the depth
-      // test. Cheaper than the span walk below even for triangles that fill half their box.
-      small_triangle_avx2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
-                                                 dzdy, dzdx, draw);
-      continue;
-    }
-#endif
-#if HEMILIGHT_RASTER_SSE2
-    if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
-      // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
-      // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
-      // additions, and the coverage mask goes straight into the depth test: no span search,
-      // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
-      small_triangle_sse2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
-                                                 dzdy, dzdx, draw);
-      continue;
-    }
-#endif
-    if (x_end - x_begin < 24 && (x_end - x_begin + 1) * (y_end - y_begin + 1) <= 96) {
-      // Small box (most triangles of big scenes): step the edge functions texel by texel
-      // (additions only; a texel is in iff the OR of the three values is not negative) and
-      // write each row's run at once (the triangle is convex: the run is contiguous).
-      std::int64_t row0 = ex[0] * x_begin + ey[0] * y_begin + e0[0];
-      std::int64_t row1 = ex[1] * x_begin + ey[1] * y_begin + e0[1];
-      std::int64_t row2 = ex[2] * x_begin + ey[2] * y_begin + e0[2];
-      for (std::int64_t y = y_begin; y <= y_end; ++y, row0 += ey[0], row1 += ey[1], row2 += ey[2]) {
-        std::int64_t a = row0, b = row1, c = row2;
-        std::int64_t x = x_begin;
-        while (x <= x_end && (a | b | c) < 0) {
-          a += ex[0];
-          b += ex[1];
-          c += ex[2];
-          ++x;
-        }
-        if (x > x_end) continue;
-        const std::int64_t first = x;
-        while (x <= x_end && (a | b | c) >= 0) {
-          a += ex[0];
-          b += ex[1];
-          c += ex[2];
-          ++x;
-        }
-        span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
-      }
-      continue;
-    }
-
-    // Exact incremental spans. Edge k bounds x from the left when ex > 0:
-    // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
-    // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
-    // per row with additions only (a Bresenham-style exact walk).
-    struct walk {
-      int kind;  // +1 left bound, -1 right bound, 0 constant in x
-      std::int64_t bound, rem, m, q_step, r_step, value, value_step;
-    } w[3] = {};
+  if (avx2_ && max_x - min_x <= avx2_extent && max_y - min_y <= avx2_extent) {
+    // Triangles up to 64 texels across, AVX2: the box is scanned eight texels per step with
+    // 32-bit edge values (see avx2_extent), the coverage mask going straight into the depth
+    // test. Cheaper than the span walk below even for triangles that fill half their box.
+    // The edge functions below, taken relative to the box's first texel centre (ox, oy): the
+    // same integers, each term below 2^14 * (2^14 + 2^8), so they fit 32 bits.
+    const std::int64_t ox = x_begin * sub_one + sub_half, oy = y_begin * sub_one + sub_half;
+    std::int32_t base[3], sx[3], sy[3];
     for (int k = 0; k < 3; ++k) {
-      walk& e = w[k];
-      const std::int64_t r = ey[k] * y_begin + e0[k];
-      if (ex[k] > 0) {
-        e.kind = 1;
-        e.m = ex[k];
-        const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
-        e.bound = -floor_div(-num, e.m);
-        e.rem = e.bound * e.m - num;
-        const std::int64_t d = -ey[k];                     // num steps by d per row
-        e.q_step = floor_div(d, e.m);
-        e.r_step = d - e.q_step * e.m;
-      } else if (ex[k] < 0) {
-        e.kind = -1;
-        e.m = -ex[k];
-        e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
-        e.rem = r - e.bound * e.m;
-        e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
-        e.r_step = ey[k] - e.q_step * e.m;
+      const fixed_point& a = p[k];
+      const fixed_point& b = p[k == 2 ? 0 : k + 1];
+      const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
+      const bool owned = dy > 0 || (dy == 0 && dx < 0);
+      sx[k] = static_cast<std::int32_t>(-dy * sub_one);
+      sy[k] = static_cast<std::int32_t>(dx * sub_one);
+      base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - (owned ? 0 : 1));
+    }
+    small_triangle_avx2_impl<M == mode::count>(base, sx, sy, x_begin, x_end, y_begin, y_end, n, depth, ids, counts,
+                                               z00, dzdy, dzdx, draw);
+    return;
+  }
+#endif
+
+  // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
+  // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
+  // d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
+  // texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
+  std::int64_t ex[3], ey[3], e0[3];
+  for (int k = 0; k < 3; ++k) {
+    const fixed_point& a = p[k];
+    const fixed_point& b = p[(k + 1) % 3];
+    const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
+    const bool owned = dy > 0 || (dy == 0 && dx < 0);
+    ex[k] = -dy * sub_one;
+    ey[k] = dx * sub_one;
+    e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - (owned ? 0 : 1);
+  }
+
+#if HEMILIGHT_RASTER_SSE2
+  if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
+    // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
+    // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
+    // additions, and the coverage mask goes straight into the depth test: no span search,
+    // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
+    small_triangle_sse2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                               dzdy, dzdx, draw);
+    return;
+  }
+#endif
+  if (x_end - x_begin < 24 && (x_end - x_begin + 1) * (y_end - y_begin + 1) <= 96) {
+    // Small box (most triangles of big scenes): step the edge functions texel by texel
+    // (additions only; a texel is in iff the OR of the three values is not negative) and
+    // write each row's run at once (the triangle is convex: the run is contiguous).
+    std::int64_t row0 = ex[0] * x_begin + ey[0] * y_begin + e0[0];
+    std::int64_t row1 = ex[1] * x_begin + ey[1] * y_begin + e0[1];
+    std::int64_t row2 = ex[2] * x_begin + ey[2] * y_begin + e0[2];
+    for (std::int64_t y = y_begin; y <= y_end; ++y, row0 += ey[0], row1 += ey[1], row2 += ey[2]) {
+      std::int64_t a = row0, b = row1, c = row2;
+      std::int64_t x = x_begin;
+      while (x <= x_end && (a | b | c) < 0) {
+        a += ex[0];
+        b += ex[1];
+        c += ex[2];
+        ++x;
+      }
+      if (x > x_end) continue;
+      const std::int64_t first = x;
+      while (x <= x_end && (a | b | c) >= 0) {
+        a += ex[0];
+        b += ex[1];
+        c += ex[2];
+        ++x;
+      }
+      span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
+    }
+    return;
+  }
+
+  // Exact incremental spans. Edge k bounds x from the left when ex > 0:
+  // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
+  // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
+  // per row with additions only (a Bresenham-style exact walk).
+  struct walk {
+    int kind;  // +1 left bound, -1 right bound, 0 constant in x
+    std::int64_t bound, rem, m, q_step, r_step, value, value_step;
+  } w[3] = {};
+  for (int k = 0; k < 3; ++k) {
+    walk& e = w[k];
+    const std::int64_t r = ey[k] * y_begin + e0[k];
+    if (ex[k] > 0) {
+      e.kind = 1;
+      e.m = ex[k];
+      const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
+      e.bound = -floor_div(-num, e.m);
+      e.rem = e.bound * e.m - num;
+      const std::int64_t d = -ey[k];                     // num steps by d per row
+      e.q_step = floor_div(d, e.m);
+      e.r_step = d - e.q_step * e.m;
+    } else if (ex[k] < 0) {
+      e.kind = -1;
+      e.m = -ex[k];
+      e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
+      e.rem = r - e.bound * e.m;
+      e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
+      e.r_step = ey[k] - e.q_step * e.m;
+    } else {
+      e.kind = 0;
+      e.value = r;
+      e.value_step = ey[k];
+    }
+  }
+  for (std::int64_t y = y_begin; y <= y_end; ++y) {
+    std::int64_t lo = x_begin, hi = x_end;
+    for (walk& e : w) {
+      // The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
+      if (e.kind > 0) {
+        lo = std::max(lo, e.bound);
+        e.rem -= e.r_step;
+        const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
+        e.bound += e.q_step - carry;
+        e.rem += carry & e.m;
+      } else if (e.kind < 0) {
+        hi = std::min(hi, e.bound);
+        e.rem += e.r_step - e.m;
+        const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
+        e.bound += e.q_step + 1 + keep;
+        e.rem += keep & e.m;
       } else {
-        e.kind = 0;
-        e.value = r;
-        e.value_step = ey[k];
+        if (e.value < 0) hi = lo - 1;
+        e.value += e.value_step;
       }
     }
-    for (std::int64_t y = y_begin; y <= y_end; ++y) {
-      std::int64_t lo = x_begin, hi = x_end;
-      for (walk& e : w) {
-        // The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
-        if (e.kind > 0) {
-          lo = std::max(lo, e.bound);
-          e.rem -= e.r_step;
-          const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
-          e.bound += e.q_step - carry;
-          e.rem += carry & e.m;
-        } else if (e.kind < 0) {
-          hi = std::min(hi, e.bound);
-          e.rem += e.r_step - e.m;
-          const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
-          e.bound += e.q_step + 1 + keep;
-          e.rem += keep & e.m;
-        } else {
-          if (e.value < 0) hi = lo - 1;
-          e.value += e.value_step;
-        }
-      }
-      if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
-    }
+    if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
   }
 }
 

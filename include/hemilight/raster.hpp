@@ -218,6 +218,15 @@ class alignas(64) hemicube_rasterizer {
                    const scene::triangle& tri, const radiance_texture* texture);
   std::uint32_t commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
                               const radiance_texture* texture);
+  struct face_setup;  // per (triangle, face) pair: the depth plane (raster.cpp)
+  template <mode M>
+  void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
+                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
+                  const radiance_texture* texture);
+  struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
+  template <mode M>
+  void draw_triangle_avx2(const scene::triangle& tri, unsigned face_mask, const simd_frame& sf, const frame& basis,
+                          const radiance_texture* texture);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;

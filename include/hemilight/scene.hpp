@@ -142,7 +142,7 @@ class scene {
   const std::vector<bvh_node>& bvh() const noexcept { return nodes_; }
 
   /// Largest number of triangles in a BVH leaf.
-  static constexpr std::uint32_t max_leaf_triangles = 4;
+  static constexpr std::uint32_t max_leaf_triangles = 8;
 
  private:
   scene() = default;
