@@ -711,3 +711,52 @@ TEST_CASE("raster: culling of small far nodes between texel centres changes no t
   INFO("triangles above the tangent plane " << above << ", tested " << r.statistics().triangles_tested);
   CHECK(r.statistics().triangles_tested < above * 8 / 10);
 }
+
+TEST_CASE("raster: edges through texel centres (exact ties) give the same coverage on every path", "[raster]") {
+  // A plane z = 1 seen straight up at N = 256: a vertex at u = (2k + 1) / N - 1 projects exactly
+  // onto the centre of texel column k (every step is exact in float and in the fixed point), so
+  // the grid's edges and the cells' diagonals pass through texel centres: every tie of the
+  // top-left rule is exercised. Cells of 37 texels go through the small-triangle kernels, cells of
+  // 100 texels through the big-triangle ones. The mesh covers the whole top face, so each of its
+  // texels must be covered exactly once, and every path must agree with the scalar reference.
+  const int n = 256;
+  for (const int cell : {37, 100}) {
+    scene_mesh m;
+    const material grey{{0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, false};  // emission, albedo
+    const auto at = [&](int k) { return static_cast<float>(2 * k + 1) / static_cast<float>(n) - 1.0f; };
+    const int first = -2 * cell, last = n + 2 * cell;
+    for (int j = first; j < last; j += cell)
+      for (int i = first; i < last; i += cell) {
+        const glm::vec3 a(at(i), at(j), 1.0f), b(at(i + cell), at(j), 1.0f), c(at(i + cell), at(j + cell), 1.0f),
+            d(at(i), at(j + cell), 1.0f);
+        // Facing down (towards the point); the diagonal alternates between the cells.
+        if (((i - first) / cell + (j - first) / cell) % 2)
+          m.add_quad(a, d, c, b, grey);
+        else
+          m.add_quad(b, a, d, c, grey);
+      }
+    const auto s = scene::create(m.desc());
+    raster_options scalar, sse2;
+    scalar.simd = false;
+    sse2.avx2 = false;
+    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar);
+    const frame f{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    std::vector<std::uint32_t> ca, cb, cc;
+    best.render_coverage({0, 0, 0}, f, n, ca);
+    sse2_only.render_coverage({0, 0, 0}, f, n, cb);
+    reference.render_coverage({0, 0, 0}, f, n, cc);
+    INFO("cell " << cell);
+    CHECK(ca == cc);
+    CHECK(cb == cc);
+    std::size_t once = 0;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(n) * n; ++i) once += cc[i] == 1 ? 1u : 0u;  // top face first
+    CHECK(once == static_cast<std::size_t>(n) * n);
+    hemicube_buffer a, c;
+    best.render({0, 0, 0}, f, n, a);
+    reference.render({0, 0, 0}, f, n, c);
+    CHECK(std::memcmp(a.distance.data(), c.distance.data(), a.distance.size() * sizeof(float)) == 0);
+    std::size_t same_triangle = 0;
+    for (std::size_t i = 0; i < a.texel_count(); ++i) same_triangle += best.seen_triangle(i) == reference.seen_triangle(i);
+    CHECK(same_triangle == a.texel_count());
+  }
+}
