@@ -177,6 +177,42 @@ struct fixed_point {
   std::int64_t x, y;
 };
 
+// One edge of the exact span walk: the bound on x (left: x >= bound, right: x <= bound) of the
+// current row as quotient and remainder, and their steps per row (see draw_fixed).
+struct edge_walk {
+  std::int64_t bound, rem, m, q_step, r_step;
+};
+
+// Rows y0..y1 of the exact span walk with NL left and NR right edges; span(y, lo, hi) writes a
+// row. The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
+template <std::size_t NL, std::size_t NR, class Span>
+inline void walk_rows(const edge_walk* left_in, const edge_walk* right_in, std::int64_t y0, std::int64_t y1,
+                      std::int64_t x_begin, std::int64_t x_end, Span& span) {
+  edge_walk left[NL], right[NR];
+  std::copy(left_in, left_in + NL, left);
+  std::copy(right_in, right_in + NR, right);
+  for (std::int64_t y = y0; y <= y1; ++y) {
+    std::int64_t lo = x_begin, hi = x_end;
+    for (std::size_t i = 0; i < NL; ++i) {
+      edge_walk& e = left[i];
+      lo = std::max(lo, e.bound);
+      e.rem -= e.r_step;
+      const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
+      e.bound += e.q_step - carry;
+      e.rem += carry & e.m;
+    }
+    for (std::size_t i = 0; i < NR; ++i) {
+      edge_walk& e = right[i];
+      hi = std::min(hi, e.bound);
+      e.rem += e.r_step - e.m;
+      const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
+      e.bound += e.q_step + 1 + keep;
+      e.rem += keep & e.m;
+    }
+    if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
+  }
+}
+
 #if HEMILIGHT_RASTER_SSE2
 // Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
 constexpr std::int64_t simd_extent = 32 * sub_one;
@@ -1200,16 +1236,26 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   // Exact incremental spans. Edge k bounds x from the left when ex > 0:
   // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
   // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
-  // per row with additions only (a Bresenham-style exact walk).
-  struct walk {
-    int kind;  // +1 left bound, -1 right bound, 0 constant in x
-    std::int64_t bound, rem, m, q_step, r_step, value, value_step;
-  } w[3] = {};
+  // per row with additions only (a Bresenham-style exact walk, walk_rows). A horizontal edge
+  // (ex = 0) bounds the rows instead: ey y + e0 >= 0.
+  std::int64_t y_first = y_begin, y_last = y_end;
   for (int k = 0; k < 3; ++k) {
-    walk& e = w[k];
-    const std::int64_t r = ey[k] * y_begin + e0[k];
+    if (ex[k] != 0) continue;
+    if (ey[k] > 0) {
+      y_first = std::max(y_first, -floor_div(e0[k], ey[k]));  // ceil(-e0 / ey)
+    } else if (ey[k] < 0) {
+      y_last = std::min(y_last, floor_div(e0[k], -ey[k]));
+    } else if (e0[k] < 0) {
+      return;  // a zero-length edge (not reached: such triangles have no area)
+    }
+  }
+  if (y_first > y_last) return;
+  edge_walk left[3], right[3];
+  int nl = 0, nr = 0;
+  for (int k = 0; k < 3; ++k) {
+    const std::int64_t r = ey[k] * y_first + e0[k];
     if (ex[k] > 0) {
-      e.kind = 1;
+      edge_walk& e = left[nl++];
       e.m = ex[k];
       const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
       e.bound = -floor_div(-num, e.m);
@@ -1218,41 +1264,24 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
       e.q_step = floor_div(d, e.m);
       e.r_step = d - e.q_step * e.m;
     } else if (ex[k] < 0) {
-      e.kind = -1;
+      edge_walk& e = right[nr++];
       e.m = -ex[k];
       e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
       e.rem = r - e.bound * e.m;
       e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
       e.r_step = ey[k] - e.q_step * e.m;
-    } else {
-      e.kind = 0;
-      e.value = r;
-      e.value_step = ey[k];
     }
   }
-  for (std::int64_t y = y_begin; y <= y_end; ++y) {
-    std::int64_t lo = x_begin, hi = x_end;
-    for (walk& e : w) {
-      // The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
-      if (e.kind > 0) {
-        lo = std::max(lo, e.bound);
-        e.rem -= e.r_step;
-        const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
-        e.bound += e.q_step - carry;
-        e.rem += carry & e.m;
-      } else if (e.kind < 0) {
-        hi = std::min(hi, e.bound);
-        e.rem += e.r_step - e.m;
-        const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
-        e.bound += e.q_step + 1 + keep;
-        e.rem += keep & e.m;
-      } else {
-        if (e.value < 0) hi = lo - 1;
-        e.value += e.value_step;
-      }
-    }
-    if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
-  }
+  // A triangle with area has a left and a right bound: (1, 1) with a horizontal edge, else
+  // (1, 2) or (2, 1). Fixed counts keep the walk in registers.
+  if (nl == 1 && nr == 1)
+    walk_rows<1, 1>(left, right, y_first, y_last, x_begin, x_end, span);
+  else if (nl == 1 && nr == 2)
+    walk_rows<1, 2>(left, right, y_first, y_last, x_begin, x_end, span);
+  else if (nl == 2 && nr == 1)
+    walk_rows<2, 1>(left, right, y_first, y_last, x_begin, x_end, span);
+  else
+    assert(false && "a triangle with area has a left and a right edge");
 }
 
 void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
