@@ -672,6 +672,9 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
   const glm::vec3 scale = glm::max(glm::abs(centre), glm::abs(position));
   const float radius = 0.5f * glm::length(node.hi - node.lo) + 1e-6f * (scale.x + scale.y + scale.z);
   const float n = static_cast<float>(n_);
+  // Every face's test below needs radius * n <= 4 w, and w <= |c| on every face: a node that big
+  // for its distance (all nodes of a room around the point) is kept without the per-face work.
+  if (radius * n > 4.0f * (std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z))) return mask;
   const float margin = 0.02f;
   for (int f = 0; f < 5; ++f) {
     if (!(mask >> f & 1u)) continue;
