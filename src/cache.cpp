@@ -137,6 +137,70 @@ class record_bvh {
   std::vector<glm::vec3> lo_, hi_;
 };
 
+// A uniform grid over the points (cells in CSR order), built once: which points lie in a
+// sphere. Placement uses it to find the points whose coverage a new or shrunk record can change.
+class point_grid {
+ public:
+  void build(const glm::vec3* p, std::size_t count) {
+    lo_ = glm::vec3(std::numeric_limits<float>::max());
+    glm::vec3 hi(-std::numeric_limits<float>::max());
+    for (std::size_t i = 0; i < count; ++i) {
+      lo_ = glm::min(lo_, p[i]);
+      hi = glm::max(hi, p[i]);
+    }
+    p_ = p;
+    const glm::vec3 ext = count ? glm::max(hi - lo_, glm::vec3(0.0f)) : glm::vec3(0.0f);
+    // About one cell per point over the box (points on surfaces fill few cells), at most 4 count + 64.
+    float cell = std::cbrt(std::max(ext.x * ext.y * ext.z, 0.0f) / float(std::max<std::size_t>(count, 1)));
+    cell = std::max({cell, 1e-3f * std::max({ext.x, ext.y, ext.z}), 1e-30f});
+    for (;;) {
+      dims_ = glm::ivec3(glm::min(glm::floor(ext / cell), glm::vec3(1023.0f))) + 1;
+      if (double(dims_.x) * dims_.y * dims_.z <= 4.0 * double(count) + 64.0) break;
+      cell *= 1.25f;
+    }
+    inv_cell_ = 1.0f / cell;
+    const std::size_t cells = std::size_t(dims_.x) * std::size_t(dims_.y) * std::size_t(dims_.z);
+    start_.assign(cells + 1, 0u);
+    for (std::size_t i = 0; i < count; ++i) ++start_[cell_index(cell_of(p[i])) + 1];
+    for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+    points_.resize(count);
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < count; ++i) points_[fill[cell_index(cell_of(p[i]))]++] = static_cast<std::uint32_t>(i);
+  }
+
+  // Calls f(i) for every point i with |p_i - c| <= r.
+  template <class F>
+  void for_each_in_sphere(const glm::vec3& c, float r, F&& f) const {
+    if (points_.empty()) return;
+    const glm::ivec3 a = cell_of(c - glm::vec3(r)), b = cell_of(c + glm::vec3(r));
+    const float r2 = r * r;
+    for (int z = a.z; z <= b.z; ++z)
+      for (int y = a.y; y <= b.y; ++y)
+        for (int x = a.x; x <= b.x; ++x) {
+          const std::size_t cell = cell_index({x, y, z});
+          for (std::uint32_t k = start_[cell]; k < start_[cell + 1]; ++k) {
+            const glm::vec3 d = p_[points_[k]] - c;
+            if (glm::dot(d, d) <= r2) f(points_[k]);
+          }
+        }
+  }
+
+ private:
+  glm::ivec3 cell_of(const glm::vec3& q) const {
+    const glm::vec3 t = glm::clamp((q - lo_) * inv_cell_, glm::vec3(0.0f), glm::vec3(dims_ - 1));
+    return glm::ivec3(t);  // NaN-free: the clamp of a finite point
+  }
+  std::size_t cell_index(const glm::ivec3& q) const {
+    return (std::size_t(q.z) * std::size_t(dims_.y) + std::size_t(q.y)) * std::size_t(dims_.x) + std::size_t(q.x);
+  }
+
+  const glm::vec3* p_ = nullptr;
+  glm::vec3 lo_{0.0f};
+  float inv_cell_ = 1.0f;
+  glm::ivec3 dims_{1};
+  std::vector<std::uint32_t> start_, points_;
+};
+
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
@@ -483,6 +547,14 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   // Per point: 0 = open, 1 = inside geometry (an invalid sample there or near one).
   std::vector<std::uint8_t> inside(count, 0);
   std::vector<std::uint8_t> covered(count, 0);
+  // Coverage is re-checked only where it can have changed: open points, points in the coverage
+  // sphere of a record added or shrunk in the last round (dirty), and points whose check leaned
+  // on floor_e (fragile), which moves as records are added. Every other point is covered by the
+  // same records with the same radii as when it was checked, so its answer stands.
+  std::vector<std::uint8_t> dirty(count, 0), fragile(count, 0);
+  point_grid grid_of_points;
+  grid_of_points.build(positions, count);
+  std::vector<float> old_radius;
   std::vector<std::uint64_t> order_key(count);
   for (std::size_t i = 0; i < count; ++i) order_key[i] = mix(i);
   std::vector<std::size_t> order(count);
@@ -507,16 +579,22 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
     }
     parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
-        if (inside[i]) continue;
+        if (inside[i] || (covered[i] && !dirty[i] && !fragile[i])) continue;
         glm::vec3 value;
         float spread = 0.0f;
         bool own = false;
         const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own);
         bool ok = w > 0.0f;
-        if (ok && o.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e);
+        bool leans_on_floor = false;
+        if (ok && o.refine_disagreement && !own) {
+          ok = spread <= a * std::max(luminance(value), floor_e);
+          leans_on_floor = ok && spread > a * luminance(value);
+        }
         covered[i] = ok ? 1 : 0;
+        fragile[i] = leans_on_floor ? 1 : 0;
       }
     });
+    std::fill(dirty.begin(), dirty.end(), std::uint8_t(0));
     std::size_t open = 0;
     for (std::size_t i = 0; i < count; ++i) open += (!covered[i] && !inside[i]) ? 1u : 0u;
     report(1.0f - float(open) / float(count));
@@ -571,6 +649,8 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 
     // 4. New records in seed order, with their radius limits.
     const std::size_t first_new = records.size();
+    old_radius.resize(first_new);
+    for (std::size_t j = 0; j < first_new; ++j) old_radius[j] = records[j].radius;
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
       const cache_sample& s = samples[k];
@@ -652,6 +732,16 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
           }
         }
       }
+    }
+    // Points whose coverage this round's records can have changed (a shrunk record's old
+    // sphere holds its new one).
+    for (std::size_t j = 0; j < records.size(); ++j) {
+      const bool added = j >= first_new;
+      if (!added && records[j].radius == old_radius[j]) continue;
+      const float r = coverage_radius(records[j], o);
+      const float reach = added ? r : std::max(r, a * old_radius[j]);
+      // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
+      grid_of_points.for_each_in_sphere(records[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
     }
     bvh.build(records, o);
     ++stats.rounds;

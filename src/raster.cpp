@@ -984,25 +984,40 @@ std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& 
                                                  const radiance_texture* texture) {
   const material& m = scene_->triangle_material(tri.index);
   const bool back = rec.plane > 0.0f && !m.two_sided;
-  rec.flags = back ? texel_back_face : texel_hit_front;
-  rec.radiance = back ? glm::vec3(0.0f) : m.emission;
-  rec.textured = !back && texture && scene_->has_lightmap_uvs();
-  if (rec.textured) {
+  const auto draw = static_cast<std::uint32_t>(draws_.size());
+  // The geometry is copied and the shading written in place (and the shade field by field):
+  // building a record or a shade with narrow stores and copying it whole stalls on store
+  // forwarding, which cost more than the rest of this function.
+  draws_.push_back(rec);
+  draw_record& d = draws_.back();
+  const glm::vec3 radiance = back ? glm::vec3(0.0f) : m.emission;
+  const std::uint8_t flags = back ? texel_back_face : texel_hit_front;
+  d.flags = flags;
+  d.radiance = radiance;
+  d.textured = !back && texture && scene_->has_lightmap_uvs();
+  if (d.textured) {
     const glm::vec3 le1 = basis.to_local(tri.v1 - tri.v0), le2 = basis.to_local(tri.v2 - tri.v0);
     const float nn = glm::dot(rec.normal, rec.normal);
-    rec.grad_b1 = glm::cross(le2, rec.normal) / nn;
-    rec.grad_b2 = glm::cross(rec.normal, le1) / nn;
+    d.grad_b1 = glm::cross(le2, rec.normal) / nn;
+    d.grad_b2 = glm::cross(rec.normal, le1) / nn;
   }
-  const auto draw = static_cast<std::uint32_t>(draws_.size());
-  draws_.push_back(rec);
-  const shade sh{rec.radiance.x, rec.radiance.y, rec.radiance.z, rec.flags};
-  shades_.push_back(sh);
+  shades_.emplace_back();
+  shade& sh = shades_.back();
+  sh.r = radiance.x;
+  sh.g = radiance.y;
+  sh.b = radiance.z;
+  sh.flags = flags;
   // Shade key: an earlier record with the same bits, if the cache remembers one.
-  std::uint32_t bits[4];
-  std::memcpy(bits, &sh, sizeof bits);
-  const std::uint32_t h = (bits[0] * 0x9e3779b1u) ^ (bits[1] * 0x85ebca77u) ^ (bits[2] * 0xc2b2ae3du) ^ bits[3];
+  const auto bits = [](float v) {
+    std::uint32_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+  };
+  const std::uint32_t r = bits(radiance.x), g = bits(radiance.y), b = bits(radiance.z);
+  const std::uint32_t h = (r * 0x9e3779b1u) ^ (g * 0x85ebca77u) ^ (b * 0xc2b2ae3du) ^ flags;
   std::uint32_t& slot = shade_cache_[(h >> 26) & 63u];
-  if (slot != 0 && std::memcmp(&shades_[slot], &sh, sizeof sh) == 0) {
+  const shade& old = shades_[slot];  // slot 0 (the sky) never matches: it is never stored below
+  if (slot != 0 && bits(old.r) == r && bits(old.g) == g && bits(old.b) == b && old.flags == flags) {
     shade_keys_.push_back(slot);
   } else {
     slot = draw;
