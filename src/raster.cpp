@@ -631,6 +631,8 @@ void hemicube_rasterizer::prepare(int resolution) {
       directions_[i] = glm::vec3(glm::normalize(d));
     }
     n_ = resolution;
+    texel_step_ = 2.0 / resolution;
+    first_centre_ = 1.0 / resolution - 1.0;
   }
   // Padded by 8 texels: the AVX2 kernels may load and store back up to 7 texels past a row's end.
   // The resolve clears what it reads, so after a render the buffer is already zero.
@@ -714,15 +716,16 @@ struct hemicube_rasterizer::face_setup {
   double z00 = 0.0, dzdy = 0.0;
   float dzdx = 0.0f;
 
-  void prepare(int face, int n, const draw_record& rec) noexcept {
+  // step = 2 / N, u0 = 1 / N - 1: the texel pitch and the first texel centre in face units
+  // (hemicube_rasterizer::prepare computes them once per resolution).
+  void prepare(int face, double step, double u0, const draw_record& rec) noexcept {
     if (ready) return;
     // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
     // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
     // Evaluated per row in double, then per texel in float.
     const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
     const double inv_k = 1.0 / static_cast<double>(rec.plane);
-    const double step = 2.0 / n;
-    const double u0 = 1.0 / n - 1.0, v0 = face == 0 ? 1.0 / n - 1.0 : 1.0 / n;
+    const double v0 = face == 0 ? u0 : 0.5 * step;  // side faces: rows start at v = 0
     dzdx = static_cast<float>(nm.u * step * inv_k);
     dzdy = nm.v * step * inv_k;
     z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
@@ -970,7 +973,7 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_triangle_avx2(const scene::
                                   _mm_xor_si128(owned, _mm_set1_epi32(-1))));  // -(owned ? 0 : 1)
     _mm_store_si128(reinterpret_cast<__m128i*>(sx), _mm_slli_epi32(_mm_sub_epi32(zero_i, dy), sub_bits));
     _mm_store_si128(reinterpret_cast<__m128i*>(sy), _mm_slli_epi32(dx, sub_bits));
-    fs.prepare(f, n, rec);
+    fs.prepare(f, texel_step_, first_centre_, rec);
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(f));
     small_triangle_avx2_impl<M == mode::count>(base, sx, sy, x_begin, x_end, y_begin, y_end, n,
                                                depth_.data() + face_offset, ids_.data() + face_offset,
@@ -1110,7 +1113,7 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   if (x_begin > x_end || y_begin > y_end) return;
   if (draw == 0) draw = commit_record(rec, basis, tri, texture);
 
-  fs.prepare(face, n, rec);
+  fs.prepare(face, texel_step_, first_centre_, rec);
   const double z00 = fs.z00, dzdy = fs.dzdy;
   const float dzdx = fs.dzdx;
 

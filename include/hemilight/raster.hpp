@@ -235,6 +235,7 @@ class alignas(64) hemicube_rasterizer {
   bool depth_clear_ = false;  // depth_ is all zero (the last render's resolve cleared it)
   std::shared_ptr<const cubemap> sky_;
   int n_ = 0;
+  double texel_step_ = 0.0, first_centre_ = 0.0;  // 2 / N and 1 / N - 1 (face units)
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
   std::vector<std::uint32_t> ids_;     // draw record of the nearest fragment per texel (0 = none)
   std::vector<std::uint32_t>* counts_ = nullptr;
