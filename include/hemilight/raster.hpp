@@ -52,7 +52,11 @@
 // used by one thread at a time. N threads = N rasterizers, no locks.
 //
 // SIMD. Two kernel sets, both bit-identical to the scalar reference path (tested):
-//   - AVX2 (picked at run time where the CPU has it; GCC/Clang on x86-64): triangles up to 64
+//   - AVX2 (picked at run time where the CPU has it; GCC/Clang on x86-64): each triangle is set
+//     up in vector registers (its three vertices and its normal moved to the local frame in one
+//     register per axis, the face tests, clip codes and the double-precision projection of the
+//     three vertices at once, the edge functions of small triangles in 32-bit lanes) with the
+//     same float and integer operations as the scalar path; triangles up to 64
 //     texels across are scanned over their box eight texels at a time with 32-bit edge values,
 //     the coverage mask going straight into the depth test; longer spans are depth-tested eight
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
