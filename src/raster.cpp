@@ -734,11 +734,34 @@ struct hemicube_rasterizer::face_setup {
 };
 
 #if HEMILIGHT_RASTER_AVX2
-// The position and the frame's axes, broadcast once per render for draw_triangle_avx2.
+// The position and the frame's axes, broadcast once per render for draw_leaf_avx2.
 struct hemicube_rasterizer::simd_frame {
-  __m128 p;                 // (x, y, z, 0)
-  __m128 t[3], b[3], n[3];  // each component of t, b, n in all four lanes
+  __m256 p[3];              // each component of the position in all eight lanes
+  __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
+
+  HEMILIGHT_TARGET_AVX2 void set(const glm::vec3& position, const frame& basis) noexcept {
+    for (int k = 0; k < 3; ++k) {
+      p[k] = _mm256_set1_ps(position[k]);
+      t[k] = _mm256_set1_ps(basis.t[k]);
+      b[k] = _mm256_set1_ps(basis.b[k]);
+      n[k] = _mm256_set1_ps(basis.n[k]);
+    }
+  }
 };
+
+namespace {
+// frame::to_local's dot(w, axis) = (w.x axis.x + w.y axis.y) + w.z axis.z, eight lanes.
+HEMILIGHT_TARGET_AVX2 inline __m256 dot8(const __m256 (&w)[3], const __m256 (&axis)[3]) noexcept {
+  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w[0], axis[0]), _mm256_mul_ps(w[1], axis[1])),
+                       _mm256_mul_ps(w[2], axis[2]));
+}
+HEMILIGHT_TARGET_AVX2 inline __m256 negative8(__m256 m) noexcept {
+  return _mm256_cmp_ps(m, _mm256_setzero_ps(), _CMP_LT_OQ);
+}
+HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
+  return _mm256_cmp_ps(m, _mm256_setzero_ps(), _CMP_GT_OQ);
+}
+}  // namespace
 
 #endif
 
@@ -749,12 +772,7 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
   simd_frame sf;
-  sf.p = _mm_setr_ps(position.x, position.y, position.z, 0.0f);
-  for (int k = 0; k < 3; ++k) {
-    sf.t[k] = _mm_set1_ps(basis.t[k]);
-    sf.b[k] = _mm_set1_ps(basis.b[k]);
-    sf.n[k] = _mm_set1_ps(basis.n[k]);
-  }
+  if (avx2_) sf.set(position, basis);
 #endif
   // Stack entries: node index (low 27 bits are plenty: 2^31 triangles need < 2^29 nodes, so the
   // face mask travels in a second word).
@@ -780,7 +798,8 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
     }
 #if HEMILIGHT_RASTER_AVX2
     if (avx2_) {
-      for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle_avx2<M>(tris[node.first + k], mask, sf, basis, texture);
+      for (std::uint32_t k = 0; k < node.count; k += 8)
+        draw_leaf_avx2<M>(tris.data() + node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis, texture);
       continue;
     }
 #endif
@@ -820,32 +839,121 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
 }
 
 #if HEMILIGHT_RASTER_AVX2
-// draw_triangle for the AVX2 path: the same results, bit for bit (the same float operations on
-// the same values, in the same order; tested against the scalar path), computed for the three
-// vertices at once. Lanes 0-2 hold the vertices, lane 3 the triangle's normal: moved to the
-// local frame together, and the normal's face coordinates come with every face's swizzle.
+// draw_triangle for the AVX2 path, up to eight triangles at a time (a BVH leaf): the same results,
+// bit for bit (the same float operations on the same values, in the same order; tested against
+// the scalar path). Lane j holds triangle j: its vertices and normal are moved to the local frame
+// and tested against the five faces together; each triangle that survives then goes through
+// draw_faces_avx2, in leaf order (the draw order of the scalar path).
 template <hemicube_rasterizer::mode M>
-HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_triangle_avx2(const scene::triangle& tri, unsigned face_mask,
-                                                                   const simd_frame& sf, const frame& basis,
-                                                                   const radiance_texture* texture) {
-  ++stats_.triangles_tested;
-  // v0, v1, v2 are 9 consecutive floats (then the index): three overlapping loads, lane 3 cleared.
-  const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
-  const float* v = &tri.v0.x;
-  const __m128 a0 = _mm_and_ps(_mm_loadu_ps(v), xyz), a1 = _mm_and_ps(_mm_loadu_ps(v + 3), xyz);
-  const __m128 a2 = _mm_and_ps(_mm_loadu_ps(v + 6), xyz);
+HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count,
+                                                               unsigned face_mask, const simd_frame& sf,
+                                                               const frame& basis, const radiance_texture* texture) {
+  static_assert(sizeof(scene::triangle) == 10 * sizeof(float), "v0, v1, v2 and the index: ten 4-byte words");
+  stats_.triangles_tested += count;
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), lane);
+  // Word offsets of each lane's triangle (lanes past the end repeat triangle 0).
+  const __m256i base = _mm256_mullo_epi32(_mm256_and_si256(lane, live), _mm256_set1_epi32(10));
+  const float* words = &tris->v0.x;
+  __m256 v[3][3];  // v[vertex][axis], world
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) v[i][k] = _mm256_i32gather_ps(words, _mm256_add_epi32(base, _mm256_set1_epi32(3 * i + k)), 4);
   // World edges and their cross product (glm::cross's operations: x.y y.z - y.y x.z, ...).
-  const __m128 e1 = _mm_sub_ps(a1, a0), e2 = _mm_sub_ps(a2, a0);
-  const __m128 c = _mm_sub_ps(
-      _mm_mul_ps(_mm_shuffle_ps(e1, e1, _MM_SHUFFLE(3, 0, 2, 1)), _mm_shuffle_ps(e2, e2, _MM_SHUFFLE(3, 1, 0, 2))),
-      _mm_mul_ps(_mm_shuffle_ps(e2, e2, _MM_SHUFFLE(3, 0, 2, 1)), _mm_shuffle_ps(e1, e1, _MM_SHUFFLE(3, 1, 0, 2))));
-  __m128 d0 = _mm_sub_ps(a0, sf.p), d1 = _mm_sub_ps(a1, sf.p), d2 = _mm_sub_ps(a2, sf.p), d3 = c;
-  _MM_TRANSPOSE4_PS(d0, d1, d2, d3);  // d0 = x of (v0, v1, v2, normal), d1 = y, d2 = z
-  // frame::to_local: dot(w, t) = (w.x t.x + w.y t.y) + w.z t.z.
-  const auto dot = [&](const __m128 (&axis)[3]) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, axis[0]), _mm_mul_ps(d1, axis[1])), _mm_mul_ps(d2, axis[2]));
-  };
-  const __m128 lx = dot(sf.t), ly = dot(sf.b), lz = dot(sf.n);
+  __m256 e1[3], e2[3];
+  for (int k = 0; k < 3; ++k) {
+    e1[k] = _mm256_sub_ps(v[1][k], v[0][k]);
+    e2[k] = _mm256_sub_ps(v[2][k], v[0][k]);
+  }
+  const __m256 c[3] = {_mm256_sub_ps(_mm256_mul_ps(e1[1], e2[2]), _mm256_mul_ps(e2[1], e1[2])),
+                       _mm256_sub_ps(_mm256_mul_ps(e1[2], e2[0]), _mm256_mul_ps(e2[2], e1[0])),
+                       _mm256_sub_ps(_mm256_mul_ps(e1[0], e2[1]), _mm256_mul_ps(e2[0], e1[1]))};
+  // To the local frame (dot8 = frame::to_local's dot). l[i][axis]: vertex i (3: the normal).
+  __m256 l[4][3];
+  for (int i = 0; i < 3; ++i) {
+    const __m256 d[3] = {_mm256_sub_ps(v[i][0], sf.p[0]), _mm256_sub_ps(v[i][1], sf.p[1]),
+                         _mm256_sub_ps(v[i][2], sf.p[2])};
+    l[i][0] = dot8(d, sf.t);
+    l[i][1] = dot8(d, sf.b);
+    l[i][2] = dot8(d, sf.n);
+  }
+  l[3][0] = dot8(c, sf.t);
+  l[3][1] = dot8(c, sf.b);
+  l[3][2] = dot8(c, sf.n);
+  // Faces: rejected when all three vertices lie outside one of the face's frustum planes (the
+  // face_planes of outcode()). With a = x - y, b = x + y, c = z - x, d = z + x, e = z - y,
+  // f = z + y per vertex ("all three < 0" is max < 0, "all three > 0" is min > 0):
+  //   top: c, d, e or f < 0;   +x: a < 0, b < 0, c > 0 or z < 0;   -x: a > 0, b > 0, d > 0 or z < 0;
+  //   +y: a > 0, b < 0, e > 0 or z < 0;   -y: a < 0, b > 0, f > 0 or z < 0.
+  // Each sum is the scalar test's up to an exact negation (x - z = -(z - x)), so the decisions
+  // are the same.
+  __m256 q_max[6], q_min[6];
+  for (int i = 0; i < 3; ++i) {
+    const __m256 x = l[i][0], y = l[i][1], z = l[i][2];
+    const __m256 q[6] = {_mm256_sub_ps(x, y), _mm256_add_ps(x, y), _mm256_sub_ps(z, x),
+                         _mm256_add_ps(z, x), _mm256_sub_ps(z, y), _mm256_add_ps(z, y)};
+    for (int k = 0; k < 6; ++k) {
+      q_max[k] = i == 0 ? q[k] : _mm256_max_ps(q_max[k], q[k]);
+      q_min[k] = i == 0 ? q[k] : _mm256_min_ps(q_min[k], q[k]);
+    }
+  }
+  const __m256 z_max = _mm256_max_ps(_mm256_max_ps(l[0][2], l[1][2]), l[2][2]);
+  const __m256 below = negative8(z_max), a_neg = negative8(q_max[0]), a_pos = positive8(q_min[0]), b_neg = negative8(q_max[1]),
+               b_pos = positive8(q_min[1]);
+  const __m256 out[5] = {
+      _mm256_or_ps(_mm256_or_ps(negative8(q_max[2]), negative8(q_max[3])), _mm256_or_ps(negative8(q_max[4]), negative8(q_max[5]))),
+      _mm256_or_ps(_mm256_or_ps(a_neg, b_neg), _mm256_or_ps(positive8(q_min[2]), below)),
+      _mm256_or_ps(_mm256_or_ps(a_pos, b_pos), _mm256_or_ps(positive8(q_min[3]), below)),
+      _mm256_or_ps(_mm256_or_ps(a_pos, b_neg), _mm256_or_ps(positive8(q_min[4]), below)),
+      _mm256_or_ps(_mm256_or_ps(a_neg, b_pos), _mm256_or_ps(positive8(q_min[5]), below))};
+  unsigned faces_of[8] = {};
+  const unsigned lanes = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(live)));
+  unsigned any = 0;
+  for (int f = 0; f < 5; ++f) {
+    if (!(face_mask >> f & 1u)) continue;
+    const unsigned in = ~static_cast<unsigned>(_mm256_movemask_ps(out[f])) & lanes;
+    any |= in;
+    for (unsigned m = in; m; m &= m - 1) faces_of[__builtin_ctz(m)] |= 1u << f;
+  }
+  if (!any) return;
+  // Per lane: (v0, v1, v2, normal) of each axis as four floats, for draw_faces_avx2.
+  alignas(32) float axis[3][8][4];
+  for (int k = 0; k < 3; ++k) {
+    // A 4 x 8 transpose: rows l[0..3][k] -> eight columns of four.
+    const __m256 t0 = _mm256_unpacklo_ps(l[0][k], l[1][k]), t1 = _mm256_unpackhi_ps(l[0][k], l[1][k]);
+    const __m256 t2 = _mm256_unpacklo_ps(l[2][k], l[3][k]), t3 = _mm256_unpackhi_ps(l[2][k], l[3][k]);
+    const __m256 c0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), c1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    const __m256 c2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), c3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    // c0 = columns 0 and 4, c1 = 1 and 5, c2 = 2 and 6, c3 = 3 and 7 (low and high halves).
+    _mm_store_ps(axis[k][0], _mm256_castps256_ps128(c0));
+    _mm_store_ps(axis[k][1], _mm256_castps256_ps128(c1));
+    _mm_store_ps(axis[k][2], _mm256_castps256_ps128(c2));
+    _mm_store_ps(axis[k][3], _mm256_castps256_ps128(c3));
+    _mm_store_ps(axis[k][4], _mm256_extractf128_ps(c0, 1));
+    _mm_store_ps(axis[k][5], _mm256_extractf128_ps(c1, 1));
+    _mm_store_ps(axis[k][6], _mm256_extractf128_ps(c2, 1));
+    _mm_store_ps(axis[k][7], _mm256_extractf128_ps(c3, 1));
+  }
+  for (unsigned m = any; m; m &= m - 1) {
+    const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
+    draw_faces_avx2<M>(tris[j], faces_of[j], axis[0][j], axis[1][j], axis[2][j], basis, texture);
+  }
+}
+
+// The per-face part of draw_leaf_avx2 for one triangle: lx, ly, lz = the local x, y, z of
+// (v0, v1, v2, normal); faces = the faces it may touch.
+template <hemicube_rasterizer::mode M>
+HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_faces_avx2(const scene::triangle& tri, unsigned faces,
+                                                                const float* lx4, const float* ly4, const float* lz4,
+                                                                const frame& basis, const radiance_texture* texture) {
+  draw_record rec;
+  rec.normal = glm::vec3(lx4[3], ly4[3], lz4[3]);
+  rec.v0 = glm::vec3(lx4[0], ly4[0], lz4[0]);
+  rec.plane = glm::dot(rec.normal, rec.v0);
+  // A plane through the point is seen edge-on: it covers no texel centre.
+  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
+  rec.index = tri.index;
+  const glm::vec3 local[3] = {rec.v0, glm::vec3(lx4[1], ly4[1], lz4[1]), glm::vec3(lx4[2], ly4[2], lz4[2])};
+  const __m128 lx = _mm_load_ps(lx4), ly = _mm_load_ps(ly4), lz = _mm_load_ps(lz4);
   const __m128 sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps();
   // The face coordinates (u, v, w) of to_clip, per face (negation is exact).
   const auto swizzle = [&](int f, __m128& u, __m128& vv, __m128& w) {
@@ -857,35 +965,6 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_triangle_avx2(const scene::
       default: u = lx; vv = lz; w = _mm_xor_ps(ly, sign); break;
     }
   };
-  // Faces: rejected when all three vertices lie outside one of the face's frustum planes. The
-  // face_planes tests of outcode() in face coordinates: w - u, w + u, w - v < 0, and w + v < 0
-  // (top) or v < 0 (sides, below the tangent plane). Each is the scalar test's sum up to an
-  // exact negation or swapped operands, so the decisions are the same.
-  unsigned faces = 0;
-  for (int f = 0; f < 5; ++f) {
-    if (!(face_mask >> f & 1u)) continue;
-    __m128 u, vv, w;
-    swizzle(f, u, vv, w);
-    const int m1 = _mm_movemask_ps(_mm_cmplt_ps(_mm_sub_ps(w, u), zero));
-    const int m2 = _mm_movemask_ps(_mm_cmplt_ps(_mm_add_ps(w, u), zero));
-    const int m3 = _mm_movemask_ps(_mm_cmplt_ps(_mm_sub_ps(w, vv), zero));
-    const int m4 = _mm_movemask_ps(_mm_cmplt_ps(f == 0 ? _mm_add_ps(w, vv) : vv, zero));
-    const int bits = m1 | m2 << 4 | m3 << 8 | m4 << 12;
-    if (!(bits & bits >> 1 & bits >> 2 & 0x1111)) faces |= 1u << f;
-  }
-  if (!faces) return;
-
-  alignas(16) float x4[4], y4[4], z4[4];
-  _mm_store_ps(x4, lx);
-  _mm_store_ps(y4, ly);
-  _mm_store_ps(z4, lz);
-  draw_record rec;
-  rec.normal = glm::vec3(x4[3], y4[3], z4[3]);
-  rec.v0 = glm::vec3(x4[0], y4[0], z4[0]);
-  rec.plane = glm::dot(rec.normal, rec.v0);
-  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
-  rec.index = tri.index;
-  const glm::vec3 local[3] = {rec.v0, glm::vec3(x4[1], y4[1], z4[1]), glm::vec3(x4[2], y4[2], z4[2])};
 
   const double scale = 0.5 * n_ * static_cast<double>(sub_one);
   const __m256d dscale = _mm256_set1_pd(scale), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);

@@ -229,8 +229,11 @@ class alignas(64) hemicube_rasterizer {
                   const radiance_texture* texture);
   struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
   template <mode M>
-  void draw_triangle_avx2(const scene::triangle& tri, unsigned face_mask, const simd_frame& sf, const frame& basis,
-                          const radiance_texture* texture);
+  void draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
+                      const frame& basis, const radiance_texture* texture);
+  template <mode M>
+  void draw_faces_avx2(const scene::triangle& tri, unsigned faces, const float* lx, const float* ly, const float* lz,
+                       const frame& basis, const radiance_texture* texture);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
