@@ -843,7 +843,8 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
 // bit for bit (the same float operations on the same values, in the same order; tested against
 // the scalar path). Lane j holds triangle j: its vertices and normal are moved to the local frame
 // and tested against the five faces together; each triangle that survives then goes through
-// draw_faces_avx2, in leaf order (the draw order of the scalar path).
+// the face stage below, face by face, in leaf order within each face (the scalar path's order
+// for every texel).
 template <hemicube_rasterizer::mode M>
 HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count,
                                                                unsigned face_mask, const simd_frame& sf,
@@ -853,11 +854,11 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), lane);
   // Word offsets of each lane's triangle (lanes past the end repeat triangle 0).
-  const __m256i base = _mm256_mullo_epi32(_mm256_and_si256(lane, live), _mm256_set1_epi32(10));
+  const __m256i word = _mm256_mullo_epi32(_mm256_and_si256(lane, live), _mm256_set1_epi32(10));
   const float* words = &tris->v0.x;
   __m256 v[3][3];  // v[vertex][axis], world
   for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < 3; ++k) v[i][k] = _mm256_i32gather_ps(words, _mm256_add_epi32(base, _mm256_set1_epi32(3 * i + k)), 4);
+    for (int k = 0; k < 3; ++k) v[i][k] = _mm256_i32gather_ps(words, _mm256_add_epi32(word, _mm256_set1_epi32(3 * i + k)), 4);
   // World edges and their cross product (glm::cross's operations: x.y y.z - y.y x.z, ...).
   __m256 e1[3], e2[3];
   for (int k = 0; k < 3; ++k) {
@@ -905,17 +906,25 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
       _mm256_or_ps(_mm256_or_ps(a_pos, b_pos), _mm256_or_ps(positive8(q_min[3]), below)),
       _mm256_or_ps(_mm256_or_ps(a_pos, b_neg), _mm256_or_ps(positive8(q_min[4]), below)),
       _mm256_or_ps(_mm256_or_ps(a_neg, b_pos), _mm256_or_ps(positive8(q_min[5]), below))};
-  unsigned faces_of[8] = {};
   const unsigned lanes = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(live)));
+  // The plane of each triangle (glm::dot(normal, v0)); a plane through the point is seen edge-on
+  // and covers no texel centre (draw_triangle's test: plane != 0 and finite).
+  const __m256 plane = dot8(l[3], l[0]);
+  const __m256 abs_plane = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), plane);
+  const unsigned drawable =
+      lanes & static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(
+                  _mm256_cmp_ps(plane, _mm256_setzero_ps(), _CMP_NEQ_OQ),
+                  _mm256_cmp_ps(abs_plane, _mm256_set1_ps(std::numeric_limits<float>::infinity()), _CMP_LT_OQ))));
+  unsigned in_face[5] = {};
   unsigned any = 0;
   for (int f = 0; f < 5; ++f) {
     if (!(face_mask >> f & 1u)) continue;
-    const unsigned in = ~static_cast<unsigned>(_mm256_movemask_ps(out[f])) & lanes;
-    any |= in;
-    for (unsigned m = in; m; m &= m - 1) faces_of[__builtin_ctz(m)] |= 1u << f;
+    in_face[f] = ~static_cast<unsigned>(_mm256_movemask_ps(out[f])) & drawable;
+    any |= in_face[f];
   }
   if (!any) return;
-  // Per lane: (v0, v1, v2, normal) of each axis as four floats, for draw_faces_avx2.
+
+  // Per lane (v0, v1, v2, normal) of each axis as four floats: the records and the clipping path.
   alignas(32) float axis[3][8][4];
   for (int k = 0; k < 3; ++k) {
     // A 4 x 8 transpose: rows l[0..3][k] -> eight columns of four.
@@ -933,131 +942,180 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
     _mm_store_ps(axis[k][6], _mm256_extractf128_ps(c2, 1));
     _mm_store_ps(axis[k][7], _mm256_extractf128_ps(c3, 1));
   }
+  alignas(32) float plane_of[8];
+  _mm256_store_ps(plane_of, plane);
+  draw_record rec[8];
+  std::uint32_t draw[8] = {};
   for (unsigned m = any; m; m &= m - 1) {
     const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
-    draw_faces_avx2<M>(tris[j], faces_of[j], axis[0][j], axis[1][j], axis[2][j], basis, texture);
+    rec[j].normal = glm::vec3(axis[0][j][3], axis[1][j][3], axis[2][j][3]);
+    rec[j].v0 = glm::vec3(axis[0][j][0], axis[1][j][0], axis[2][j][0]);
+    rec[j].plane = plane_of[j];
+    rec[j].index = tris[j].index;
   }
-}
 
-// The per-face part of draw_leaf_avx2 for one triangle: lx, ly, lz = the local x, y, z of
-// (v0, v1, v2, normal); faces = the faces it may touch.
-template <hemicube_rasterizer::mode M>
-HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_faces_avx2(const scene::triangle& tri, unsigned faces,
-                                                                const float* lx4, const float* ly4, const float* lz4,
-                                                                const frame& basis, const radiance_texture* texture) {
-  draw_record rec;
-  rec.normal = glm::vec3(lx4[3], ly4[3], lz4[3]);
-  rec.v0 = glm::vec3(lx4[0], ly4[0], lz4[0]);
-  rec.plane = glm::dot(rec.normal, rec.v0);
-  // A plane through the point is seen edge-on: it covers no texel centre.
-  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
-  rec.index = tri.index;
-  const glm::vec3 local[3] = {rec.v0, glm::vec3(lx4[1], ly4[1], lz4[1]), glm::vec3(lx4[2], ly4[2], lz4[2])};
-  const __m128 lx = _mm_load_ps(lx4), ly = _mm_load_ps(ly4), lz = _mm_load_ps(lz4);
-  const __m128 sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps();
-  // The face coordinates (u, v, w) of to_clip, per face (negation is exact).
-  const auto swizzle = [&](int f, __m128& u, __m128& vv, __m128& w) {
-    switch (f) {
-      case 0: u = lx; vv = ly; w = lz; break;
-      case 1: u = ly; vv = lz; w = lx; break;
-      case 2: u = _mm_xor_ps(ly, sign); vv = lz; w = _mm_xor_ps(lx, sign); break;
-      case 3: u = _mm_xor_ps(lx, sign); vv = lz; w = ly; break;
-      default: u = lx; vv = lz; w = _mm_xor_ps(ly, sign); break;
-    }
-  };
-
-  const double scale = 0.5 * n_ * static_cast<double>(sub_one);
-  const __m256d dscale = _mm256_set1_pd(scale), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
-  const __m128 near4 = _mm_set1_ps(near_), band = _mm_set1_ps(guard_band);
-  std::uint32_t draw = 0;
+  // Face by face, all lanes at once (faces cover different texels, so only the order within a
+  // face matters, and within a face the lanes are drawn in leaf order, as the scalar path does).
+  const int n = n_;
+  const __m256 sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
+  const __m256 near8 = _mm256_set1_ps(near_), band = _mm256_set1_ps(guard_band);
+  const __m256d one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5), minus_half = _mm256_set1_pd(-0.5);
+  const __m256d dscale = _mm256_set1_pd(0.5 * n * static_cast<double>(sub_one)), zero_d = _mm256_setzero_pd();
+  const __m256i zero_i = _mm256_setzero_si256(), ones_i = _mm256_set1_epi32(-1);
   for (int f = 0; f < 5; ++f) {
-    if (!(faces >> f & 1u)) continue;
-    ++stats_.face_triangles;
-    __m128 u, vv, w;
-    swizzle(f, u, vv, w);
-    // raster_face's clip codes; with any vertex outside a clip plane, raster_face clips.
-    const __m128 gw = _mm_mul_ps(band, w);
-    const __m128 out = _mm_or_ps(
-        _mm_or_ps(_mm_cmplt_ps(_mm_sub_ps(w, near4), zero), _mm_cmplt_ps(_mm_sub_ps(gw, u), zero)),
-        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(_mm_add_ps(gw, u), zero), _mm_cmplt_ps(_mm_sub_ps(gw, vv), zero)),
-                  _mm_cmplt_ps(_mm_add_ps(gw, vv), zero)));
-    if (_mm_movemask_ps(out) & 7) {
-      raster_face<M>(f, local, rec, draw, basis, tri, texture);
-      continue;
+    const unsigned todo = in_face[f];
+    if (!todo) continue;
+    stats_.face_triangles += static_cast<std::size_t>(__builtin_popcount(todo));
+    // to_clip's face coordinates (u, v, w) of the three vertices and the normal (negation is exact).
+    __m256 u[4], vv[4], w[4];
+    for (int i = 0; i < 4; ++i) {
+      const __m256 x = l[i][0], y = l[i][1], z = l[i][2];
+      switch (f) {
+        case 0: u[i] = x; vv[i] = y; w[i] = z; break;
+        case 1: u[i] = y; vv[i] = z; w[i] = x; break;
+        case 2: u[i] = _mm256_xor_ps(y, sign); vv[i] = z; w[i] = _mm256_xor_ps(x, sign); break;
+        case 3: u[i] = _mm256_xor_ps(x, sign); vv[i] = z; w[i] = y; break;
+        default: u[i] = x; vv[i] = z; w[i] = _mm256_xor_ps(y, sign); break;
+      }
     }
-    // raster_face's projection and snapping, four lanes of double: iw = 1 / w,
-    // round((u iw + 1) scale), round((v iw + v_offset) scale), halves away from zero.
-    const __m256d iw = _mm256_div_pd(one, _mm256_cvtps_pd(w));
-    const __m256d xs = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(u), iw), one), dscale);
-    const __m256d ys = _mm256_mul_pd(
-        _mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(vv), iw), _mm256_set1_pd(f == 0 ? 1.0 : 0.0)), dscale);
-    const __m256d zero_d = _mm256_setzero_pd();
-    const __m256d hx = _mm256_blendv_pd(_mm256_xor_pd(half, _mm256_set1_pd(-0.0)), half,
-                                        _mm256_cmp_pd(xs, zero_d, _CMP_GE_OQ));
-    const __m256d hy = _mm256_blendv_pd(_mm256_xor_pd(half, _mm256_set1_pd(-0.0)), half,
-                                        _mm256_cmp_pd(ys, zero_d, _CMP_GE_OQ));
-    // Vertices (x0, x1, x2, x0): lane 3 repeats vertex 0, so four-lane minima are three-lane ones.
-    __m128i X = _mm_shuffle_epi32(_mm256_cvttpd_epi32(_mm256_add_pd(xs, hx)), _MM_SHUFFLE(0, 2, 1, 0));
-    __m128i Y = _mm_shuffle_epi32(_mm256_cvttpd_epi32(_mm256_add_pd(ys, hy)), _MM_SHUFFLE(0, 2, 1, 0));
-    face_setup fs;
-    // The bounding box, all four bounds at once: lanes 0-3 (min x, min y, -max x, -max y).
-    __m128i lo = _mm_min_epi32(_mm_unpacklo_epi64(X, Y), _mm_unpackhi_epi64(X, Y));  // (x0|x2, x1|x0, y0|y2, y1|y0)
-    __m128i hi = _mm_max_epi32(_mm_unpacklo_epi64(X, Y), _mm_unpackhi_epi64(X, Y));
-    lo = _mm_min_epi32(lo, _mm_shuffle_epi32(lo, _MM_SHUFFLE(2, 3, 0, 1)));            // (min x, min x, min y, min y)
-    hi = _mm_max_epi32(hi, _mm_shuffle_epi32(hi, _MM_SHUFFLE(2, 3, 0, 1)));
-    const std::int64_t min_x = _mm_cvtsi128_si32(lo), min_y = _mm_extract_epi32(lo, 2);
-    const std::int64_t max_x = _mm_cvtsi128_si32(hi), max_y = _mm_extract_epi32(hi, 2);
-    if (max_x - min_x > avx2_extent || max_y - min_y > avx2_extent) {
-      // Big: draw_fixed's exact paths (64-bit edge functions).
-      alignas(16) std::int32_t ix[4], iy[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(ix), X);
-      _mm_store_si128(reinterpret_cast<__m128i*>(iy), Y);
-      const std::int64_t px[3] = {ix[0], ix[1], ix[2]}, py[3] = {iy[0], iy[1], iy[2]};
-      draw_fixed<M>(f, px, py, fs, rec, draw, basis, tri, texture);
-      continue;
+    // raster_face's clip codes: lanes with a vertex outside a clip plane are clipped by raster_face.
+    __m256 outside = zero;
+    for (int i = 0; i < 3; ++i) {
+      const __m256 gw = _mm256_mul_ps(band, w[i]);
+      outside = _mm256_or_ps(outside, _mm256_or_ps(_mm256_cmp_ps(_mm256_sub_ps(w[i], near8), zero, _CMP_LT_OQ),
+                                                   _mm256_cmp_ps(_mm256_sub_ps(gw, u[i]), zero, _CMP_LT_OQ)));
+      outside = _mm256_or_ps(outside, _mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(gw, u[i]), zero, _CMP_LT_OQ),
+                                                   _mm256_cmp_ps(_mm256_sub_ps(gw, vv[i]), zero, _CMP_LT_OQ)));
+      outside = _mm256_or_ps(outside, _mm256_cmp_ps(_mm256_add_ps(gw, vv[i]), zero, _CMP_LT_OQ));
     }
-    // Small (up to 64 texels across): draw_fixed's AVX2 path with the set-up in 32-bit lanes,
-    // lane k = edge k from vertex k to vertex k + 1 (all values below 2^30, see avx2_extent).
-    const int n = n_, rows = f == 0 ? n : n / 2;
-    const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
-    const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
-    const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
-    const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
-    if (x_begin > x_end || y_begin > y_end) continue;
-    __m128i dx = _mm_sub_epi32(_mm_shuffle_epi32(X, _MM_SHUFFLE(0, 0, 2, 1)), X);
-    __m128i dy = _mm_sub_epi32(_mm_shuffle_epi32(Y, _MM_SHUFFLE(0, 0, 2, 1)), Y);
-    // Twice the signed area, (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) = dy0 dx2 - dx0 dy2.
-    const std::int32_t area = _mm_cvtsi128_si32(
-        _mm_sub_epi32(_mm_mullo_epi32(dy, _mm_shuffle_epi32(dx, _MM_SHUFFLE(2, 2, 2, 2))),
-                      _mm_mullo_epi32(dx, _mm_shuffle_epi32(dy, _MM_SHUFFLE(2, 2, 2, 2)))));
-    if (area == 0) continue;
-    if (area < 0) {
-      // Clockwise: swap vertices 1 and 2; the edges become (-dx2, -dx1, -dx0).
-      X = _mm_shuffle_epi32(X, _MM_SHUFFLE(0, 1, 2, 0));
-      Y = _mm_shuffle_epi32(Y, _MM_SHUFFLE(0, 1, 2, 0));
-      dx = _mm_sub_epi32(_mm_setzero_si128(), _mm_shuffle_epi32(dx, _MM_SHUFFLE(3, 0, 1, 2)));
-      dy = _mm_sub_epi32(_mm_setzero_si128(), _mm_shuffle_epi32(dy, _MM_SHUFFLE(3, 0, 1, 2)));
+    const unsigned clipped = static_cast<unsigned>(_mm256_movemask_ps(outside)) & todo;
+    // raster_face's projection and snapping in double, four lanes per register: iw = 1 / w,
+    // round((u iw + 1) scale), round((v iw + v_offset) scale), halves away from zero. Clipped
+    // lanes compute garbage here (w may be <= 0) and are not used.
+    const __m256d v_offset = _mm256_set1_pd(f == 0 ? 1.0 : 0.0);
+    __m256i X[3], Y[3];
+    for (int i = 0; i < 3; ++i) {
+      __m128i xs_half[2], ys_half[2];
+      for (int h = 0; h < 2; ++h) {
+        const __m128 uh = h ? _mm256_extractf128_ps(u[i], 1) : _mm256_castps256_ps128(u[i]);
+        const __m128 vh = h ? _mm256_extractf128_ps(vv[i], 1) : _mm256_castps256_ps128(vv[i]);
+        const __m128 wh = h ? _mm256_extractf128_ps(w[i], 1) : _mm256_castps256_ps128(w[i]);
+        const __m256d iw = _mm256_div_pd(one, _mm256_cvtps_pd(wh));
+        const __m256d xs = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(uh), iw), one), dscale);
+        const __m256d ys = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_cvtps_pd(vh), iw), v_offset), dscale);
+        xs_half[h] = _mm256_cvttpd_epi32(_mm256_add_pd(xs, _mm256_blendv_pd(minus_half, half, _mm256_cmp_pd(xs, zero_d, _CMP_GE_OQ))));
+        ys_half[h] = _mm256_cvttpd_epi32(_mm256_add_pd(ys, _mm256_blendv_pd(minus_half, half, _mm256_cmp_pd(ys, zero_d, _CMP_GE_OQ))));
+      }
+      X[i] = _mm256_set_m128i(xs_half[1], xs_half[0]);
+      Y[i] = _mm256_set_m128i(ys_half[1], ys_half[0]);
     }
-    if (draw == 0) draw = commit_record(rec, basis, tri, texture);
-    // Owned edges (dy > 0, or dy = 0 and dx < 0) keep their ties; the others get bias 1.
-    const __m128i zero_i = _mm_setzero_si128();
-    const __m128i owned = _mm_or_si128(_mm_cmpgt_epi32(dy, zero_i),
-                                       _mm_and_si128(_mm_cmpeq_epi32(dy, zero_i), _mm_cmplt_epi32(dx, zero_i)));
-    const __m128i ox = _mm_set1_epi32(static_cast<std::int32_t>(x_begin * sub_one + sub_half));
-    const __m128i oy = _mm_set1_epi32(static_cast<std::int32_t>(y_begin * sub_one + sub_half));
-    alignas(16) std::int32_t base[4], sx[4], sy[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(base),
-                    _mm_add_epi32(_mm_sub_epi32(_mm_mullo_epi32(dx, _mm_sub_epi32(oy, Y)),
-                                                _mm_mullo_epi32(dy, _mm_sub_epi32(ox, X))),
-                                  _mm_xor_si128(owned, _mm_set1_epi32(-1))));  // -(owned ? 0 : 1)
-    _mm_store_si128(reinterpret_cast<__m128i*>(sx), _mm_slli_epi32(_mm_sub_epi32(zero_i, dy), sub_bits));
-    _mm_store_si128(reinterpret_cast<__m128i*>(sy), _mm_slli_epi32(dx, sub_bits));
-    fs.prepare(f, texel_step_, first_centre_, rec);
+    const __m256i min_x = _mm256_min_epi32(_mm256_min_epi32(X[0], X[1]), X[2]);
+    const __m256i max_x = _mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]);
+    const __m256i min_y = _mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]);
+    const __m256i max_y = _mm256_max_epi32(_mm256_max_epi32(Y[0], Y[1]), Y[2]);
+    // Lanes over 64 texels across go to draw_fixed's exact 64-bit paths.
+    const __m256i limit = _mm256_set1_epi32(static_cast<int>(avx2_extent));
+    const unsigned big = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(
+                             _mm256_or_si256(_mm256_cmpgt_epi32(_mm256_sub_epi32(max_x, min_x), limit),
+                                             _mm256_cmpgt_epi32(_mm256_sub_epi32(max_y, min_y), limit))))) &
+                         todo & ~clipped;
+    // Texels whose centre (k + 1/2) lies in the box, clamped to the face (ceil_sub, floor_sub).
+    const __m256i halfi = _mm256_set1_epi32(static_cast<int>(sub_half));
+    const __m256i x_begin = _mm256_max_epi32(
+        _mm256_sub_epi32(zero_i, _mm256_srai_epi32(_mm256_sub_epi32(halfi, min_x), sub_bits)), zero_i);
+    const __m256i x_end = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(max_x, halfi), sub_bits),
+                                           _mm256_set1_epi32(n - 1));
+    const __m256i y_begin = _mm256_max_epi32(
+        _mm256_sub_epi32(zero_i, _mm256_srai_epi32(_mm256_sub_epi32(halfi, min_y), sub_bits)), zero_i);
+    const __m256i y_end = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(max_y, halfi), sub_bits),
+                                           _mm256_set1_epi32((f == 0 ? n : n / 2) - 1));
+    const unsigned empty = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(
+        _mm256_or_si256(_mm256_cmpgt_epi32(x_begin, x_end), _mm256_cmpgt_epi32(y_begin, y_end)))));
+    // Edges k (vertex k to k + 1) and twice the signed area, dy0 dx2 - dx0 dy2; clockwise lanes
+    // swap vertices 1 and 2.
+    __m256i dx[3], dy[3];
+    for (int k = 0; k < 3; ++k) {
+      dx[k] = _mm256_sub_epi32(X[(k + 1) % 3], X[k]);
+      dy[k] = _mm256_sub_epi32(Y[(k + 1) % 3], Y[k]);
+    }
+    const __m256i area = _mm256_sub_epi32(_mm256_mullo_epi32(dy[0], dx[2]), _mm256_mullo_epi32(dx[0], dy[2]));
+    const __m256i cw = _mm256_cmpgt_epi32(zero_i, area);
+    const unsigned flat = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(area, zero_i))));
+    const __m256i x1 = _mm256_blendv_epi8(X[1], X[2], cw), x2 = _mm256_blendv_epi8(X[2], X[1], cw);
+    const __m256i y1 = _mm256_blendv_epi8(Y[1], Y[2], cw), y2 = _mm256_blendv_epi8(Y[2], Y[1], cw);
+    const __m256i px[3] = {X[0], x1, x2}, py[3] = {Y[0], y1, y2};
+    const __m256i ox = _mm256_add_epi32(_mm256_slli_epi32(x_begin, sub_bits), halfi);
+    const __m256i oy = _mm256_add_epi32(_mm256_slli_epi32(y_begin, sub_bits), halfi);
+    alignas(32) std::int32_t base[3][8], sx[3][8], sy[3][8];
+    for (int k = 0; k < 3; ++k) {
+      const __m256i ddx = _mm256_sub_epi32(px[(k + 1) % 3], px[k]), ddy = _mm256_sub_epi32(py[(k + 1) % 3], py[k]);
+      // Owned edges (dy > 0, or dy = 0 and dx < 0) keep their ties; the others get bias 1.
+      const __m256i owned = _mm256_or_si256(_mm256_cmpgt_epi32(ddy, zero_i),
+                                            _mm256_and_si256(_mm256_cmpeq_epi32(ddy, zero_i), _mm256_cmpgt_epi32(zero_i, ddx)));
+      _mm256_store_si256(reinterpret_cast<__m256i*>(base[k]),
+                         _mm256_add_epi32(_mm256_sub_epi32(_mm256_mullo_epi32(ddx, _mm256_sub_epi32(oy, py[k])),
+                                                           _mm256_mullo_epi32(ddy, _mm256_sub_epi32(ox, px[k]))),
+                                          _mm256_xor_si256(owned, ones_i)));  // -(owned ? 0 : 1)
+      _mm256_store_si256(reinterpret_cast<__m256i*>(sx[k]), _mm256_slli_epi32(_mm256_sub_epi32(zero_i, ddy), sub_bits));
+      _mm256_store_si256(reinterpret_cast<__m256i*>(sy[k]), _mm256_slli_epi32(ddx, sub_bits));
+    }
+    // face_setup::prepare's depth plane, four lanes of double at a time.
+    alignas(32) double z00[8], dzdy[8];
+    alignas(32) float dzdx[8];
+    {
+      const __m256d step = _mm256_set1_pd(texel_step_), u0 = _mm256_set1_pd(first_centre_);
+      const __m256d v0 = f == 0 ? u0 : _mm256_set1_pd(0.5 * texel_step_);
+      for (int h = 0; h < 2; ++h) {
+        const __m128 nu = h ? _mm256_extractf128_ps(u[3], 1) : _mm256_castps256_ps128(u[3]);
+        const __m128 nv = h ? _mm256_extractf128_ps(vv[3], 1) : _mm256_castps256_ps128(vv[3]);
+        const __m128 nw = h ? _mm256_extractf128_ps(w[3], 1) : _mm256_castps256_ps128(w[3]);
+        const __m128 pk = h ? _mm256_extractf128_ps(plane, 1) : _mm256_castps256_ps128(plane);
+        const __m256d inv_k = _mm256_div_pd(one, _mm256_cvtps_pd(pk));
+        const __m256d nud = _mm256_cvtps_pd(nu), nvd = _mm256_cvtps_pd(nv), nwd = _mm256_cvtps_pd(nw);
+        _mm_store_ps(dzdx + 4 * h, _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_mul_pd(nud, step), inv_k)));
+        _mm256_store_pd(dzdy + 4 * h, _mm256_mul_pd(_mm256_mul_pd(nvd, step), inv_k));
+        _mm256_store_pd(z00 + 4 * h,
+                        _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(nwd, _mm256_mul_pd(nud, u0)), _mm256_mul_pd(nvd, v0)), inv_k));
+      }
+    }
+    alignas(32) std::int32_t xb[8], xe[8], yb[8], ye[8], vx[3][8], vy[3][8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(xb), x_begin);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(xe), x_end);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(yb), y_begin);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ye), y_end);
+    if (big) {
+      for (int i = 0; i < 3; ++i) {
+        _mm256_store_si256(reinterpret_cast<__m256i*>(vx[i]), X[i]);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(vy[i]), Y[i]);
+      }
+    }
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(f));
-    small_triangle_avx2_impl<M == mode::count>(base, sx, sy, x_begin, x_end, y_begin, y_end, n,
-                                               depth_.data() + face_offset, ids_.data() + face_offset,
-                                               M == mode::count ? counts_->data() + face_offset : nullptr, fs.z00,
-                                               fs.dzdy, fs.dzdx, draw);
+    float* depth = depth_.data() + face_offset;
+    std::uint32_t* ids = ids_.data() + face_offset;
+    std::uint32_t* counts = M == mode::count ? counts_->data() + face_offset : nullptr;
+    for (unsigned m = todo; m; m &= m - 1) {
+      const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
+      const unsigned bit = 1u << j;
+      const scene::triangle& tri = tris[j];
+      if (clipped & bit) {
+        const glm::vec3 local[3] = {rec[j].v0, glm::vec3(axis[0][j][1], axis[1][j][1], axis[2][j][1]),
+                                    glm::vec3(axis[0][j][2], axis[1][j][2], axis[2][j][2])};
+        raster_face<M>(f, local, rec[j], draw[j], basis, tri, texture);
+        continue;
+      }
+      if (big & bit) {
+        face_setup fs;
+        const std::int64_t bx[3] = {vx[0][j], vx[1][j], vx[2][j]}, by[3] = {vy[0][j], vy[1][j], vy[2][j]};
+        draw_fixed<M>(f, bx, by, fs, rec[j], draw[j], basis, tri, texture);
+        continue;
+      }
+      if ((empty | flat) & bit) continue;
+      if (draw[j] == 0) draw[j] = commit_record(rec[j], basis, tri, texture);
+      const std::int32_t b3[3] = {base[0][j], base[1][j], base[2][j]}, sx3[3] = {sx[0][j], sx[1][j], sx[2][j]},
+                         sy3[3] = {sy[0][j], sy[1][j], sy[2][j]};
+      small_triangle_avx2_impl<M == mode::count>(b3, sx3, sy3, xb[j], xe[j], yb[j], ye[j], n, depth, ids, counts,
+                                                 z00[j], dzdy[j], dzdx[j], draw[j]);
+    }
   }
 }
 #endif

@@ -231,9 +231,6 @@ class alignas(64) hemicube_rasterizer {
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis, const radiance_texture* texture);
-  template <mode M>
-  void draw_faces_avx2(const scene::triangle& tri, unsigned faces, const float* lx, const float* ly, const float* lz,
-                       const frame& basis, const radiance_texture* texture);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
