@@ -52,7 +52,9 @@ glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3
 // O(log n + k) for k records whose box holds the point.
 class record_bvh {
  public:
-  void build(const std::vector<cache_record>& records, const cache_options& o) {
+  // threads: how many cores the build may use (the two halves below the root are built in
+  // parallel; the tree is the same for any count).
+  void build(const std::vector<cache_record>& records, const cache_options& o, int threads = 1) {
     records_ = &records;
     nodes_.clear();
     index_.resize(records.size());
@@ -64,7 +66,34 @@ class record_bvh {
       lo_[i] = records[i].position - glm::vec3(r);
       hi_[i] = records[i].position + glm::vec3(r);
     }
-    if (!records.empty()) build_node(0, static_cast<std::uint32_t>(records.size()));
+    if (records.empty()) return;
+    const auto count = static_cast<std::uint32_t>(records.size());
+    nodes_.push_back({});
+    const std::uint32_t mid = split(nodes_[0], 0, count);
+    if (mid == 0) return;  // the root is a leaf
+    // Left and right subtrees into their own arrays (in parallel), then spliced: root, left root,
+    // right root, the rest of the left, the rest of the right.
+    std::vector<node> half[2];
+    parallel_for(2, threads, 1, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t h = b; h < e; ++h) {
+        half[h].push_back({});
+        build_into(half[h], 0, h ? mid : 0, h ? count : mid);
+      }
+    });
+    const auto left_size = static_cast<std::uint32_t>(half[0].size());
+    const auto remap = [&](std::uint32_t h, std::uint32_t k) -> std::uint32_t {
+      if (k == 0) return 1 + h;
+      return h == 0 ? 3 + (k - 1) : 3 + (left_size - 1) + (k - 1);
+    };
+    nodes_.resize(1 + half[0].size() + half[1].size());
+    nodes_[0].first = 1;
+    nodes_[0].count = 0;
+    for (std::uint32_t h = 0; h < 2; ++h)
+      for (std::uint32_t k = 0; k < half[h].size(); ++k) {
+        node nd = half[h][k];
+        if (nd.count == 0) nd.first = remap(h, nd.first);
+        nodes_[remap(h, k)] = nd;
+      }
   }
 
   template <class F>
@@ -91,13 +120,9 @@ class record_bvh {
     std::uint32_t first, count;  // leaf: records [first, first + count); inner: children first, first + 1
   };
 
-  // Builds the node for index_[begin, end) at nodes_[slot]; median split on the longest axis of
-  // the centres. Depth stays below 64 because every split halves the range.
-  void build_node(std::uint32_t begin, std::uint32_t end) {
-    nodes_.push_back({});
-    build_into(static_cast<std::uint32_t>(nodes_.size() - 1), begin, end);
-  }
-  void build_into(std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
+  // Sets nd's box over index_[begin, end); returns 0 if it stays a leaf (<= 4 records), else
+  // the split point after a median split on the longest axis of the centres (index_ reordered).
+  std::uint32_t split(node& nd, std::uint32_t begin, std::uint32_t end) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     glm::vec3 clo = lo, chi = hi;
     for (std::uint32_t k = begin; k < end; ++k) {
@@ -107,12 +132,12 @@ class record_bvh {
       clo = glm::min(clo, (*records_)[i].position);
       chi = glm::max(chi, (*records_)[i].position);
     }
-    nodes_[slot].lo = lo;
-    nodes_[slot].hi = hi;
+    nd.lo = lo;
+    nd.hi = hi;
     if (end - begin <= 4) {
-      nodes_[slot].first = begin;
-      nodes_[slot].count = end - begin;
-      return;
+      nd.first = begin;
+      nd.count = end - begin;
+      return 0;
     }
     const glm::vec3 ext = chi - clo;
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
@@ -122,13 +147,22 @@ class record_bvh {
                        const float pa = (*records_)[a].position[axis], pb = (*records_)[b].position[axis];
                        return pa < pb || (pa == pb && a < b);  // total order: deterministic
                      });
-    const std::uint32_t child = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.push_back({});
-    nodes_.push_back({});
-    nodes_[slot].first = child;
-    nodes_[slot].count = 0;
-    build_into(child, begin, mid);
-    build_into(child + 1, mid, end);
+    nd.count = 0;
+    return mid;
+  }
+  // Builds the subtree of index_[begin, end) with its root at out[slot]; children are allocated
+  // in pairs (left, right = left + 1). Depth stays below 64 because every split halves the range.
+  void build_into(std::vector<node>& out, std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
+    node nd{};
+    const std::uint32_t mid = split(nd, begin, end);
+    if (mid != 0) {
+      nd.first = static_cast<std::uint32_t>(out.size());
+      out.push_back({});
+      out.push_back({});
+      build_into(out, nd.first, begin, mid);
+      build_into(out, nd.first + 1, mid, end);
+    }
+    out[slot] = nd;
   }
 
   const std::vector<cache_record>* records_ = nullptr;
@@ -702,13 +736,19 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
     // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
     // over pairs (new record, any record) within reach (deterministic).
     if (records.size() > first_new && (o.neighbour_clamp || o.shrink_disagreeing)) {
-      bvh.build(records, o);
+      bvh.build(records, o, threads);
+      // Candidates of each new record: records whose coverage box holds x_i (the tree is not
+      // rebuilt during the sequential pass below, so these are gathered first, in parallel).
+      std::vector<std::vector<std::uint32_t>> candidates(records.size() - first_new);
+      parallel_for(candidates.size(), threads, 64, [&](int, std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          std::vector<std::uint32_t>& near = candidates[k];
+          bvh.query(records[first_new + k].position, [&](std::uint32_t j) { near.push_back(j); });
+          std::sort(near.begin(), near.end());
+        }
+      });
       for (std::size_t i = first_new; i < records.size(); ++i) {
-        // Candidates: records whose coverage box holds x_i, plus those x_i's own sphere reaches.
-        std::vector<std::uint32_t> near;
-        bvh.query(records[i].position, [&](std::uint32_t j) { near.push_back(j); });
-        std::sort(near.begin(), near.end());
-        for (std::uint32_t j : near) {
+        for (std::uint32_t j : candidates[i - first_new]) {
           if (std::size_t(j) == i) continue;
           cache_record& ri = records[i];
           cache_record& rj = records[j];
@@ -743,7 +783,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
       grid_of_points.for_each_in_sphere(records[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
     }
-    bvh.build(records, o);
+    bvh.build(records, o, threads);
     ++stats.rounds;
     if (spacing > finest) spacing = std::max(finest, 0.5f * spacing);
     else if (seeds.empty()) break;  // defensive: nothing could be placed
