@@ -709,7 +709,13 @@ TEST_CASE("raster: culling of small far nodes between texel centres changes no t
     above += up;
   }
   INFO("triangles above the tangent plane " << above << ", tested " << r.statistics().triangles_tested);
-  CHECK(r.statistics().triangles_tested < above * 8 / 10);
+  // The cost follows the visible part, not the scene. (BVH leaves hold up to 32 triangles: the
+  // AVX2 set-up tests eight at a time for less than one node visit costs, so leaves are coarse
+  // and far leaves are bigger than the between-centres test's few texels; the tested triangles
+  // are bounded by a small multiple of those above the plane. With leaves of 8 this was 0.8x,
+  // at 1.5x the instructions per hemicube on this heightfield at N = 16: docs/raster.md.)
+  CHECK(r.statistics().triangles_tested < above * 5 / 2);
+  CHECK(r.statistics().triangles_tested < m.triangle_count() / 5);
 }
 
 TEST_CASE("raster: edges through texel centres (exact ties) give the same coverage on every path", "[raster]") {

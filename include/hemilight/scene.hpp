@@ -141,8 +141,9 @@ class scene {
   const std::vector<triangle>& triangles() const noexcept { return triangles_; }
   const std::vector<bvh_node>& bvh() const noexcept { return nodes_; }
 
-  /// Largest number of triangles in a BVH leaf.
-  static constexpr std::uint32_t max_leaf_triangles = 8;
+  /// Largest number of triangles in a BVH leaf. Coarse on purpose: the rasterizer's AVX2 set-up
+  /// tests eight triangles of a leaf for less than a node visit costs (docs/raster.md).
+  static constexpr std::uint32_t max_leaf_triangles = 32;
 
  private:
   scene() = default;
