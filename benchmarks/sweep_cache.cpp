@@ -19,6 +19,8 @@
 //     --append            append rows to out.csv (header only if the file is empty)
 //     --gradients LIST    any of yes,no (default yes,no)
 //     --threads T         worker threads (default 0 = all cores)
+//     --second-opinion F  cache_options::second_opinion (default: the option's default; 0 = off)
+//     --worst K           print the K points of largest error against the per-point reference
 //     --variant NAME      written to the last CSV column (default "default"): which cache options
 //   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
 //   (stride 1, 1 roll), so reruns with other cache options do not render it again.
@@ -50,6 +52,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -179,6 +182,8 @@ int main(int argc, char** argv) {
   bool append = false;
   std::vector<bool> gradient_modes{true, false};
   std::string variant = "default";
+  int worst_k = 0;
+  float second_opinion = cache_options{}.second_opinion;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
   std::vector<std::string> scene_keys{"cornell", "hexagon", "sky"};
@@ -209,6 +214,11 @@ int main(int argc, char** argv) {
     else if (arg == "--truth-cache") truth_dir = value();
     else if (arg == "--append") append = true;
     else if (arg == "--variant") variant = value();
+    else if (arg == "--second-opinion") {
+      const std::string v = value();
+      second_opinion = std::strtof(v.c_str(), nullptr);
+      if (!(second_opinion >= 0.0f && second_opinion < 1e6f)) usage(("bad --second-opinion '" + v + "'").c_str());
+    } else if (arg == "--worst") worst_k = to_int(value(), "worst");
     else if (arg == "--threads") thread_arg = to_int(value(), "threads");
     else if (arg == "--gradients") {
       gradient_modes.clear();
@@ -380,6 +390,7 @@ int main(int argc, char** argv) {
           cache_options o;
           o.error_threshold = a;
           o.use_gradients = gradients;
+          o.second_opinion = second_opinion;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
           double sum = 0.0, worst = 0.0;
@@ -393,6 +404,22 @@ int main(int argc, char** argv) {
             ++m;
           }
           const double rms = std::sqrt(sum / double(std::max<std::size_t>(m, 1)));
+          if (worst_k > 0) {  // the worst points against the per-point reference
+            std::vector<std::pair<double, std::size_t>> errs;
+            for (std::size_t i = 0; i < count; ++i) {
+              if (ref[i].backface > 0.1f || !r.valid[i]) continue;
+              const double e_ref = ref[i].luminance;
+              errs.push_back({std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean), i});
+            }
+            const std::size_t kk = std::min<std::size_t>(std::size_t(worst_k), errs.size());
+            std::partial_sort(errs.begin(), errs.begin() + std::ptrdiff_t(kk), errs.end(), std::greater<>());
+            for (std::size_t j = 0; j < kk; ++j) {
+              const std::size_t i = errs[j].second;
+              std::printf("    worst %zu: point %zu (%.4f, %.4f, %.4f) n (%.0f, %.0f, %.0f) ref %.4f cache %.4f err %.1f%%\n", j, i,
+                          ps.p[i].x, ps.p[i].y, ps.p[i].z, ps.n[i].x, ps.n[i].y, ps.n[i].z, ref[i].luminance,
+                          lum(r.irradiance[i]), 100.0 * errs[j].first);
+            }
+          }
           double total = 0.0, total_max = 0.0;
           vs_converged([&](std::size_t i) { return lum(r.irradiance[i]); }, total, total_max);
           std::fprintf(out, "%s,%d,%d,%zu,%.2f,%d,%zu,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%d,%d,%zu,%d,%zu,%.6f,%.6f,%d,%.2f,%s\n",
