@@ -391,6 +391,7 @@ int main(int argc, char** argv) {
           o.error_threshold = a;
           o.use_gradients = gradients;
           o.second_opinion = second_opinion;
+          o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
           double sum = 0.0, worst = 0.0;
