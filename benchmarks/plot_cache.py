@@ -10,7 +10,10 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
                          and, if DIR/cache_resolution.csv exists (bash benchmarks/run.sh cache_resolution),
                          DIR/cache_resolution.png and DIR/cache_resolution.md (the table of
                          interpolated hemicube fractions at the targets and gradient savings);
-                         the same for cache_resolution_k128.csv (hexagon ceiling, 128 x 128 grid).
+                         the same for cache_resolution_k128.csv (hexagon ceiling and Cornell box,
+                         128 x 128 grid). Rows may carry a `variant` column (sweep_cache --variant: which
+                         cache options); with more than one variant, each gets its own curves (marker and
+                         line style) and its own rows in the .md table.
 """
 import math
 import os
@@ -29,10 +32,19 @@ def resolution(r):
     return int(r.get("resolution", 64) or 64)
 
 
-def curve(rows, scene, n, grad, key):
-    """(fraction, error) points of one curve, sorted by fraction."""
+def variant(r):
+    return r.get("variant") or "default"
+
+
+def variants(rows):
+    return list(dict.fromkeys(variant(r) for r in rows))
+
+
+def curve(rows, scene, n, grad, key, var=None):
+    """(fraction, error) points of one curve, sorted by fraction (of one variant if given)."""
     return sorted((r["fraction"], r[key]) for r in rows
-                  if r["scene"] == scene and resolution(r) == n and int(r["gradients"]) == grad)
+                  if r["scene"] == scene and resolution(r) == n and int(r["gradients"]) == grad
+                  and (var is None or variant(r) == var))
 
 
 def fraction_for(pts, target):
@@ -65,12 +77,18 @@ def chart(rows, path):
                 if not any(resolution(r) == n for r in sr):
                     continue
                 c = COLORS.get(n, "k")
-                for grad, style in ((1, "o-"), (0, "s--")):
-                    pts = [p for p in curve(rows, scene, n, grad, key) if p[1] > 0]  # 0: every point rendered
-                    if pts:
-                        ax.plot([100 * p[0] for p in pts], [100 * p[1] for p in pts], style, color=c, ms=3.5,
-                                alpha=1.0 if grad else 0.6,
-                                label=f"N={n} {'gradients' if grad else 'no gradients'}")
+                vs = variants(sr)
+                for vi, var in enumerate(vs):
+                    for grad, style in ((1, "o-"), (0, "s--")):
+                        if len(vs) > 1:
+                            style = ("o-", "^:", "s-.", "d--")[vi % 4] if grad else style
+                        pts = [p for p in curve(rows, scene, n, grad, key, var) if p[1] > 0]  # 0: every point rendered
+                        if pts:
+                            label = f"N={n} {'gradients' if grad else 'no gradients'}"
+                            if len(vs) > 1:
+                                label += f", {var}"
+                            ax.plot([100 * p[0] for p in pts], [100 * p[1] for p in pts], style, color=c, ms=3.5,
+                                    alpha=1.0 if grad else 0.6, label=label)
                 if key == "rms_rel_err_converged":
                     ref = [r["reference_rms_rel_err_converged"] for r in sr if resolution(r) == n][0]
                     ax.axhline(100 * ref, color=c, ls=":", lw=1.2, label=f"N={n} hemicube per point")
@@ -107,9 +125,9 @@ def table(rows, path):
     """Markdown: per scene and N, the per-point reference's own error, the hemicube fraction at
     which the curves reach 1% and 3% RMS, and the gradient savings at equal RMS."""
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    out = ["| scene | N | per-point vs converged (RMS) | error vs | fraction for 1% (grad / no grad) | "
+    out = ["| scene | N | variant | per-point vs converged (RMS) | error vs | fraction for 1% (grad / no grad) | "
            "fraction for 3% (grad / no grad) | gradient savings at equal RMS (no-grad fraction / grad fraction) |",
-           "| --- | --- | --- | --- | --- | --- | --- |"]
+           "| --- | --- | --- | --- | --- | --- | --- | --- |"]
 
     def fmt(f):
         return "not reached" if f is None else f"{100 * f:.1f}%"
@@ -118,21 +136,24 @@ def table(rows, path):
         for n in sorted({resolution(r) for r in rows if r["scene"] == scene}):
             ref = [r["reference_rms_rel_err_converged"] for r in rows
                    if r["scene"] == scene and resolution(r) == n][0]
-            for key, what in (("rms_rel_err", "per point"), ("rms_rel_err_converged", "converged")):
-                g = curve(rows, scene, n, 1, key)
-                ng = curve(rows, scene, n, 0, key)
+            for var, key, what in [(v, k, w) for v in variants([r for r in rows if r["scene"] == scene])
+                                   for k, w in (("rms_rel_err", "per point"), ("rms_rel_err_converged", "converged"))]:
+                g = curve(rows, scene, n, 1, key, var)
+                ng = curve(rows, scene, n, 0, key, var)
+                if not g and not ng:
+                    continue
                 savings = []
                 for f, e in g:
-                    if e <= 0.0:  # every point rendered: nothing to compare
+                    if e <= 0.0 or not ng:  # every point rendered, or no no-gradient run: nothing to compare
                         continue
                     f_ng = fraction_for(ng, e)
                     if f_ng is None:
                         savings.append(f"{100 * e:.2f}%: > {max(p[0] for p in ng) / f:.1f}x")
                     else:
                         savings.append(f"{100 * e:.2f}%: {f_ng / f:.1f}x")
-                out.append(f"| {scene} | {n} | {100 * ref:.2f}% | {what} | {fmt(fraction_for(g, 0.01))} / "
-                           f"{fmt(fraction_for(ng, 0.01))} | {fmt(fraction_for(g, 0.03))} / {fmt(fraction_for(ng, 0.03))} | "
-                           + "; ".join(savings) + " |")
+                out.append(f"| {scene} | {n} | {var} | {100 * ref:.2f}% | {what} | {fmt(fraction_for(g, 0.01))} / "
+                           f"{fmt(fraction_for(ng, 0.01)) if ng else '-'} | {fmt(fraction_for(g, 0.03))} / {fmt(fraction_for(ng, 0.03)) if ng else '-'} | "
+                           + ("; ".join(savings) or "(not measured)") + " |")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
     print(f"wrote {path}")

@@ -17,6 +17,13 @@
 //     --truth-cache DIR   keep the converged (and check) luminances in DIR/*.bin keyed by scene,
 //                         grid, N and stride, so split runs do not render them twice
 //     --append            append rows to out.csv (header only if the file is empty)
+//     --gradients LIST    any of yes,no (default yes,no)
+//     --threads T         worker threads (default 0 = all cores)
+//     --second-opinion F  cache_options::second_opinion (default: the option's default; 0 = off)
+//     --worst K           print the K points of largest error against the per-point reference
+//     --variant NAME      written to the last CSV column (default "default"): which cache options
+//   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
+//   (stride 1, 1 roll), so reruns with other cache options do not render it again.
 //   `sweep_cache out.csv` alone gives the default run of `bash benchmarks/run.sh cache`.
 //
 // Scenes (reference_scenes.hpp): the Cornell box floor and walls; the hexagon room's ceiling
@@ -45,6 +52,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -170,8 +178,12 @@ std::vector<truth_entry> render_luminance(const point_set& ps, const std::vector
 
 int main(int argc, char** argv) {
   std::string path = "cache_sweep.csv", truth_dir;
-  int k = 128, converged_n = 256, stride = 7, rolls = 1, check_n = 0, check_stride = 4;
+  int k = 128, converged_n = 256, stride = 7, rolls = 1, check_n = 0, check_stride = 4, thread_arg = 0;
   bool append = false;
+  std::vector<bool> gradient_modes{true, false};
+  std::string variant = "default";
+  int worst_k = 0;
+  float second_opinion = cache_options{}.second_opinion;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
   std::vector<std::string> scene_keys{"cornell", "hexagon", "sky"};
@@ -201,12 +213,26 @@ int main(int argc, char** argv) {
     else if (arg == "--check-stride") check_stride = to_int(value(), "check stride");
     else if (arg == "--truth-cache") truth_dir = value();
     else if (arg == "--append") append = true;
+    else if (arg == "--variant") variant = value();
+    else if (arg == "--second-opinion") {
+      const std::string v = value();
+      second_opinion = std::strtof(v.c_str(), nullptr);
+      if (!(second_opinion >= 0.0f && second_opinion < 1e6f)) usage(("bad --second-opinion '" + v + "'").c_str());
+    } else if (arg == "--worst") worst_k = to_int(value(), "worst");
+    else if (arg == "--threads") thread_arg = to_int(value(), "threads");
+    else if (arg == "--gradients") {
+      gradient_modes.clear();
+      for (const std::string& s : split(value())) {
+        if (s != "yes" && s != "no") usage(("bad --gradients '" + s + "' (yes, no)").c_str());
+        gradient_modes.push_back(s == "yes");
+      }
+    }
     else if (arg.size() > 1 && arg[0] == '-') usage(("unknown option " + arg).c_str());
     else if (positional == 0) path = arg, ++positional;
     else if (positional == 1) k = to_int(arg, "grid"), ++positional;
     else usage(("unexpected argument " + arg).c_str());
   }
-  if (resolutions.empty() || thresholds.empty() || scene_keys.empty()) usage("empty list");
+  if (resolutions.empty() || thresholds.empty() || scene_keys.empty() || gradient_modes.empty()) usage("empty list");
 
   bool write_header = true;
   if (append)
@@ -224,7 +250,7 @@ int main(int argc, char** argv) {
                       "rms_rel_err_converged,max_rel_err_converged,reference_rms_rel_err_converged,"
                       "reference_max_rel_err_converged,seconds,reference_seconds,converged_resolution,"
                       "converged_rolls,converged_points,check_resolution,check_points,converged_rms_rel_err_check,"
-                      "converged_max_rel_err_check,threads,loadavg\n");
+                      "converged_max_rel_err_check,threads,loadavg,variant\n");
 
   std::vector<point_set> sets;
   for (const std::string& key : scene_keys) {
@@ -261,7 +287,7 @@ int main(int argc, char** argv) {
     sets.push_back(std::move(ps));
   }
 
-  const int threads = resolve_thread_count(0);
+  const int threads = resolve_thread_count(thread_arg);
   for (point_set& ps : sets) {
     const std::size_t count = ps.p.size();
     auto sc = scene::create(ps.mesh.desc());
@@ -337,54 +363,71 @@ int main(int argc, char** argv) {
       hemicube_sampler_options so;
       so.resolution = resolution;
       const irradiance_sampler sampler = make_hemicube_sampler(sc, so, threads);
-      // Per-point reference: a hemicube at every point.
-      std::vector<irradiance_sample> ref(count);
+      // Per-point reference: a hemicube at every point (luminance, backface fraction; stride 1,
+      // one roll = no nudge, the same sampler calls as the cache makes).
+      std::vector<std::size_t> all(count);
+      for (std::size_t i = 0; i < count; ++i) all[i] = i;
       const double load_ref = loadavg();
-      const auto t0 = std::chrono::steady_clock::now();
-      parallel_for(count, threads, 16, [&](int w, std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) ref[i] = sampler(w, ps.p[i], ps.n[i]);
-      });
-      const double ref_seconds = seconds_since(t0);
+      double ref_seconds = 0.0;
+      const std::vector<truth_entry> ref = render_luminance(ps, all, resolution, 1, threads, cache_file(resolution, 1, 1), ref_seconds);
       double mean = 0.0;
       std::size_t valid = 0;
       for (std::size_t i = 0; i < count; ++i)
-        if (ref[i].backface_fraction <= 0.1f) {
-          mean += lum(ref[i].irradiance);
+        if (ref[i].backface <= 0.1f) {
+          mean += ref[i].luminance;
           ++valid;
         }
       mean /= double(std::max<std::size_t>(valid, 1));
       double ref_rms = 0.0, ref_max = 0.0;
-      vs_converged([&](std::size_t i) { return lum(ref[i].irradiance); }, ref_rms, ref_max);
+      vs_converged([&](std::size_t i) { return ref[i].luminance; }, ref_rms, ref_max);
       std::printf(" N = %d: per-point reference %.1f s (%.0f hemicubes/s on %d threads, load %.2f); its own error "
                   "vs converged: RMS %.3f%%, max %.1f%%\n",
                   resolution, ref_seconds, double(count) / ref_seconds, threads, load_ref, 100.0 * ref_rms,
                   100.0 * ref_max);
       std::fflush(stdout);
       for (float a : thresholds)
-        for (bool gradients : {true, false}) {
+        for (bool gradients : gradient_modes) {
           cache_options o;
           o.error_threshold = a;
           o.use_gradients = gradients;
+          o.second_opinion = second_opinion;
+          o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
           double sum = 0.0, worst = 0.0;
           std::size_t m = 0;
           for (std::size_t i = 0; i < count; ++i) {
-            if (ref[i].backface_fraction > 0.1f || !r.valid[i]) continue;
-            const double e_ref = lum(ref[i].irradiance);
+            if (ref[i].backface > 0.1f || !r.valid[i]) continue;
+            const double e_ref = ref[i].luminance;
             const double err = std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean);
             sum += err * err;
             worst = std::max(worst, err);
             ++m;
           }
           const double rms = std::sqrt(sum / double(std::max<std::size_t>(m, 1)));
+          if (worst_k > 0) {  // the worst points against the per-point reference
+            std::vector<std::pair<double, std::size_t>> errs;
+            for (std::size_t i = 0; i < count; ++i) {
+              if (ref[i].backface > 0.1f || !r.valid[i]) continue;
+              const double e_ref = ref[i].luminance;
+              errs.push_back({std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean), i});
+            }
+            const std::size_t kk = std::min<std::size_t>(std::size_t(worst_k), errs.size());
+            std::partial_sort(errs.begin(), errs.begin() + std::ptrdiff_t(kk), errs.end(), std::greater<>());
+            for (std::size_t j = 0; j < kk; ++j) {
+              const std::size_t i = errs[j].second;
+              std::printf("    worst %zu: point %zu (%.4f, %.4f, %.4f) n (%.0f, %.0f, %.0f) ref %.4f cache %.4f err %.1f%%\n", j, i,
+                          ps.p[i].x, ps.p[i].y, ps.p[i].z, ps.n[i].x, ps.n[i].y, ps.n[i].z, ref[i].luminance,
+                          lum(r.irradiance[i]), 100.0 * errs[j].first);
+            }
+          }
           double total = 0.0, total_max = 0.0;
           vs_converged([&](std::size_t i) { return lum(r.irradiance[i]); }, total, total_max);
-          std::fprintf(out, "%s,%d,%d,%zu,%.2f,%d,%zu,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%d,%d,%zu,%d,%zu,%.6f,%.6f,%d,%.2f\n",
+          std::fprintf(out, "%s,%d,%d,%zu,%.2f,%d,%zu,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%d,%d,%zu,%d,%zu,%.6f,%.6f,%d,%.2f,%s\n",
                        ps.name.c_str(), k, resolution, count, double(a), gradients ? 1 : 0, r.stats.hemicubes,
                        double(r.stats.hemicubes) / double(count), rms, worst, total, total_max, ref_rms, ref_max,
                        r.stats.seconds, ref_seconds, converged_n, rolls, subset.size(), check_n, check_points, check_rms,
-                       check_max, threads, load);
+                       check_max, threads, load, variant.c_str());
           std::fflush(out);
           std::printf("  a = %.2f %-12s %6zu hemicubes (%5.2f%%)  vs per-point RMS %.3f%% max %.1f%%  vs converged RMS "
                       "%.3f%% max %.1f%%  %.2f s (load %.2f)\n",

@@ -239,9 +239,19 @@ class point_grid {
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
 // `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered).
+// What the placement's coverage test needs beyond the value: how many records cover the point and
+// the largest first-order term |lum(prediction) - lum(E_i)| of a covering record relative to
+// max(lum(E_i), floor) (floor given in).
+struct coverage_detail {
+  float floor = 0.0f;
+  int records = 0;
+  float first_order = 0.0f;
+};
+
 float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
-                  bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr) {
+                  bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
+                  coverage_detail* detail = nullptr) {
   glm::vec3 sum(0.0f);
   std::array<glm::vec3, 4> sh_sum{};
   hl2_cone cone_sum;
@@ -264,6 +274,11 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
     const float l = luminance(e);
     lo = std::min(lo, l);
     hi = std::max(hi, l);
+    if (detail) {
+      const float li = luminance(r.irradiance);
+      ++detail->records;
+      detail->first_order = std::max(detail->first_order, std::fabs(l - li) / std::max({li, detail->floor, 1e-30f}));
+    }
     at_record = at_record || r.position == x;
   });
   out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
@@ -340,6 +355,8 @@ void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t 
   if (o.min_radius > 0.0f && o.max_radius > 0.0f && o.min_radius > o.max_radius)
     throw_invalid_argument(fn + "min_radius " + std::to_string(o.min_radius) + " is larger than max_radius " +
                            std::to_string(o.max_radius));
+  if (!(o.second_opinion >= 0.0f) || !std::isfinite(o.second_opinion))
+    throw_invalid_argument(fn + "second_opinion is " + std::to_string(o.second_opinion) + "; it must be finite and >= 0 (0 = off)");
   if (!(o.invalid_backface_fraction >= 0.0f && o.invalid_backface_fraction <= 1.0f))
     throw_invalid_argument(fn + "invalid_backface_fraction is " + std::to_string(o.invalid_backface_fraction) +
                            "; it must be in [0, 1]");
@@ -617,12 +634,24 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         glm::vec3 value;
         float spread = 0.0f;
         bool own = false;
-        const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own);
+        coverage_detail detail;
+        detail.floor = floor_e;
+        const bool second_opinion = o.second_opinion > 0.0f;
+        const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own, nullptr, nullptr,
+                                    second_opinion ? &detail : nullptr);
         bool ok = w > 0.0f;
         bool leans_on_floor = false;
         if (ok && o.refine_disagreement && !own) {
           ok = spread <= a * std::max(luminance(value), floor_e);
           leans_on_floor = ok && spread > a * luminance(value);
+        }
+        // Second opinion: a point that only one record covers is not covered while that record's
+        // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record
+        // can disagree with an extrapolation that may be wrong (an edge between two rows of
+        // points, a second derivative the gradient does not see).
+        if (ok && second_opinion && !own && detail.records == 1) {
+          ok = detail.first_order <= o.second_opinion * a;
+          leans_on_floor = leans_on_floor || (ok && floor_e > 0.0f);  // the floor moves: re-check
         }
         covered[i] = ok ? 1 : 0;
         fragile[i] = leans_on_floor ? 1 : 0;
