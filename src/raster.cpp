@@ -329,18 +329,18 @@ HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, i
 // base, sx, sy: the 32-bit edge values at the box's first texel (x_begin, y_begin) and their
 // steps per texel in x and y (the caller checks they fit, see avx2_extent).
 template <bool count_mode>
-HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, const std::int32_t* sx,
-                                                    const std::int32_t* sy, std::int64_t x_begin,
-                                                    std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
-                                                    float* depth, std::uint32_t* ids, std::uint32_t* counts,
-                                                    double z00, double dzdy, float dzdx, std::uint32_t draw) noexcept {
+HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_avx2_body(
+    const std::int32_t* base, const std::int32_t* sx, const std::int32_t* sy, std::size_t stride, std::int64_t x_begin,
+    std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n, float* depth, std::uint32_t* ids,
+    std::uint32_t* counts, double z00, double dzdy, float dzdx, std::uint32_t draw) noexcept {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   __m256i step[3], row[3], dy[3];
-  for (int k = 0; k < 3; ++k) {
-    // Values at (x_begin + lane, y_begin).
-    row[k] = _mm256_add_epi32(_mm256_set1_epi32(base[k]), _mm256_mullo_epi32(_mm256_set1_epi32(sx[k]), lane));
-    step[k] = _mm256_set1_epi32(8 * sx[k]);
-    dy[k] = _mm256_set1_epi32(sy[k]);
+  for (std::size_t k = 0; k < 3; ++k) {
+    // Values at (x_begin + lane, y_begin); edge k's values are at [k * stride].
+    const std::int32_t b = base[k * stride], ex = sx[k * stride];
+    row[k] = _mm256_add_epi32(_mm256_set1_epi32(b), _mm256_mullo_epi32(_mm256_set1_epi32(ex), lane));
+    step[k] = _mm256_set1_epi32(8 * ex);
+    dy[k] = _mm256_set1_epi32(sy[k * stride]);
   }
   const __m256 dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
   const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
@@ -392,6 +392,17 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
     row[1] = _mm256_add_epi32(row[1], dy[1]);
     row[2] = _mm256_add_epi32(row[2], dy[2]);
   }
+}
+
+// small_triangle_avx2_body as a function (for draw_fixed, outside the AVX2 set-up).
+template <bool count_mode>
+HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, const std::int32_t* sx,
+                                                    const std::int32_t* sy, std::int64_t x_begin, std::int64_t x_end,
+                                                    std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
+                                                    std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
+                                                    float dzdx, std::uint32_t draw) noexcept {
+  small_triangle_avx2_body<count_mode>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                       dzdy, dzdx, draw);
 }
 
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
@@ -1111,10 +1122,8 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
       }
       if ((empty | flat) & bit) continue;
       if (draw[j] == 0) draw[j] = commit_record(rec[j], basis, tri, texture);
-      const std::int32_t b3[3] = {base[0][j], base[1][j], base[2][j]}, sx3[3] = {sx[0][j], sx[1][j], sx[2][j]},
-                         sy3[3] = {sy[0][j], sy[1][j], sy[2][j]};
-      small_triangle_avx2_impl<M == mode::count>(b3, sx3, sy3, xb[j], xe[j], yb[j], ye[j], n, depth, ids, counts,
-                                                 z00[j], dzdy[j], dzdx[j], draw[j]);
+      small_triangle_avx2_body<M == mode::count>(&base[0][j], &sx[0][j], &sy[0][j], 8, xb[j], xe[j], yb[j], ye[j], n,
+                                                 depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j]);
     }
   }
 }
