@@ -418,12 +418,14 @@ const std::array<axis_symmetry, 48>& cube_symmetries() {
 }
 
 // Where texel (x, y) of face f of an n x n cube grid goes under a symmetry: texel index (face-major,
-// rows, columns) origin + x dx + y dy.
+// rows, columns) origin + x dx + y dy, in copy `copy` of the grid (0: as stored, 1: each face
+// transposed, see contiguous_runs).
 struct face_map {
   std::ptrdiff_t origin = 0, dx = 0, dy = 0;
+  int copy = 0;
 };
 
-face_map map_face(const axis_symmetry& m, int f, int n) {
+face_map map_face(const axis_symmetry& m, int f, int n, bool contiguous_runs = false) {
   const face_frame& fr = frame_of(f);
   const glm::vec3 a = m.apply(fr.axis), c = m.apply(fr.column), r = m.apply(fr.row);
   int f2 = 0;
@@ -435,6 +437,15 @@ face_map map_face(const axis_symmetry& m, int f, int n) {
   const int cv = static_cast<int>(glm::dot(c, g.row)), rv = static_cast<int>(glm::dot(r, g.row));
   const std::ptrdiff_t nn = n, ox = (cu < 0 || ru < 0) ? nn - 1 : 0, oy = (cv < 0 || rv < 0) ? nn - 1 : 0;
   face_map fm;
+  if (contiguous_runs && cu == 0 && n > 1) {
+    // x (the canonical run direction) moves along a column: read the transposed copy, where
+    // texel (X, Y) of a face is at index X n + Y, so that the run is consecutive in memory.
+    fm.origin = std::ptrdiff_t(f2) * nn * nn + ox * nn + oy;
+    fm.dx = cv;
+    fm.dy = ru * nn;
+    fm.copy = 1;
+    return fm;
+  }
   fm.origin = std::ptrdiff_t(f2) * nn * nn + oy * nn + ox;
   fm.dx = cv * nn + cu;
   fm.dy = rv * nn + ru;
@@ -608,12 +619,12 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
 // sums within a face, double across faces. A run's texels are consecutive in memory or one row
 // apart, depending on the symmetry; runs are padded to multiples of four texels where the face
 // is wide enough.
-void apply_stencil_portable(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+void apply_stencil_portable(const stencil& s, const face_map* maps, const float* const* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
   for (int c = 0; c < 4; ++c) out[c] = 0.0;
   for (const stencil_face& sf : s.faces) {
     const face_map& m = maps[sf.face];
-    const float* base = px4 + m.origin * 4;
+    const float* base = px4[m.copy] + m.origin * 4;
     const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
 #if defined(__SSE2__)
     __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps();
@@ -648,13 +659,13 @@ void apply_stencil_portable(const stencil& s, const face_map* maps, const float*
 // The same with AVX2 + FMA (picked at run time when the CPU has them): one broadcast and one
 // fused multiply-add per tap, four partial sums. Sums differ from the portable path only in
 // float rounding (fused multiply-adds, another order of the additions).
-__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* px4,
+__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* const* px4,
                                                              double out[4]) noexcept {
   const float* w = s.weights.data();
   __m256d acc = _mm256_setzero_pd();
   for (const stencil_face& sf : s.faces) {
     const face_map& m = maps[sf.face];
-    const float* base = px4 + m.origin * 4;
+    const float* base = px4[m.copy] + m.origin * 4;
     const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
     __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps(), a3 = _mm_setzero_ps();
     for (std::int32_t i = sf.begin; i < sf.end; ++i) {
@@ -676,7 +687,7 @@ __attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, co
 }
 #endif
 
-void apply_stencil(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+void apply_stencil(const stencil& s, const face_map* maps, const float* const* px4, double out[4]) noexcept {
 #if HEMILIGHT_CUBEMAP_AVX2
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   if (avx2) return apply_stencil_avx2(s, maps, px4, out);
@@ -725,21 +736,27 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
   const lobe_power lobe(static_cast<double>(power), cos_max);
   const double_table tab(*level.centres);
   cube_image out = cube_image::make(out_size, ch);
-  // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth).
-  std::vector<float> rgba;
-  const float* px4 = in.pixels.data();
-  if (ch == 3) {
-    const std::size_t count = 6u * std::size_t(n) * std::size_t(n);
-    rgba.assign(count * 4, 0.0f);
-    for (std::size_t i = 0; i < count; ++i)
-      for (std::size_t c = 0; c < 3; ++c) rgba[i * 4 + c] = in.pixels[i * 3 + c];
-    px4 = rgba.data();
-  }
+  // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth),
+  // and a second copy with each face transposed: under a symmetry that turns the canonical rows
+  // into columns, a stencil run reads consecutive texels of that copy instead of texels one row
+  // (n texels, a cache line and often a page) apart.
+  const std::size_t count = 6u * std::size_t(n) * std::size_t(n);
+  std::vector<float> rgba(count * 4 * 2, 0.0f);
+  for (std::size_t i = 0; i < count; ++i)
+    for (std::size_t c = 0; c < std::size_t(ch); ++c) rgba[i * 4 + c] = in.pixels[i * std::size_t(ch) + c];
+  float* transposed = rgba.data() + count * 4;
+  const std::size_t nn = std::size_t(n) * std::size_t(n);
+  for (std::size_t f = 0; f < 6; ++f)
+    for (std::size_t y = 0; y < std::size_t(n); ++y)
+      for (std::size_t x = 0; x < std::size_t(n); ++x)
+        std::copy_n(rgba.data() + (f * nn + y * std::size_t(n) + x) * 4, 4,
+                    transposed + (f * nn + x * std::size_t(n) + y) * 4);
+  const float* const px4[2] = {rgba.data(), transposed};
   const auto& sym = cube_symmetries();
   // Maps of the canonical faces under each symmetry, for the input and for the output grid.
   std::vector<face_map> in_maps(48 * 6), out_maps(48);
   for (std::size_t g = 0; g < 48; ++g) {
-    for (int f = 0; f < 6; ++f) in_maps[g * 6 + std::size_t(f)] = map_face(sym[g], f, n);
+    for (int f = 0; f < 6; ++f) in_maps[g * 6 + std::size_t(f)] = map_face(sym[g], f, n, true);
     out_maps[g] = map_face(sym[g], 4, out_size);  // the fundamental domain lies on +Z (face 4)
   }
   // The fundamental domain: texels (x, y) of face +Z with x <= y <= (n - 1) / 2. Every output
