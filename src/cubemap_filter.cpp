@@ -470,18 +470,19 @@ struct stencil {
   double norm = 1;             // 1 / (sum of the float weights): constant input stays constant
 };
 
-// Input texel directions (face-local) and exact solid angles in double, per size.
+// Input texel directions (face-local) and exact solid angles in double, per size: texel (x, y)
+// points along (coord[x], coord[y], 1) inv_len[y n + x].
 struct double_table {
-  std::vector<glm::dvec3> dir;
-  std::vector<double> omega;
-  explicit double_table(const face_table& t) : dir(t.texels.size()), omega(t.texels.size()) {
+  std::vector<double> coord, inv_len, omega;
+  explicit double_table(const face_table& t)
+      : coord(std::size_t(t.n)), inv_len(t.texels.size()), omega(t.texels.size()) {
     const int n = t.n;
+    for (int x = 0; x < n; ++x) coord[std::size_t(x)] = cubemap_texel_coordinate(n, x, edge_fixup::none);
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         const std::size_t i = std::size_t(y) * std::size_t(n) + std::size_t(x);
-        const double u = cubemap_texel_coordinate(n, x, edge_fixup::none);
-        const double v = cubemap_texel_coordinate(n, y, edge_fixup::none);
-        dir[i] = glm::normalize(glm::dvec3(u, v, 1.0));
+        const double u = coord[std::size_t(x)], v = coord[std::size_t(y)];
+        inv_len[i] = 1.0 / std::sqrt(u * u + v * v + 1.0);
         omega[i] = static_cast<double>(t.texels[i].w);
       }
   }
@@ -525,7 +526,7 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
   const double k = cos_max * cos_max;
   const double h = 0.5 * n;
   double total = 0;
-  std::vector<double> row_w;
+  static thread_local std::vector<double> row_w;  // one row's weights
   for (int f = 0; f < 6; ++f) {
     const face_frame& fr = frame_of(f);
     const glm::dvec3 dl(glm::dot(d, glm::dvec3(fr.column)), glm::dot(d, glm::dvec3(fr.row)),
@@ -555,20 +556,20 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
         xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5) + 1);
         if (xb < xa) continue;
       }
-      row_w.assign(std::size_t(xb - xa + 1), 0.0);
-      int first = -1, last = -1;
+      // The weights of the span, then the run from the first to the last nonzero one.
+      row_w.resize(std::size_t(xb - xa + 1));
       const std::size_t row = std::size_t(y) * std::size_t(n);
+      const double* inv_len = tab.inv_len.data() + row;
+      const double* omega = tab.omega.data() + row;
+      const double cy = dl.y * tab.coord[std::size_t(y)] + dl.z;
       for (int x = xa; x <= xb; ++x) {
-        const glm::dvec3& w = tab.dir[row + std::size_t(x)];
-        const double dot = dl.x * w.x + dl.y * w.y + dl.z * w.z;
-        if (!(dot > cos_max) || !(dot > 0.0)) continue;
-        const double wt = tab.omega[row + std::size_t(x)] * lobe(dot);
-        if (!(wt > 0.0)) continue;
-        row_w[std::size_t(x - xa)] = wt;
-        if (first < 0) first = x;
-        last = x;
+        const double dot = (dl.x * tab.coord[std::size_t(x)] + cy) * inv_len[x];
+        row_w[std::size_t(x - xa)] = dot > cos_max && dot > 0.0 ? omega[x] * lobe(dot) : 0.0;
       }
-      if (first < 0) continue;
+      int first = xa, last = xb;
+      while (first <= xb && !(row_w[std::size_t(first - xa)] > 0.0)) ++first;
+      if (first > xb) continue;
+      while (!(row_w[std::size_t(last - xa)] > 0.0)) --last;
       // Pad the run with zero weights to a multiple of four texels, inside the face's row, so the
       // SIMD loop has no tail (a zero weight times a finite texel adds nothing).
       int lo = first, hi = last;
@@ -578,9 +579,12 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
         lo = hi - padded + 1;
       }
       s.runs.push_back({f, y, lo, hi - lo + 1});
+      const std::size_t at = s.weights.size();
+      s.weights.resize(at + std::size_t(hi - lo + 1));
+      float* out = s.weights.data() + at;
       for (int x = lo; x <= hi; ++x) {
         const double wt = x >= first && x <= last ? row_w[std::size_t(x - xa)] : 0.0;
-        s.weights.push_back(static_cast<float>(wt));
+        out[x - lo] = static_cast<float>(wt);
         total += wt;
       }
     }
@@ -656,9 +660,11 @@ void apply_stencil_portable(const stencil& s, const face_map* maps, const float*
 }
 
 #if HEMILIGHT_CUBEMAP_AVX2
-// The same with AVX2 + FMA (picked at run time when the CPU has them): one broadcast and one
-// fused multiply-add per tap, four partial sums. Sums differ from the portable path only in
-// float rounding (fused multiply-adds, another order of the additions).
+// The same with AVX2 + FMA (picked at run time when the CPU has them). A run is consecutive
+// texels, forwards or backwards (map_face with contiguous runs): one 256-bit load reads two
+// texels, and the weight vector (w_k x 4 | w_k+1 x 4) comes from one 128-bit broadcast of four
+// weights and an in-lane permute; four 256-bit partial sums. Sums differ from the portable path
+// only in float rounding (fused multiply-adds, another order of the additions).
 __attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* const* px4,
                                                              double out[4]) noexcept {
   const float* w = s.weights.data();
@@ -667,21 +673,49 @@ __attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, co
     const face_map& m = maps[sf.face];
     const float* base = px4[m.copy] + m.origin * 4;
     const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
-    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps(), a3 = _mm_setzero_ps();
-    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
-      const stencil_run& r = s.runs[std::size_t(i)];
-      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
-      int k = 0;
-      for (; k + 3 < r.count; k += 4, p += 4 * step) {
-        a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
-        a1 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 1), _mm_loadu_ps(p + step), a1);
-        a2 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 2), _mm_loadu_ps(p + 2 * step), a2);
-        a3 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 3), _mm_loadu_ps(p + 3 * step), a3);
+    __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps(), a2 = _mm256_setzero_ps(), a3 = _mm256_setzero_ps();
+    __m128 t = _mm_setzero_ps();
+    if (m.dx == 1 || m.dx == -1) {
+      // Forwards, a 256-bit load at tap k's texel holds taps (k | k + 1); backwards, the load one
+      // texel lower holds (k + 1 | k): pick the weights to match.
+      const bool back = m.dx < 0;
+      const __m256i lo = back ? _mm256_setr_epi32(1, 1, 1, 1, 0, 0, 0, 0) : _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1);
+      const __m256i hi = back ? _mm256_setr_epi32(3, 3, 3, 3, 2, 2, 2, 2) : _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+      const std::ptrdiff_t pair = back ? -4 : 0;
+      for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+        const stencil_run& r = s.runs[std::size_t(i)];
+        const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+        int k = 0;
+        for (; k + 7 < r.count; k += 8, p += 8 * step) {
+          const __m256 w0 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k));
+          const __m256 w1 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k + 4));
+          a0 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, lo), _mm256_loadu_ps(p + pair), a0);
+          a1 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, hi), _mm256_loadu_ps(p + pair + 2 * step), a1);
+          a2 = _mm256_fmadd_ps(_mm256_permutevar_ps(w1, lo), _mm256_loadu_ps(p + pair + 4 * step), a2);
+          a3 = _mm256_fmadd_ps(_mm256_permutevar_ps(w1, hi), _mm256_loadu_ps(p + pair + 6 * step), a3);
+        }
+        if (k + 3 < r.count) {
+          const __m256 w0 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k));
+          a0 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, lo), _mm256_loadu_ps(p + pair), a0);
+          a1 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, hi), _mm256_loadu_ps(p + pair + 2 * step), a1);
+          k += 4;
+          p += 4 * step;
+        }
+        for (; k < r.count; ++k, p += step) t = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), t);
+        w += r.count;
       }
-      for (; k < r.count; ++k, p += step) a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
-      w += r.count;
+    } else {
+      // a face of one texel (n = 1): no run has more than one texel
+      for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+        const stencil_run& r = s.runs[std::size_t(i)];
+        const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+        for (int k = 0; k < r.count; ++k, p += step) t = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), t);
+        w += r.count;
+      }
     }
-    acc = _mm256_add_pd(acc, _mm256_cvtps_pd(_mm_add_ps(_mm_add_ps(a0, a1), _mm_add_ps(a2, a3))));
+    const __m256 a = _mm256_add_ps(_mm256_add_ps(a0, a1), _mm256_add_ps(a2, a3));
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1)), t);
+    acc = _mm256_add_pd(acc, _mm256_cvtps_pd(sum));
   }
   _mm256_storeu_pd(out, acc);
 }
