@@ -111,6 +111,10 @@ void check_options(const char* fn, const filter_options& o) {
 struct chain_level {
   const cube_image* image = nullptr;
   std::shared_ptr<const face_table> centres;
+  // The stencil path's two four-float copies of the image (four_float_copies), built on first
+  // use and kept for the next level of a chain that reads the same input level. An input_chain
+  // is used by one thread at a time (each call makes its own).
+  mutable std::vector<float> four_float;
 };
 
 struct input_chain {
@@ -118,10 +122,10 @@ struct input_chain {
   std::vector<chain_level> levels;
   explicit input_chain(const cube_image& top) {
     owned.reserve(16);
-    levels.push_back({&top, face_table::get(top.size)});
+    levels.push_back({&top, face_table::get(top.size), {}});
     while (levels.back().image->size > 1 && levels.back().image->size % 2 == 0) {
       owned.push_back(downsample_cube(*levels.back().image));
-      levels.push_back({&owned.back(), face_table::get(owned.back().size)});
+      levels.push_back({&owned.back(), face_table::get(owned.back().size), {}});
     }
   }
 };
@@ -821,6 +825,31 @@ void share_edge_texels(cube_image& out, edge_fixup fixup) {
   }
 }
 
+// Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth), as
+// stored and then with each face transposed (texel (x, y) of face f at f n^2 + x n + y): under a
+// symmetry that turns the canonical rows into columns, a stencil run reads consecutive texels of
+// the transposed copy instead of texels one row (n texels, a cache line and often a page) apart.
+const std::vector<float>& four_float_copies(const chain_level& level, int thread_count) {
+  if (!level.four_float.empty()) return level.four_float;
+  const cube_image& in = *level.image;
+  const std::size_t n = std::size_t(in.size), ch = std::size_t(in.channels), nn = n * n, count = 6 * nn;
+  std::vector<float>& out = level.four_float;
+  out.resize(count * 8);
+  float* transposed = out.data() + count * 4;
+  parallel_for(6 * n, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {  // row y of face f: a row of one copy, a column of the other
+      const std::size_t f = r / n, y = r % n;
+      for (std::size_t x = 0; x < n; ++x) {
+        const float* src = in.pixels.data() + (f * nn + y * n + x) * ch;
+        float* a = out.data() + (f * nn + y * n + x) * 4;
+        float* b = transposed + (f * nn + x * n + y) * 4;
+        for (std::size_t c = 0; c < 4; ++c) a[c] = b[c] = c < ch ? src[c] : 0.0f;
+      }
+    }
+  });
+  return out;
+}
+
 cube_image filter_chain_stencils(const chain_level& level, float power, bool irradiance, int out_size,
                                  const filter_options& o) {
   const cube_image& in = *level.image;
@@ -831,22 +860,8 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
   const lobe_power lobe(static_cast<double>(power), cos_max);
   const double_table tab(*level.centres);
   cube_image out = cube_image::make(out_size, ch);
-  // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth),
-  // and a second copy with each face transposed: under a symmetry that turns the canonical rows
-  // into columns, a stencil run reads consecutive texels of that copy instead of texels one row
-  // (n texels, a cache line and often a page) apart.
-  const std::size_t count = 6u * std::size_t(n) * std::size_t(n);
-  std::vector<float> rgba(count * 4 * 2, 0.0f);
-  for (std::size_t i = 0; i < count; ++i)
-    for (std::size_t c = 0; c < std::size_t(ch); ++c) rgba[i * 4 + c] = in.pixels[i * std::size_t(ch) + c];
-  float* transposed = rgba.data() + count * 4;
-  const std::size_t nn = std::size_t(n) * std::size_t(n);
-  for (std::size_t f = 0; f < 6; ++f)
-    for (std::size_t y = 0; y < std::size_t(n); ++y)
-      for (std::size_t x = 0; x < std::size_t(n); ++x)
-        std::copy_n(rgba.data() + (f * nn + y * std::size_t(n) + x) * 4, 4,
-                    transposed + (f * nn + x * std::size_t(n) + y) * 4);
-  const float* const px4[2] = {rgba.data(), transposed};
+  const std::vector<float>& rgba = four_float_copies(level, o.thread_count);
+  const float* const px4[2] = {rgba.data(), rgba.data() + rgba.size() / 2};
   const auto& sym = cube_symmetries();
   // Maps of the canonical faces under each symmetry, for the input and for the output grid.
   std::vector<face_map> in_maps(48 * 6), out_maps(48);
