@@ -684,10 +684,10 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
 }
 
 // Applies a stencil to the image of its output texel under one symmetry (`maps`: the symmetry's
-// map of each canonical input face) on four-float texels `px4` (RGBA, or RGB and a zero). Float
-// sums within a face, double across faces. A run's texels are consecutive in memory or one row
-// apart, depending on the symmetry; runs are padded to multiples of four texels where the face
-// is wide enough.
+// map of each canonical input face) on four-float texels (`px4`: the two copies of
+// four_float_copies, RGBA or RGB and a zero). Float sums within a face, double across faces. A
+// run's texels are consecutive in memory, forwards or backwards (faces of one texel aside);
+// runs are padded to multiples of four texels where the face is wide enough.
 void apply_stencil_portable(const stencil& s, const face_map* maps, const float* const* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
   for (int c = 0; c < 4; ++c) out[c] = 0.0;
