@@ -884,51 +884,48 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
       assert(t < out_count);
       if (owner[t] < 0) owner[t] = static_cast<std::int32_t>(g * domain.size() + i);
     }
-  // Chunks of the domain bounded by their number of taps (~16 MB of weights and runs).
+  // Work items: blocks of neighbouring stencils of the domain (~128 KB of weights, so that they
+  // stay in the worker's cache). A worker builds a block's stencils, then applies them in the
+  // order symmetry, stencil: each weight is read up to 48 times from cache, and within one
+  // symmetry neighbouring output texels read neighbouring input texels. Blocks are independent
+  // (no barrier inside a level, which matters when another process shares the cores), and
+  // there are at least ~4 per worker so that small levels still use every core. Each output
+  // texel comes from the same stencil and the same order of sums whichever worker computes it.
   const double cap = 2.0 * pi * (1.0 - std::max(cos_max, 0.0));
   const double taps = std::min(6.0 * n * n, 1.5 * cap / (4.0 * pi / (6.0 * n * n)) + 8.0);
-  const std::size_t chunk = std::clamp<std::size_t>(static_cast<std::size_t>(2.0e6 / taps), 1, domain.size());
+  const std::size_t workers = static_cast<std::size_t>(resolve_thread_count(o.thread_count));
+  const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1,
+                                                    std::max<std::size_t>(1, domain.size() / (4 * workers)));
+  const std::size_t blocks = (domain.size() + block - 1) / block;
   const double scale = irradiance ? pi : 1.0;
-  std::vector<stencil> stencils(chunk);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> tasks;  // (stencil in chunk, output texel)
-  std::vector<std::uint8_t> task_g;
-  for (std::size_t begin = 0; begin < domain.size(); begin += chunk) {
-    const std::size_t end = std::min(domain.size(), begin + chunk);
-    parallel_for(end - begin, o.thread_count, 8, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        const auto [x, y] = domain[begin + i];
+  std::vector<std::vector<stencil>> scratch(workers);  // one block of stencils per worker
+  parallel_for(blocks, o.thread_count, 1, [&](int worker, std::size_t begin, std::size_t end) {
+    std::vector<stencil>& stencils = scratch[std::size_t(worker)];
+    stencils.resize(block);
+    for (std::size_t bi = begin; bi < end; ++bi) {
+      const std::size_t b0 = bi * block, b1 = std::min(domain.size(), b0 + block);
+      for (std::size_t i = b0; i < b1; ++i) {
+        const auto [x, y] = domain[i];
         const glm::dvec3 d = glm::normalize(face_point_d(4, cubemap_texel_coordinate(out_size, x, o.fixup),
                                                          cubemap_texel_coordinate(out_size, y, o.fixup)));
-        build_stencil(tab, n, lobe, cos_max, d, stencils[i]);
+        build_stencil(tab, n, lobe, cos_max, d, stencils[i - b0]);
       }
-    });
-    tasks.clear();
-    task_g.clear();
-    // Order: blocks of neighbouring stencils (~128 KB of weights, so they stay in cache), then
-    // symmetry, then stencil: a block's weights are read 48 times from cache, and within one
-    // symmetry neighbouring output texels read neighbouring input texels.
-    const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1, chunk);
-    for (std::size_t b0 = begin; b0 < end; b0 += block)
-      for (std::size_t g = 0; g < 48; ++g)
-        for (std::size_t i = b0; i < std::min(end, b0 + block); ++i) {
-          const face_map& m = out_maps[g];
+      for (std::size_t g = 0; g < 48; ++g) {
+        const face_map& m = out_maps[g];
+        const face_map* maps = in_maps.data() + g * 6;
+        for (std::size_t i = b0; i < b1; ++i) {
           const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
           if (owner[t] != static_cast<std::int32_t>(g * domain.size() + i)) continue;
-          tasks.emplace_back(static_cast<std::uint32_t>(i - begin), static_cast<std::uint32_t>(t));
-          task_g.push_back(static_cast<std::uint8_t>(g));
+          const stencil& st = stencils[i - b0];
+          float* dst = out.pixels.data() + t * std::size_t(ch);
+          double v[4];
+          apply_stencil(st, maps, px4, v);
+          for (int c = 0; c < ch; ++c)  // alpha: the mean, not scaled
+            dst[c] = static_cast<float>(v[c] * st.norm * (c < 3 ? scale : 1.0));
         }
-    parallel_for(tasks.size(), o.thread_count, 32, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const stencil& s = stencils[tasks[k].first];
-        const face_map* maps = in_maps.data() + std::size_t(task_g[k]) * 6;
-        float* dst = out.pixels.data() + std::size_t(tasks[k].second) * std::size_t(ch);
-        double v[4];
-        apply_stencil(s, maps, px4, v);
-        for (int c = 0; c < ch; ++c)  // alpha: the mean, not scaled
-          dst[c] = static_cast<float>(v[c] * s.norm * (c < 3 ? scale : 1.0));
       }
-    });
-  }
+    }
+  });
   if (o.fixup != edge_fixup::none) share_edge_texels(out, o.fixup);
   return out;
 }
