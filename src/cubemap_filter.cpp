@@ -423,7 +423,7 @@ const std::array<axis_symmetry, 48>& cube_symmetries() {
 
 // Where texel (x, y) of face f of an n x n cube grid goes under a symmetry: texel index (face-major,
 // rows, columns) origin + x dx + y dy, in copy `copy` of the grid (0: as stored, 1: each face
-// transposed, see contiguous_runs).
+// transposed; map_face picks the copy in which x moves along a row when contiguous_runs is set).
 struct face_map {
   std::ptrdiff_t origin = 0, dx = 0, dy = 0;
   int copy = 0;
@@ -548,14 +548,16 @@ __attribute__((target("avx2,fma"))) double row_weights_avx2(const lobe_power& lo
   __m256d sum = _mm256_setzero_pd();
   int i = 0;
   for (; i + 3 < count; i += 4) {
-    const __m256d dot = _mm256_mul_pd(_mm256_fmadd_pd(vdlx, _mm256_loadu_pd(coord + i), vcy), _mm256_loadu_pd(inv_len + i));
+    const __m256d dot =
+        _mm256_mul_pd(_mm256_fmadd_pd(vdlx, _mm256_loadu_pd(coord + i), vcy), _mm256_loadu_pd(inv_len + i));
     const __m256d f = _mm256_min_pd(_mm256_mul_pd(_mm256_sub_pd(one, dot), inv), top);
     const __m128i k = _mm256_cvttpd_epi32(f);
     const __m256d t = _mm256_sub_pd(f, _mm256_cvtepi32_pd(k));
     // (the masked form: GCC 12 warns about the unmasked one's undefined source operand)
     const __m256d e0 = _mm256_mask_i32gather_pd(zero, table, k, all, 8);
     const __m256d e1 = _mm256_mask_i32gather_pd(zero, table + 1, k, all, 8);
-    const __m256d w = _mm256_and_pd(_mm256_mul_pd(_mm256_loadu_pd(omega + i), _mm256_fmadd_pd(t, _mm256_sub_pd(e1, e0), e0)),
+    const __m256d lobe_w = _mm256_fmadd_pd(t, _mm256_sub_pd(e1, e0), e0);
+    const __m256d w = _mm256_and_pd(_mm256_mul_pd(_mm256_loadu_pd(omega + i), lobe_w),
                                     _mm256_cmp_pd(dot, cmax, _CMP_GT_OQ));
     _mm256_storeu_pd(out + i, w);
     sum = _mm256_add_pd(sum, w);
@@ -730,8 +732,8 @@ void apply_stencil_portable(const stencil& s, const face_map* maps, const float*
 // texels, and the weight vector (w_k x 4 | w_k+1 x 4) comes from one 128-bit broadcast of four
 // weights and an in-lane permute; four 256-bit partial sums. Sums differ from the portable path
 // only in float rounding (fused multiply-adds, another order of the additions).
-__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* const* px4,
-                                                             double out[4]) noexcept {
+__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps,
+                                                             const float* const* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
   __m256d acc = _mm256_setzero_pd();
   for (const stencil_face& sf : s.faces) {
