@@ -111,6 +111,10 @@ void check_options(const char* fn, const filter_options& o) {
 struct chain_level {
   const cube_image* image = nullptr;
   std::shared_ptr<const face_table> centres;
+  // The stencil path's two four-float copies of the image (four_float_copies), built on first
+  // use and kept for the next level of a chain that reads the same input level. An input_chain
+  // is used by one thread at a time (each call makes its own).
+  mutable std::vector<float> four_float;
 };
 
 struct input_chain {
@@ -118,10 +122,10 @@ struct input_chain {
   std::vector<chain_level> levels;
   explicit input_chain(const cube_image& top) {
     owned.reserve(16);
-    levels.push_back({&top, face_table::get(top.size)});
+    levels.push_back({&top, face_table::get(top.size), {}});
     while (levels.back().image->size > 1 && levels.back().image->size % 2 == 0) {
       owned.push_back(downsample_cube(*levels.back().image));
-      levels.push_back({&owned.back(), face_table::get(owned.back().size)});
+      levels.push_back({&owned.back(), face_table::get(owned.back().size), {}});
     }
   }
 };
@@ -418,12 +422,14 @@ const std::array<axis_symmetry, 48>& cube_symmetries() {
 }
 
 // Where texel (x, y) of face f of an n x n cube grid goes under a symmetry: texel index (face-major,
-// rows, columns) origin + x dx + y dy.
+// rows, columns) origin + x dx + y dy, in copy `copy` of the grid (0: as stored, 1: each face
+// transposed; map_face picks the copy in which x moves along a row when contiguous_runs is set).
 struct face_map {
   std::ptrdiff_t origin = 0, dx = 0, dy = 0;
+  int copy = 0;
 };
 
-face_map map_face(const axis_symmetry& m, int f, int n) {
+face_map map_face(const axis_symmetry& m, int f, int n, bool contiguous_runs = false) {
   const face_frame& fr = frame_of(f);
   const glm::vec3 a = m.apply(fr.axis), c = m.apply(fr.column), r = m.apply(fr.row);
   int f2 = 0;
@@ -435,6 +441,15 @@ face_map map_face(const axis_symmetry& m, int f, int n) {
   const int cv = static_cast<int>(glm::dot(c, g.row)), rv = static_cast<int>(glm::dot(r, g.row));
   const std::ptrdiff_t nn = n, ox = (cu < 0 || ru < 0) ? nn - 1 : 0, oy = (cv < 0 || rv < 0) ? nn - 1 : 0;
   face_map fm;
+  if (contiguous_runs && cu == 0 && n > 1) {
+    // x (the canonical run direction) moves along a column: read the transposed copy, where
+    // texel (X, Y) of a face is at index X n + Y, so that the run is consecutive in memory.
+    fm.origin = std::ptrdiff_t(f2) * nn * nn + ox * nn + oy;
+    fm.dx = cv;
+    fm.dy = ru * nn;
+    fm.copy = 1;
+    return fm;
+  }
   fm.origin = std::ptrdiff_t(f2) * nn * nn + oy * nn + ox;
   fm.dx = cv * nn + cu;
   fm.dy = rv * nn + ru;
@@ -459,18 +474,19 @@ struct stencil {
   double norm = 1;             // 1 / (sum of the float weights): constant input stays constant
 };
 
-// Input texel directions (face-local) and exact solid angles in double, per size.
+// Input texel directions (face-local) and exact solid angles in double, per size: texel (x, y)
+// points along (coord[x], coord[y], 1) inv_len[y n + x].
 struct double_table {
-  std::vector<glm::dvec3> dir;
-  std::vector<double> omega;
-  explicit double_table(const face_table& t) : dir(t.texels.size()), omega(t.texels.size()) {
+  std::vector<double> coord, inv_len, omega;
+  explicit double_table(const face_table& t)
+      : coord(std::size_t(t.n)), inv_len(t.texels.size()), omega(t.texels.size()) {
     const int n = t.n;
+    for (int x = 0; x < n; ++x) coord[std::size_t(x)] = cubemap_texel_coordinate(n, x, edge_fixup::none);
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         const std::size_t i = std::size_t(y) * std::size_t(n) + std::size_t(x);
-        const double u = cubemap_texel_coordinate(n, x, edge_fixup::none);
-        const double v = cubemap_texel_coordinate(n, y, edge_fixup::none);
-        dir[i] = glm::normalize(glm::dvec3(u, v, 1.0));
+        const double u = coord[std::size_t(x)], v = coord[std::size_t(y)];
+        inv_len[i] = 1.0 / std::sqrt(u * u + v * v + 1.0);
         omega[i] = static_cast<double>(t.texels[i].w);
       }
   }
@@ -504,6 +520,55 @@ struct lobe_power {
   }
 };
 
+// The weights of `count` consecutive texels of one input row (texel i: face coordinate
+// coord[i], 1/|(u, v, 1)| inv_len[i], solid angle omega[i]) for the face-local lobe direction with
+// components (dlx, cy = dly v + dlz): omega lobe(dot) where dot > cos_max, else 0. Returns their sum.
+double row_weights(const lobe_power& lobe, double cos_max, double dlx, double cy, const double* coord,
+                   const double* inv_len, const double* omega, int count, double* out) noexcept {
+  double total = 0;
+  for (int i = 0; i < count; ++i) {
+    const double dot = (dlx * coord[i] + cy) * inv_len[i];
+    out[i] = dot > cos_max && dot > 0.0 ? omega[i] * lobe(dot) : 0.0;
+    total += out[i];
+  }
+  return total;
+}
+
+#if HEMILIGHT_CUBEMAP_AVX2
+// The same for a tabulated lobe, four texels at a time (AVX2 + FMA, the table read by gathers):
+// equal to the portable one to double rounding. cos_max >= 0, so dot > cos_max implies dot > 0.
+__attribute__((target("avx2,fma"))) double row_weights_avx2(const lobe_power& lobe, double cos_max, double dlx,
+                                                             double cy, const double* coord, const double* inv_len,
+                                                             const double* omega, int count, double* out) noexcept {
+  const __m256d vdlx = _mm256_set1_pd(dlx), vcy = _mm256_set1_pd(cy), one = _mm256_set1_pd(1.0);
+  const __m256d inv = _mm256_set1_pd(lobe.inv_step), top = _mm256_set1_pd(static_cast<double>(lobe_power::steps));
+  const __m256d cmax = _mm256_set1_pd(cos_max), zero = _mm256_setzero_pd();
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  const double* table = lobe.table.data();
+  __m256d sum = _mm256_setzero_pd();
+  int i = 0;
+  for (; i + 3 < count; i += 4) {
+    const __m256d dot =
+        _mm256_mul_pd(_mm256_fmadd_pd(vdlx, _mm256_loadu_pd(coord + i), vcy), _mm256_loadu_pd(inv_len + i));
+    const __m256d f = _mm256_min_pd(_mm256_mul_pd(_mm256_sub_pd(one, dot), inv), top);
+    const __m128i k = _mm256_cvttpd_epi32(f);
+    const __m256d t = _mm256_sub_pd(f, _mm256_cvtepi32_pd(k));
+    // (the masked form: GCC 12 warns about the unmasked one's undefined source operand)
+    const __m256d e0 = _mm256_mask_i32gather_pd(zero, table, k, all, 8);
+    const __m256d e1 = _mm256_mask_i32gather_pd(zero, table + 1, k, all, 8);
+    const __m256d lobe_w = _mm256_fmadd_pd(t, _mm256_sub_pd(e1, e0), e0);
+    const __m256d w = _mm256_and_pd(_mm256_mul_pd(_mm256_loadu_pd(omega + i), lobe_w),
+                                    _mm256_cmp_pd(dot, cmax, _CMP_GT_OQ));
+    _mm256_storeu_pd(out + i, w);
+    sum = _mm256_add_pd(sum, w);
+  }
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, sum);
+  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) +
+         row_weights(lobe, cos_max, dlx, cy, coord + i, inv_len + i, omega + i, count - i, out + i);
+}
+#endif
+
 void build_stencil(const double_table& tab, int n, const lobe_power& lobe, double cos_max, const glm::dvec3& d,
                    stencil& s) {
   s.runs.clear();
@@ -514,7 +579,13 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
   const double k = cos_max * cos_max;
   const double h = 0.5 * n;
   double total = 0;
-  std::vector<double> row_w;
+  static thread_local std::vector<double> row_w;  // one row's weights
+#if HEMILIGHT_CUBEMAP_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+  constexpr bool avx2 = false;
+  constexpr auto row_weights_avx2 = row_weights;
+#endif
   for (int f = 0; f < 6; ++f) {
     const face_frame& fr = frame_of(f);
     const glm::dvec3 dl(glm::dot(d, glm::dvec3(fr.column)), glm::dot(d, glm::dvec3(fr.row)),
@@ -544,20 +615,19 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
         xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5) + 1);
         if (xb < xa) continue;
       }
-      row_w.assign(std::size_t(xb - xa + 1), 0.0);
-      int first = -1, last = -1;
-      const std::size_t row = std::size_t(y) * std::size_t(n);
-      for (int x = xa; x <= xb; ++x) {
-        const glm::dvec3& w = tab.dir[row + std::size_t(x)];
-        const double dot = dl.x * w.x + dl.y * w.y + dl.z * w.z;
-        if (!(dot > cos_max) || !(dot > 0.0)) continue;
-        const double wt = tab.omega[row + std::size_t(x)] * lobe(dot);
-        if (!(wt > 0.0)) continue;
-        row_w[std::size_t(x - xa)] = wt;
-        if (first < 0) first = x;
-        last = x;
-      }
-      if (first < 0) continue;
+      // The weights of the span, then the run from the first to the last nonzero one.
+      row_w.resize(std::size_t(xb - xa + 1));
+      const std::size_t row = std::size_t(y) * std::size_t(n) + std::size_t(xa);
+      const double cy = dl.y * tab.coord[std::size_t(y)] + dl.z;
+      const double row_total =
+          (avx2 && lobe.tabulated ? row_weights_avx2 : row_weights)(lobe, cos_max, dl.x, cy, tab.coord.data() + xa,
+                                                                     tab.inv_len.data() + row, tab.omega.data() + row,
+                                                                     xb - xa + 1, row_w.data());
+      if (!(row_total > 0.0)) continue;
+      total += row_total;  // the weights outside [first, last] are 0
+      int first = xa, last = xb;
+      while (!(row_w[std::size_t(first - xa)] > 0.0)) ++first;
+      while (!(row_w[std::size_t(last - xa)] > 0.0)) --last;
       // Pad the run with zero weights to a multiple of four texels, inside the face's row, so the
       // SIMD loop has no tail (a zero weight times a finite texel adds nothing).
       int lo = first, hi = last;
@@ -567,11 +637,13 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
         lo = hi - padded + 1;
       }
       s.runs.push_back({f, y, lo, hi - lo + 1});
-      for (int x = lo; x <= hi; ++x) {
-        const double wt = x >= first && x <= last ? row_w[std::size_t(x - xa)] : 0.0;
-        s.weights.push_back(static_cast<float>(wt));
-        total += wt;
-      }
+      const std::size_t at = s.weights.size();
+      s.weights.resize(at + std::size_t(hi - lo + 1));
+      float* out = s.weights.data() + at;
+      std::fill(out, out + (first - lo), 0.0f);
+      const double* src = row_w.data() + (first - xa);
+      for (int i = 0; i <= last - first; ++i) out[first - lo + i] = static_cast<float>(src[i]);
+      std::fill(out + (last - lo + 1), out + (hi - lo + 1), 0.0f);
     }
   }
   if (!(total > 0.0)) {
@@ -595,25 +667,35 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
     s.faces.back().end = static_cast<std::int32_t>(i + 1);
   }
   // Normalise in double, then make the float weights' own sum exactly what the output divides by.
-  double fsum = 0;
-  for (float& w : s.weights) {
-    w = static_cast<float>(static_cast<double>(w) / total);
-    fsum += static_cast<double>(w);
+  // (four partial sums: one chain of dependent additions per tap was a tenth of the build time)
+  double fsum[4] = {0, 0, 0, 0};
+  const double inv_total = 1.0 / total;
+  const std::size_t count = s.weights.size();
+  float* w = s.weights.data();
+  std::size_t i = 0;
+  for (; i + 3 < count; i += 4)
+    for (std::size_t j = 0; j < 4; ++j) {
+      w[i + j] = static_cast<float>(static_cast<double>(w[i + j]) * inv_total);
+      fsum[j] += static_cast<double>(w[i + j]);
+    }
+  for (; i < count; ++i) {
+    w[i] = static_cast<float>(static_cast<double>(w[i]) * inv_total);
+    fsum[0] += static_cast<double>(w[i]);
   }
-  s.norm = 1.0 / fsum;
+  s.norm = 1.0 / ((fsum[0] + fsum[1]) + (fsum[2] + fsum[3]));
 }
 
 // Applies a stencil to the image of its output texel under one symmetry (`maps`: the symmetry's
-// map of each canonical input face) on four-float texels `px4` (RGBA, or RGB and a zero). Float
-// sums within a face, double across faces. A run's texels are consecutive in memory or one row
-// apart, depending on the symmetry; runs are padded to multiples of four texels where the face
-// is wide enough.
-void apply_stencil_portable(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+// map of each canonical input face) on four-float texels (`px4`: the two copies of
+// four_float_copies, RGBA or RGB and a zero). Float sums within a face, double across faces. A
+// run's texels are consecutive in memory, forwards or backwards (faces of one texel aside);
+// runs are padded to multiples of four texels where the face is wide enough.
+void apply_stencil_portable(const stencil& s, const face_map* maps, const float* const* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
   for (int c = 0; c < 4; ++c) out[c] = 0.0;
   for (const stencil_face& sf : s.faces) {
     const face_map& m = maps[sf.face];
-    const float* base = px4 + m.origin * 4;
+    const float* base = px4[m.copy] + m.origin * 4;
     const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
 #if defined(__SSE2__)
     __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps();
@@ -645,38 +727,68 @@ void apply_stencil_portable(const stencil& s, const face_map* maps, const float*
 }
 
 #if HEMILIGHT_CUBEMAP_AVX2
-// The same with AVX2 + FMA (picked at run time when the CPU has them): one broadcast and one
-// fused multiply-add per tap, four partial sums. Sums differ from the portable path only in
-// float rounding (fused multiply-adds, another order of the additions).
-__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps, const float* px4,
-                                                             double out[4]) noexcept {
+// The same with AVX2 + FMA (picked at run time when the CPU has them). A run is consecutive
+// texels, forwards or backwards (map_face with contiguous runs): one 256-bit load reads two
+// texels, and the weight vector (w_k x 4 | w_k+1 x 4) comes from one 128-bit broadcast of four
+// weights and an in-lane permute; four 256-bit partial sums. Sums differ from the portable path
+// only in float rounding (fused multiply-adds, another order of the additions).
+__attribute__((target("avx2,fma"))) void apply_stencil_avx2(const stencil& s, const face_map* maps,
+                                                             const float* const* px4, double out[4]) noexcept {
   const float* w = s.weights.data();
   __m256d acc = _mm256_setzero_pd();
   for (const stencil_face& sf : s.faces) {
     const face_map& m = maps[sf.face];
-    const float* base = px4 + m.origin * 4;
+    const float* base = px4[m.copy] + m.origin * 4;
     const std::ptrdiff_t step = m.dx * 4, row = m.dy * 4;
-    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps(), a3 = _mm_setzero_ps();
-    for (std::int32_t i = sf.begin; i < sf.end; ++i) {
-      const stencil_run& r = s.runs[std::size_t(i)];
-      const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
-      int k = 0;
-      for (; k + 3 < r.count; k += 4, p += 4 * step) {
-        a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
-        a1 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 1), _mm_loadu_ps(p + step), a1);
-        a2 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 2), _mm_loadu_ps(p + 2 * step), a2);
-        a3 = _mm_fmadd_ps(_mm_broadcast_ss(w + k + 3), _mm_loadu_ps(p + 3 * step), a3);
+    __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps(), a2 = _mm256_setzero_ps(), a3 = _mm256_setzero_ps();
+    __m128 t = _mm_setzero_ps();
+    if (m.dx == 1 || m.dx == -1) {
+      // Forwards, a 256-bit load at tap k's texel holds taps (k | k + 1); backwards, the load one
+      // texel lower holds (k + 1 | k): pick the weights to match.
+      const bool back = m.dx < 0;
+      const __m256i lo = back ? _mm256_setr_epi32(1, 1, 1, 1, 0, 0, 0, 0) : _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1);
+      const __m256i hi = back ? _mm256_setr_epi32(3, 3, 3, 3, 2, 2, 2, 2) : _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+      const std::ptrdiff_t pair = back ? -4 : 0;
+      for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+        const stencil_run& r = s.runs[std::size_t(i)];
+        const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+        int k = 0;
+        for (; k + 7 < r.count; k += 8, p += 8 * step) {
+          const __m256 w0 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k));
+          const __m256 w1 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k + 4));
+          a0 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, lo), _mm256_loadu_ps(p + pair), a0);
+          a1 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, hi), _mm256_loadu_ps(p + pair + 2 * step), a1);
+          a2 = _mm256_fmadd_ps(_mm256_permutevar_ps(w1, lo), _mm256_loadu_ps(p + pair + 4 * step), a2);
+          a3 = _mm256_fmadd_ps(_mm256_permutevar_ps(w1, hi), _mm256_loadu_ps(p + pair + 6 * step), a3);
+        }
+        if (k + 3 < r.count) {
+          const __m256 w0 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(w + k));
+          a0 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, lo), _mm256_loadu_ps(p + pair), a0);
+          a1 = _mm256_fmadd_ps(_mm256_permutevar_ps(w0, hi), _mm256_loadu_ps(p + pair + 2 * step), a1);
+          k += 4;
+          p += 4 * step;
+        }
+        for (; k < r.count; ++k, p += step) t = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), t);
+        w += r.count;
       }
-      for (; k < r.count; ++k, p += step) a0 = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), a0);
-      w += r.count;
+    } else {
+      // a face of one texel (n = 1): no run has more than one texel
+      for (std::int32_t i = sf.begin; i < sf.end; ++i) {
+        const stencil_run& r = s.runs[std::size_t(i)];
+        const float* p = base + std::ptrdiff_t(r.x0) * step + std::ptrdiff_t(r.y) * row;
+        for (int k = 0; k < r.count; ++k, p += step) t = _mm_fmadd_ps(_mm_broadcast_ss(w + k), _mm_loadu_ps(p), t);
+        w += r.count;
+      }
     }
-    acc = _mm256_add_pd(acc, _mm256_cvtps_pd(_mm_add_ps(_mm_add_ps(a0, a1), _mm_add_ps(a2, a3))));
+    const __m256 a = _mm256_add_ps(_mm256_add_ps(a0, a1), _mm256_add_ps(a2, a3));
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1)), t);
+    acc = _mm256_add_pd(acc, _mm256_cvtps_pd(sum));
   }
   _mm256_storeu_pd(out, acc);
 }
 #endif
 
-void apply_stencil(const stencil& s, const face_map* maps, const float* px4, double out[4]) noexcept {
+void apply_stencil(const stencil& s, const face_map* maps, const float* const* px4, double out[4]) noexcept {
 #if HEMILIGHT_CUBEMAP_AVX2
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   if (avx2) return apply_stencil_avx2(s, maps, px4, out);
@@ -715,6 +827,31 @@ void share_edge_texels(cube_image& out, edge_fixup fixup) {
   }
 }
 
+// Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth), as
+// stored and then with each face transposed (texel (x, y) of face f at f n^2 + x n + y): under a
+// symmetry that turns the canonical rows into columns, a stencil run reads consecutive texels of
+// the transposed copy instead of texels one row (n texels, a cache line and often a page) apart.
+const std::vector<float>& four_float_copies(const chain_level& level, int thread_count) {
+  if (!level.four_float.empty()) return level.four_float;
+  const cube_image& in = *level.image;
+  const std::size_t n = std::size_t(in.size), ch = std::size_t(in.channels), nn = n * n, count = 6 * nn;
+  std::vector<float>& out = level.four_float;
+  out.resize(count * 8);
+  float* transposed = out.data() + count * 4;
+  parallel_for(6 * n, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {  // row y of face f: a row of one copy, a column of the other
+      const std::size_t f = r / n, y = r % n;
+      for (std::size_t x = 0; x < n; ++x) {
+        const float* src = in.pixels.data() + (f * nn + y * n + x) * ch;
+        float* a = out.data() + (f * nn + y * n + x) * 4;
+        float* b = transposed + (f * nn + x * n + y) * 4;
+        for (std::size_t c = 0; c < 4; ++c) a[c] = b[c] = c < ch ? src[c] : 0.0f;
+      }
+    }
+  });
+  return out;
+}
+
 cube_image filter_chain_stencils(const chain_level& level, float power, bool irradiance, int out_size,
                                  const filter_options& o) {
   const cube_image& in = *level.image;
@@ -725,21 +862,13 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
   const lobe_power lobe(static_cast<double>(power), cos_max);
   const double_table tab(*level.centres);
   cube_image out = cube_image::make(out_size, ch);
-  // Four floats per texel, so that one SIMD load reads a texel (RGB inputs get a zero fourth).
-  std::vector<float> rgba;
-  const float* px4 = in.pixels.data();
-  if (ch == 3) {
-    const std::size_t count = 6u * std::size_t(n) * std::size_t(n);
-    rgba.assign(count * 4, 0.0f);
-    for (std::size_t i = 0; i < count; ++i)
-      for (std::size_t c = 0; c < 3; ++c) rgba[i * 4 + c] = in.pixels[i * 3 + c];
-    px4 = rgba.data();
-  }
+  const std::vector<float>& rgba = four_float_copies(level, o.thread_count);
+  const float* const px4[2] = {rgba.data(), rgba.data() + rgba.size() / 2};
   const auto& sym = cube_symmetries();
   // Maps of the canonical faces under each symmetry, for the input and for the output grid.
   std::vector<face_map> in_maps(48 * 6), out_maps(48);
   for (std::size_t g = 0; g < 48; ++g) {
-    for (int f = 0; f < 6; ++f) in_maps[g * 6 + std::size_t(f)] = map_face(sym[g], f, n);
+    for (int f = 0; f < 6; ++f) in_maps[g * 6 + std::size_t(f)] = map_face(sym[g], f, n, true);
     out_maps[g] = map_face(sym[g], 4, out_size);  // the fundamental domain lies on +Z (face 4)
   }
   // The fundamental domain: texels (x, y) of face +Z with x <= y <= (n - 1) / 2. Every output
@@ -757,51 +886,48 @@ cube_image filter_chain_stencils(const chain_level& level, float power, bool irr
       assert(t < out_count);
       if (owner[t] < 0) owner[t] = static_cast<std::int32_t>(g * domain.size() + i);
     }
-  // Chunks of the domain bounded by their number of taps (~16 MB of weights and runs).
+  // Work items: blocks of neighbouring stencils of the domain (~128 KB of weights, so that they
+  // stay in the worker's cache). A worker builds a block's stencils, then applies them in the
+  // order symmetry, stencil: each weight is read up to 48 times from cache, and within one
+  // symmetry neighbouring output texels read neighbouring input texels. Blocks are independent
+  // (no barrier inside a level, which matters when another process shares the cores), and
+  // there are at least ~4 per worker so that small levels still use every core. Each output
+  // texel comes from the same stencil and the same order of sums whichever worker computes it.
   const double cap = 2.0 * pi * (1.0 - std::max(cos_max, 0.0));
   const double taps = std::min(6.0 * n * n, 1.5 * cap / (4.0 * pi / (6.0 * n * n)) + 8.0);
-  const std::size_t chunk = std::clamp<std::size_t>(static_cast<std::size_t>(2.0e6 / taps), 1, domain.size());
+  const std::size_t workers = static_cast<std::size_t>(resolve_thread_count(o.thread_count));
+  const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1,
+                                                    std::max<std::size_t>(1, domain.size() / (4 * workers)));
+  const std::size_t blocks = (domain.size() + block - 1) / block;
   const double scale = irradiance ? pi : 1.0;
-  std::vector<stencil> stencils(chunk);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> tasks;  // (stencil in chunk, output texel)
-  std::vector<std::uint8_t> task_g;
-  for (std::size_t begin = 0; begin < domain.size(); begin += chunk) {
-    const std::size_t end = std::min(domain.size(), begin + chunk);
-    parallel_for(end - begin, o.thread_count, 8, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        const auto [x, y] = domain[begin + i];
+  std::vector<std::vector<stencil>> scratch(workers);  // one block of stencils per worker
+  parallel_for(blocks, o.thread_count, 1, [&](int worker, std::size_t begin, std::size_t end) {
+    std::vector<stencil>& stencils = scratch[std::size_t(worker)];
+    stencils.resize(block);
+    for (std::size_t bi = begin; bi < end; ++bi) {
+      const std::size_t b0 = bi * block, b1 = std::min(domain.size(), b0 + block);
+      for (std::size_t i = b0; i < b1; ++i) {
+        const auto [x, y] = domain[i];
         const glm::dvec3 d = glm::normalize(face_point_d(4, cubemap_texel_coordinate(out_size, x, o.fixup),
                                                          cubemap_texel_coordinate(out_size, y, o.fixup)));
-        build_stencil(tab, n, lobe, cos_max, d, stencils[i]);
+        build_stencil(tab, n, lobe, cos_max, d, stencils[i - b0]);
       }
-    });
-    tasks.clear();
-    task_g.clear();
-    // Order: blocks of neighbouring stencils (~128 KB of weights, so they stay in cache), then
-    // symmetry, then stencil: a block's weights are read 48 times from cache, and within one
-    // symmetry neighbouring output texels read neighbouring input texels.
-    const std::size_t block = std::clamp<std::size_t>(static_cast<std::size_t>(32768.0 / taps), 1, chunk);
-    for (std::size_t b0 = begin; b0 < end; b0 += block)
-      for (std::size_t g = 0; g < 48; ++g)
-        for (std::size_t i = b0; i < std::min(end, b0 + block); ++i) {
-          const face_map& m = out_maps[g];
+      for (std::size_t g = 0; g < 48; ++g) {
+        const face_map& m = out_maps[g];
+        const face_map* maps = in_maps.data() + g * 6;
+        for (std::size_t i = b0; i < b1; ++i) {
           const std::size_t t = std::size_t(m.origin + domain[i].first * m.dx + domain[i].second * m.dy);
           if (owner[t] != static_cast<std::int32_t>(g * domain.size() + i)) continue;
-          tasks.emplace_back(static_cast<std::uint32_t>(i - begin), static_cast<std::uint32_t>(t));
-          task_g.push_back(static_cast<std::uint8_t>(g));
+          const stencil& st = stencils[i - b0];
+          float* dst = out.pixels.data() + t * std::size_t(ch);
+          double v[4];
+          apply_stencil(st, maps, px4, v);
+          for (int c = 0; c < ch; ++c)  // alpha: the mean, not scaled
+            dst[c] = static_cast<float>(v[c] * st.norm * (c < 3 ? scale : 1.0));
         }
-    parallel_for(tasks.size(), o.thread_count, 32, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const stencil& s = stencils[tasks[k].first];
-        const face_map* maps = in_maps.data() + std::size_t(task_g[k]) * 6;
-        float* dst = out.pixels.data() + std::size_t(tasks[k].second) * std::size_t(ch);
-        double v[4];
-        apply_stencil(s, maps, px4, v);
-        for (int c = 0; c < ch; ++c)  // alpha: the mean, not scaled
-          dst[c] = static_cast<float>(v[c] * s.norm * (c < 3 ? scale : 1.0));
       }
-    });
-  }
+    }
+  });
   if (o.fixup != edge_fixup::none) share_edge_texels(out, o.fixup);
   return out;
 }
