@@ -177,6 +177,22 @@ inline int fast_floor(double v) noexcept {
   return i - (v < static_cast<double>(i) ? 1 : 0);
 }
 
+// The row v of a face crossed by a cap whose boundary is an ellipse (the `ellipse` case of
+// cap_range): A u^2 + B u + C >= 0 from (dl.(u, v, 1))^2 >= k (1 + u^2 + v^2), A = qa < 0, between
+// the roots (-B -+ sqrt(disc)) / (2 qa), the first the smaller; inv_2qa = 0.5 / qa. The roots are
+// clamped to [-2, 2] (near the ellipse's limit qa -> 0 they blow up). False if the row misses it.
+inline bool cap_row(double dlx, double dly, double dlz, double k, double qa, double inv_2qa, double v, double& lo,
+                    double& hi) noexcept {
+  const double e = dlz + v * dly;
+  const double qb = 2.0 * dlx * e, qc = e * e - k * (1.0 + v * v);
+  const double disc = qb * qb - 4.0 * qa * qc;
+  if (disc < 0.0) return false;
+  const double root = std::sqrt(disc);
+  lo = std::clamp((-qb + root) * inv_2qa, -2.0, 2.0);
+  hi = std::clamp((-qb - root) * inv_2qa, -2.0, 2.0);
+  return true;
+}
+
 // Range of face coordinate (along `c`) covered by the cap {w : d.w >= cos(theta)} on the face with
 // local direction components (dc, dr, da) of d. Returns false if the cap misses the face.
 bool cap_range(double dc, double da, double s2, double rho, double& lo, double& hi) {
@@ -315,15 +331,8 @@ glm::dvec4 filter_direction(const chain_level& level, const lobe& lb, const glm:
         // A < 0 in the ellipse case. Texel centres u = (2x + 1)/n - 1 between the roots; no margin
         // is needed: a centre that rounding puts on the wrong side has a weight of ~cutoff.
         const double v = (2.0 * y + 1.0) / n - 1.0;
-        const double e = dl.z + v * dl.y;
-        const double qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
-        const double disc = qb * qb - 4.0 * qa * qc;
-        if (disc < 0.0) continue;
-        const double root = std::sqrt(disc);
-        // roots (-qb -+ root) / (2 qa); with qa < 0 the first is the smaller
-        // clamped to the face (with a margin): near the ellipse's limit qa -> 0 and the roots blow up
-        const double r_lo = std::clamp((-qb + root) * inv_2qa, -2.0, 2.0);
-        const double r_hi = std::clamp((-qb - root) * inv_2qa, -2.0, 2.0);
+        double r_lo, r_hi;
+        if (!cap_row(dl.x, dl.y, dl.z, k, qa, inv_2qa, v, r_lo, r_hi)) continue;
         xa = std::max(x0, fast_floor((r_lo + 1.0) * h - 0.5) + 1);
         xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5));
         if (xb < xa) continue;
@@ -604,13 +613,8 @@ void build_stencil(const double_table& tab, int n, const lobe_power& lobe, doubl
         // the row's span of the cap (as filter_direction), widened by one texel each side: the
         // weights below decide exactly which texels count
         const double v = (2.0 * y + 1.0) / n - 1.0;
-        const double e = dl.z + v * dl.y;
-        const double qb = 2.0 * dl.x * e, qc = e * e - k * (1.0 + v * v);
-        const double disc = qb * qb - 4.0 * qa * qc;
-        if (disc < 0.0) continue;
-        const double root = std::sqrt(disc);
-        const double r_lo = std::clamp((-qb + root) * (0.5 / qa), -2.0, 2.0);
-        const double r_hi = std::clamp((-qb - root) * (0.5 / qa), -2.0, 2.0);
+        double r_lo, r_hi;
+        if (!cap_row(dl.x, dl.y, dl.z, k, qa, 0.5 / qa, v, r_lo, r_hi)) continue;
         xa = std::max(x0, fast_floor((r_lo + 1.0) * h - 0.5));
         xb = std::min(x1, fast_floor((r_hi + 1.0) * h - 0.5) + 1);
         if (xb < xa) continue;

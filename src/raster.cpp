@@ -295,6 +295,19 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 }
 #endif
 
+// The resolves' per-texel copy (groups of texels with different shades, and the scalar path): the shade (ids[k]
+// indexes shades) copied to its radiance planes and flags.
+inline void copy_shades(const std::uint32_t* ids, std::size_t count, const hemicube_rasterizer::shade* shades,
+                        float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
+  for (std::size_t k = 0; k < count; ++k) {
+    const hemicube_rasterizer::shade& sh = shades[ids[k]];
+    red[k] = sh.r;
+    green[k] = sh.g;
+    blue[k] = sh.b;
+    flags[k] = static_cast<std::uint8_t>(sh.flags);
+  }
+}
+
 #if HEMILIGHT_RASTER_AVX2
 // The AVX2 kernels compute exactly what the scalar reference does (the same float operations in
 // the same order; target("avx2") does not enable FMA contraction), so buffers stay bit-identical.
@@ -438,13 +451,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
           run_id = run_key = _mm256_set1_epi32(-1);
           alignas(32) std::uint32_t lane[8];
           _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
-          for (std::size_t k = 0; k < 8; ++k) {
-            const hemicube_rasterizer::shade& sh = shades[lane[k]];
-            red[i + k] = sh.r;
-            green[i + k] = sh.g;
-            blue[i + k] = sh.b;
-            flags[i + k] = static_cast<std::uint8_t>(sh.flags);
-          }
+          copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
           continue;
         }
         // A new run of shade key `first`.
@@ -515,13 +522,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
       }
       std::uint32_t lane[4];
       _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
-      for (std::size_t k = 0; k < 4; ++k) {
-        const hemicube_rasterizer::shade& sh = shades[lane[k]];
-        red[i + k] = sh.r;
-        green[i + k] = sh.g;
-        blue[i + k] = sh.b;
-        flags[i + k] = static_cast<std::uint8_t>(sh.flags);
-      }
+      copy_shades(lane, 4, shades, red + i, green + i, blue + i, flags + i);
     }
   }
 #endif
@@ -530,11 +531,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
     distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
     ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
     depth[i] = 0.0f;                         // cleared for the next render
-    const hemicube_rasterizer::shade& sh = shades[ids[i]];
-    red[i] = sh.r;
-    green[i] = sh.g;
-    blue[i] = sh.b;
-    flags[i] = static_cast<std::uint8_t>(sh.flags);
+    copy_shades(ids + i, 1, shades, red + i, green + i, blue + i, flags + i);
   }
 }
 
