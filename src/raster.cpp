@@ -295,8 +295,8 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 }
 #endif
 
-// The resolves' per-texel copy (groups of texels with different shades, and the scalar path): the shade (ids[k]
-// indexes shades) copied to its radiance planes and flags.
+// The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
+// the shade (ids[k] indexes shades) copied to the radiance planes and flags.
 inline void copy_shades(const std::uint32_t* ids, std::size_t count, const hemicube_rasterizer::shade* shades,
                         float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
   for (std::size_t k = 0; k < count; ++k) {

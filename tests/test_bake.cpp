@@ -468,6 +468,24 @@ double triangle_solid_angle(const glm::dvec3& p, glm::dvec3 a, glm::dvec3 b, glm
   return 2.0 * std::atan2(num, den);
 }
 
+// A directional hemicube reference at N = 512 in the floors' texel frame (+z, +x, +y) of the
+// directional tests below (integrate_options::directional: L1 SH and the HL2 basis).
+struct floor_reference {
+  explicit floor_reference(const scene_desc& d) : raster(scene::create(d)), integrator(512, directional()) {}
+  irradiance_sample at(const glm::vec3& p) {
+    raster.render(p, frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, 512, buf);
+    return integrator.integrate(buf);
+  }
+  static integrate_options directional() {
+    integrate_options io;
+    io.directional = true;
+    return io;
+  }
+  hemicube_rasterizer raster;
+  hemicube_integrator integrator;
+  hemicube_buffer buf;
+};
+
 }  // namespace
 
 TEST_CASE("Directional maps under a uniform sky match the closed forms in right- and left-handed charts", "[bake]") {
@@ -564,12 +582,7 @@ TEST_CASE("Directional maps against Lambert's closed form and per-texel hemicube
   // the tangent frame (+z, +x, +y), integrated with integrate_options::directional, at N = 512 on
   // every fourth texel of every fourth row (at N = 64 without roll the emitter's edges line up
   // with the texel grid: 8 texel centres for 8.5 texels across, a 12% error at the centre).
-  auto sc = scene::create(in.scene);
-  hemicube_rasterizer raster(sc);
-  integrate_options io;
-  io.directional = true;
-  hemicube_integrator integrator(512, io);
-  hemicube_buffer buf;
+  floor_reference reference(in.scene);
 
   double sh_err = 0, sh_norm = 0, trunc_err = 0, cache_err = 0, ref_err = 0, ref_norm = 0, hl2_norm = 0, worst_trunc = 0;
   for (int row = 0; row < 16; ++row)
@@ -590,8 +603,7 @@ TEST_CASE("Directional maps against Lambert's closed form and per-texel hemicube
       const bool probe = row % 4 == 1 && col % 4 == 1;
       irradiance_sample ref;
       if (probe) {
-        raster.render(glm::vec3(p) + glm::vec3(0, 1e-4f, 0), frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, 512, buf);
-        ref = integrator.integrate(buf);
+        ref = reference.at(glm::vec3(p) + glm::vec3(0, 1e-4f, 0));
       }
       for (std::size_t j = 0; j < 3; ++j) {
         const double exact = glm::dot(phi, basis[j]);
@@ -766,12 +778,7 @@ TEST_CASE("HL2 maps of a grazing side light in right- and left-handed charts aga
   const bake_result r = bake_lightmap(in, o);
   const lightmap_samples smp = compute_lightmap_samples(in, 64, 16);
 
-  auto sc = scene::create(in.scene);
-  hemicube_rasterizer raster(sc);
-  integrate_options io;
-  io.directional = true;
-  hemicube_integrator integrator(512, io);
-  hemicube_buffer buf;
+  floor_reference reference(in.scene);
   double cone_err = 0, sh_err = 0, norm = 0;
   for (int floor_b = 0; floor_b < 2; ++floor_b)
     for (int row = 1; row < 16; row += 3)
@@ -782,8 +789,7 @@ TEST_CASE("HL2 maps of a grazing side light in right- and left-handed charts aga
         // The texel frames as laid out above (not read from the baker).
         const glm::vec3 b = floor_b ? glm::vec3(-1, 0, 0) : glm::vec3(1, 0, 0);
         CHECK(glm::length(smp.bitangent[k] - b) < 1e-6f);
-        raster.render(p, frame{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, 512, buf);
-        const irradiance_sample ref = integrator.integrate(buf);
+        const irradiance_sample ref = reference.at(p);
         std::array<glm::vec3, 4> sh;
         for (std::size_t j = 0; j < 4; ++j) {
           const float* q = &r.sh_l1[j].pixels[3 * k];
