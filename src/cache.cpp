@@ -235,10 +235,6 @@ class point_grid {
   std::vector<std::uint32_t> start_, points_;
 };
 
-// Interpolation at one point through the BVH; returns the weight sum (0: not covered).
-// `spread` (optional) receives the range (max - min) of the luminance the covering records
-// predict for the point, and `own` whether one of them sits at the point itself.
-// `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered).
 // What the placement's coverage test needs beyond the value: how many records cover the point and
 // the largest first-order term |lum(prediction) - lum(E_i)| of a covering record relative to
 // max(lum(E_i), floor) (floor given in).
@@ -248,6 +244,11 @@ struct coverage_detail {
   float first_order = 0.0f;
 };
 
+// Interpolation at one point through the BVH; returns the weight sum (0: not covered).
+// `spread` (optional) receives the range (max - min) of the luminance the covering records
+// predict for the point, and `own` whether one of them sits at the point itself.
+// `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered),
+// `cone` the same of the HL2 cones, `detail` (optional) what coverage_detail describes.
 float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
