@@ -192,6 +192,7 @@ hemicube_integrator::hemicube_integrator(int resolution, const integrate_options
   table_ = integration_table::get(resolution);  // validates the resolution
   const std::size_t count = hemicube_texel_count(resolution);
   inv_r_.resize(count);
+  lit_.resize(count / 8 + 2);
 }
 
 namespace {
@@ -368,11 +369,12 @@ HEMILIGHT_TARGET_AVX2_FMA inline double hsum(__m256 v) noexcept {
 
 // Pass 1 with the vector sums: inv[i] = 1 / dist[i]; s1 = (E_r, E_g, E_b, sum P, sum P / r,
 // sum P back); phi = per channel (sum L x, sum L y), always (six FMAs per step; the caller
-// ignores them without g_r or directional outputs); returns min dist.
+// ignores them without g_r or directional outputs); lit[k] = whether any radiance of texels
+// 8k..8k+7 is non-zero (bitwise; count / 8 rounded up entries); returns min dist.
 HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, const float* b, const float* dist,
                                                 const std::uint8_t* flags, const float* vx, const float* vy,
-                                                const float* vz, float* inv, std::size_t count, double* s1,
-                                                double* phi) noexcept {
+                                                const float* vz, float* inv, std::uint8_t* lit, std::size_t count,
+                                                double* s1, double* phi) noexcept {
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m128i back_bit = _mm_set1_epi8(2);  // texel_back_face
   __m256 min_d = _mm256_set1_ps(std::numeric_limits<float>::infinity());
@@ -394,18 +396,22 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
       fl = _mm_cmpeq_epi8(_mm_and_si128(fl, back_bit), back_bit);
       const __m256 is_back = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(fl));
       bk = _mm256_add_ps(bk, _mm256_and_ps(is_back, p));
-      __m256 l = _mm256_loadu_ps(r + i);
-      e0 = _mm256_fmadd_ps(l, p, e0);
-      a0 = _mm256_fmadd_ps(l, x, a0);
-      a1 = _mm256_fmadd_ps(l, y, a1);
-      l = _mm256_loadu_ps(g + i);
-      e1 = _mm256_fmadd_ps(l, p, e1);
-      a2 = _mm256_fmadd_ps(l, x, a2);
-      a3 = _mm256_fmadd_ps(l, y, a3);
-      l = _mm256_loadu_ps(b + i);
-      e2 = _mm256_fmadd_ps(l, p, e2);
-      a4 = _mm256_fmadd_ps(l, x, a4);
-      a5 = _mm256_fmadd_ps(l, y, a5);
+      const __m256 lr = _mm256_loadu_ps(r + i), lg = _mm256_loadu_ps(g + i), lb = _mm256_loadu_ps(b + i);
+      // Black groups (every bit of the three channels zero) add exactly nothing below; most of
+      // an emission-only hemicube is black, so they skip the sums and tell the wall pass.
+      const __m256i any = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(lr, lg), lb));
+      const bool is_lit = !_mm256_testz_si256(any, any);
+      lit[i >> 3] = is_lit;
+      if (!is_lit) continue;
+      e0 = _mm256_fmadd_ps(lr, p, e0);
+      a0 = _mm256_fmadd_ps(lr, x, a0);
+      a1 = _mm256_fmadd_ps(lr, y, a1);
+      e1 = _mm256_fmadd_ps(lg, p, e1);
+      a2 = _mm256_fmadd_ps(lg, x, a2);
+      a3 = _mm256_fmadd_ps(lg, y, a3);
+      e2 = _mm256_fmadd_ps(lb, p, e2);
+      a4 = _mm256_fmadd_ps(lb, x, a4);
+      a5 = _mm256_fmadd_ps(lb, y, a5);
     }
     const __m256 sums[12] = {e0, e1, e2, pt, hs, bk, a0, a1, a2, a3, a4, a5};
     for (int k = 0; k < 6; ++k) s1[k] += hsum(sums[k]);
@@ -415,7 +421,9 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
   _mm256_store_ps(m, min_d);
   float md = m[0];
   for (float v : m) md = v < md ? v : md;
+  if (i < count) lit[i >> 3] = 0;
   for (; i < count; ++i) {  // tail (count is a multiple of 4, not always of 8)
+    lit[i >> 3] |= r[i] != 0.0f || g[i] != 0.0f || b[i] != 0.0f;
     inv[i] = 1.0f / dist[i];
     md = dist[i] < md ? dist[i] : md;
     const double p = vz[i];
@@ -437,10 +445,13 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
 
 // Both wall passes inside faces (right neighbour i + 1, coefficients rx, ry, over i < count - 1;
 // the texel above i + row, coefficients ux, uy, over i < count - row) into acc[6], as
-// wall_sums_impl does for each.
+// wall_sums_impl does for each. lit: texel_pass_avx2's black-group map; a group whose texels
+// and right and upper neighbours are all black has zero radiance differences and is skipped
+// (it would add exactly +-0 to every sum: the result is the same bits).
 HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, const float* b, const float* inv,
-                                              const float* rx, const float* ry, const float* ux, const float* uy,
-                                              std::size_t row, std::size_t count, float cap, double* acc) noexcept {
+                                              const std::uint8_t* lit, const float* rx, const float* ry,
+                                              const float* ux, const float* uy, std::size_t row,
+                                              std::size_t count, float cap, double* acc) noexcept {
   const std::size_t both = count - row;  // texels with both walls
   const __m256 cp = _mm256_set1_ps(cap);
   std::size_t i = 0;
@@ -448,6 +459,8 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
     const std::size_t b1 = std::min(both, b0 + block) & ~std::size_t(7);
     __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0;
     for (i = b0; i < b1; i += 8) {
+      // Texels i..i+8 (right walls) and i+row..i+row+7 (upper walls) all black: nothing to add.
+      if (!(lit[i >> 3] | lit[(i >> 3) + 1] | lit[(i + row) >> 3] | lit[(i + row + 7) >> 3])) continue;
       const __m256 iv = _mm256_loadu_ps(inv + i);
       const __m256 wr = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + 1)), cp);
       const __m256 wu = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + row)), cp);
@@ -528,7 +541,7 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
 #endif
   if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
-    min_d = texel_pass_avx2(r, g, b, dist, flags, vx, vy, vz, inv, count, s1, phi);
+    min_d = texel_pass_avx2(r, g, b, dist, flags, vx, vy, vz, inv, lit_.data(), count, s1, phi);
     have_phi = true;
 #endif
   } else if constexpr (std::is_same<Inner, float>::value) {
@@ -590,7 +603,7 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     };
     if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
-      wall_pass_avx2(r, g, b, inv, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
+      wall_pass_avx2(r, g, b, inv, lit_.data(), arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
                      arc ? t.right_great_arc_y.data() : t.right_classified_y.data(),
                      arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
                      arc ? t.up_great_arc_y.data() : t.up_classified_y.data(), row, count, cap, acc);
@@ -602,6 +615,8 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
             arc ? t.up_great_arc_y.data() : t.up_classified_y.data());
     }
     for (const integration_table::wall& w : t.border_walls) {  // 6 N walls across face borders
+      // Equal radiance on both sides adds exactly zero (most walls of an emission-only hemicube).
+      if (r[w.a] == r[w.b] && g[w.a] == g[w.b] && b[w.a] == b[w.b]) continue;
       const double iw = std::min(std::max(inv[w.a], inv[w.b]), cap);
       const float* c = arc ? w.great_arc : w.classified;
       const double wx = c[0] * iw, wy = c[1] * iw;

@@ -309,6 +309,44 @@ TEST_CASE("integrate: float and double accumulation agree (both float kernels)",
   CHECK(integrate(buf, od).backface_fraction == Approx(1.0 / 7.0).epsilon(0.02));
 }
 
+TEST_CASE("integrate: black texel groups are skipped without losing a wall", "[integrate]") {
+  // The AVX2 kernels skip groups of eight texels whose radiance is all zero (and whose right and
+  // upper neighbours are too). One lit texel at a time, at every position (every lane of a group,
+  // group ends, row and face ends, N = 30 whose rows are not a multiple of 8, N = 6 and 10 with a
+  // tail of 4, which the last upper walls of N = 10 read): a skipped wall would drop about a
+  // quarter of the texel's gradient. Reference: the
+  // double path, which has no skip. One texel's walls are four terms, so float and double agree
+  // to rounding: 1e-5 of the gradient's size, plus 1e-6 of the largest single-texel gradient of
+  // that N for texels whose opposite walls cancel (their float sum keeps ~1e-7 of the terms).
+  const closed_form_scene s = lit_room();
+  for (int n : {6, 10, 16, 30}) {
+    hemicube_buffer buf = render(s, n, s.position, s.normal);
+    std::fill(buf.radiance.begin(), buf.radiance.end(), 0.0f);
+    integrate_options of, od;
+    od.double_precision = true;
+    hemicube_integrator fast(n, of), ref(n, od);
+    std::vector<irradiance_sample> a, d;
+    float largest = 0.0f;
+    for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+      for (int c = 0; c < 3; ++c) buf.channel(c)[i] = 1.0f + 0.5f * static_cast<float>(c);
+      a.push_back(fast.integrate(buf));
+      d.push_back(ref.integrate(buf));
+      for (int c = 0; c < 3; ++c) buf.channel(c)[i] = 0.0f;
+      largest = std::max(largest, glm::length(d.back().translation_gradient[2]));
+    }
+    REQUIRE(largest > 0.0f);
+    for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+      INFO("N " << n << ", lit texel " << i);
+      CHECK(a[i].irradiance.z == Approx(d[i].irradiance.z).epsilon(1e-6));
+      for (std::size_t c = 0; c < 3; ++c) {
+        const float size = glm::length(d[i].translation_gradient[c]);
+        CHECK(glm::length(a[i].translation_gradient[c] - d[i].translation_gradient[c]) <=
+              1e-5f * size + 1e-6f * largest);
+      }
+    }
+  }
+}
+
 TEST_CASE("integrate: the result does not depend on the hemicube's roll beyond the discretisation bound", "[integrate]") {
   const closed_form_scene s = unoccluded_emitter();
   const int n = 64;

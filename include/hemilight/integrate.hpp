@@ -35,6 +35,7 @@
 #include "hemilight/hemicube.hpp"
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -140,6 +141,7 @@ class hemicube_integrator {
   integrate_options options_;
   std::shared_ptr<const integration_table> table_;
   std::vector<float> inv_r_;  // scratch: 1/distance per texel
+  std::vector<std::uint8_t> lit_;  // scratch (AVX2 kernels): per group of 8 texels, any radiance non-zero
 };
 
 /// Convenience: integrate one buffer with a temporary integrator (fetches the cached table;
