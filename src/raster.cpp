@@ -338,6 +338,58 @@ HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, i
   }
 }
 
+// The exact span walk's rows in depth mode (draw_fixed): walk_rows with span_avx2's depth test
+// inlined and its constants set up once per triangle instead of once per row. The same float
+// operations on the same values as span_avx2 and the scalar span, so the same bits.
+struct depth_spans_avx2 {
+  float* depth;
+  std::uint32_t* ids;
+  std::size_t n;
+  double z00, dzdy;
+  __m256 dz, zmin, id;
+  __m256i lane, eight;
+  std::size_t spans = 0, fragments = 0;
+
+  HEMILIGHT_TARGET_AVX2 depth_spans_avx2(float* depth_, std::uint32_t* ids_, int n_, double z00_, double dzdy_,
+                                         float dzdx, std::uint32_t draw) noexcept
+      : depth(depth_), ids(ids_), n(static_cast<std::size_t>(n_)), z00(z00_), dzdy(dzdy_),
+        dz(_mm256_set1_ps(dzdx)), zmin(_mm256_set1_ps(FLT_MIN)),
+        id(_mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)))),
+        lane(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), eight(_mm256_set1_epi32(8)) {}
+
+  HEMILIGHT_TARGET_AVX2 void operator()(int y, int lo, int hi) noexcept {
+    ++spans;
+    fragments += static_cast<std::size_t>(hi - lo + 1);
+    const std::size_t row = static_cast<std::size_t>(y) * n;
+    const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * y));
+    const __m256i end = _mm256_set1_epi32(hi + 1);
+    float* drow = depth + row;
+    std::uint32_t* irow = ids + row;
+    __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), lane);
+    for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
+      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
+      depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
+    }
+  }
+};
+
+// The span walk of draw_fixed (see there), depth mode, AVX2. flatten: walk_rows and the span
+// functor are inlined here (an always_inline functor could not be: walk_rows is not AVX2 code).
+HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(int nl, int nr, const edge_walk* left, const edge_walk* right,
+                                           std::int64_t y0, std::int64_t y1, std::int64_t x_begin, std::int64_t x_end,
+                                           float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
+                                           float dzdx, std::uint32_t draw, raster_statistics& stats) noexcept {
+  depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
+  if (nl == 1 && nr == 1)
+    walk_rows<1, 1>(left, right, y0, y1, x_begin, x_end, span);
+  else if (nl == 1 && nr == 2)
+    walk_rows<1, 2>(left, right, y0, y1, x_begin, x_end, span);
+  else if (nl == 2 && nr == 1)
+    walk_rows<2, 1>(left, right, y0, y1, x_begin, x_end, span);
+  stats.spans += span.spans;
+  stats.fragments += span.fragments;
+}
+
 // The small-triangle path of small_triangle_sse2_impl, eight texels per step.
 // base, sx, sy: the 32-bit edge values at the box's first texel (x_begin, y_begin) and their
 // steps per texel in x and y (the caller checks they fit, see avx2_extent).
@@ -441,12 +493,20 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
                                         _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(ids + i), id);
     if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) != -1) {
-      const __m256i key = _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
+      // Eight texels of one record (most groups: big triangles, black walls) look up its key
+      // with one load; only groups of several records gather (slow on some CPUs). Either way the
+      // run remembers the record, so the next group of the same record skips the lookup.
+      const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
+      const bool one_record = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1;
+      const __m256i key =
+          one_record ? _mm256_set1_epi32(static_cast<int>(keys[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(id))]))
+                     : _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
+      const __m256i this_run = one_record ? id0 : _mm256_set1_epi32(-1);
       if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1) {
-        run_id = _mm256_set1_epi32(-1);  // same shade, other records: the run goes on
+        run_id = this_run;  // same shade (maybe other records): the run goes on
       } else {
         const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
-        if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
+        if (!one_record && _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
           // Mixed shades: texel by texel.
           run_id = run_key = _mm256_set1_epi32(-1);
           alignas(32) std::uint32_t lane[8];
@@ -456,8 +516,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
         }
         // A new run of shade key `first`.
         run_key = first;
-        const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
-        run_id = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1 ? id0 : _mm256_set1_epi32(-1);
+        run_id = this_run;
         const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
         run_r = _mm256_set1_ps(sh.r);
         run_g = _mm256_set1_ps(sh.g);
@@ -1438,6 +1497,13 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   }
   // A triangle with area has a left and a right bound: (1, 1) with a horizontal edge, else
   // (1, 2) or (2, 1). Fixed counts keep the walk in registers.
+  assert((nl == 1 && nr == 1) || (nl == 1 && nr == 2) || (nl == 2 && nr == 1));
+#if HEMILIGHT_RASTER_AVX2
+  if (M == mode::depth && avx2_) {
+    walk_depth_avx2(nl, nr, left, right, y_first, y_last, x_begin, x_end, depth, ids, n, z00, dzdy, dzdx, draw, stats_);
+    return;
+  }
+#endif
   if (nl == 1 && nr == 1)
     walk_rows<1, 1>(left, right, y_first, y_last, x_begin, x_end, span);
   else if (nl == 1 && nr == 2)
