@@ -506,9 +506,33 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
         run_id = this_run;  // same shade (maybe other records): the run goes on
       } else {
         const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
-        if (!one_record && _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, first)) != -1) {
-          // Mixed shades: texel by texel.
+        const __m256i is_first = _mm256_cmpeq_epi32(key, first);
+        if (!one_record && _mm256_movemask_epi8(is_first) != -1) {
           run_id = run_key = _mm256_set1_epi32(-1);
+          // Two shades (a group across the boundary of two regions, the usual mixed group): the
+          // first lane's and the last lane's, blended.
+          const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
+          if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
+            const hemicube_rasterizer::shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+            const hemicube_rasterizer::shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
+            const __m256 m = _mm256_castsi256_ps(is_first);
+            _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
+            _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
+            _mm256_storeu_ps(blue + i, _mm256_blendv_ps(_mm256_set1_ps(s1.b), _mm256_set1_ps(s0.b), m));
+            // Byte k of `pick` is 0xff where lane k has the first shade: byte 0 of each lane's mask.
+            const __m256i bytes = _mm256_shuffle_epi8(
+                is_first, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1,
+                                           -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
+            const std::uint64_t pick =
+                static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_castsi256_si128(bytes))) |
+                static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_extracti128_si256(bytes, 1))))
+                    << 32;
+            const std::uint64_t f0 = (s0.flags & 0xffu) * 0x0101010101010101ull, f1 = (s1.flags & 0xffu) * 0x0101010101010101ull;
+            const std::uint64_t f = (f0 & pick) | (f1 & ~pick);
+            std::memcpy(flags + i, &f, 8);
+            continue;
+          }
+          // More shades: texel by texel.
           alignas(32) std::uint32_t lane[8];
           _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
           copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
@@ -1185,8 +1209,13 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
 }
 #endif
 
-std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
-                                                 const radiance_texture* texture) {
+#if defined(__GNUC__) || defined(__clang__)
+// Inlined into the set-up: called once per drawn triangle, where a call's saves and restores
+// were a fifth of its cost.
+__attribute__((always_inline))
+#endif
+inline std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
+                                                        const radiance_texture* texture) {
   const material& m = scene_->triangle_material(tri.index);
   const bool back = rec.plane > 0.0f && !m.two_sided;
   const auto draw = static_cast<std::uint32_t>(draws_.size());
@@ -1471,6 +1500,36 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
     } else if (e0[k] < 0) {
       return;  // a zero-length edge (not reached: such triangles have no area)
     }
+  }
+  // A triangle reaching far past the face's sides (clipped triangles reach the guard band) has
+  // rows whose span lies wholly outside the face: they are walked for nothing. Its part inside
+  // the columns x_begin..x_end (widened by a texel) spans the rows whose centres lie within the
+  // y range of that part's vertices (the corners inside the strip and the edges' crossings of
+  // its sides); widened by a row, that range is conservative (the crossings are computed in
+  // double, to far below a texel), so the rows it drops have no covered texel and the walk
+  // below stays exact. Convexity: the rows of the part are contiguous.
+  const double strip_lo = static_cast<double>((x_begin - 1) * sub_one + sub_half);
+  const double strip_hi = static_cast<double>((x_end + 1) * sub_one + sub_half);
+  if (static_cast<double>(min_x) < strip_lo || static_cast<double>(max_x) > strip_hi) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int k = 0; k < 3; ++k) {
+      const double ax = static_cast<double>(p[k].x), ay = static_cast<double>(p[k].y);
+      const double bx = static_cast<double>(p[(k + 1) % 3].x), by = static_cast<double>(p[(k + 1) % 3].y);
+      if (ax >= strip_lo && ax <= strip_hi) {
+        lo = std::min(lo, ay);
+        hi = std::max(hi, ay);
+      }
+      for (const double side : {strip_lo, strip_hi}) {
+        if ((ax < side) == (bx < side)) continue;
+        const double y = ay + (side - ax) / (bx - ax) * (by - ay);
+        lo = std::min(lo, y);
+        hi = std::max(hi, y);
+      }
+    }
+    if (!(lo <= hi)) return;  // the triangle passes beside the face's columns
+    // Rows k with centre k + 1/2 in [lo, hi] (fixed point), one more on each side.
+    y_first = std::max(y_first, static_cast<std::int64_t>(std::floor((lo - sub_half) / sub_one)));
+    y_last = std::min(y_last, static_cast<std::int64_t>(std::ceil((hi - sub_half) / sub_one)));
   }
   if (y_first > y_last) return;
   edge_walk left[3], right[3];
