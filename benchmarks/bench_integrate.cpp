@@ -7,6 +7,7 @@
 #include "hemilight/raster.hpp"
 #include "hemilight/reference_scenes.hpp"
 
+#include "bench_points.hpp"
 #include "integrate_scenes.hpp"
 
 #include <benchmark/benchmark.h>
@@ -59,7 +60,7 @@ static void build_table(benchmark::State& state) {
 BENCHMARK(build_table)->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 
 // The target: render + integrate with gradients (great arc) at N = 64 on the Cornell box,
-// one core. Points on the floor, walls and boxes of the box, normals into the room, cycled.
+// one core, at the 128 points of bench::cornell_floor_and_back_wall (bench_points.hpp), cycled.
 static void render_and_integrate_cornell(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const scene_mesh mesh = cornell_box();
@@ -67,17 +68,11 @@ static void render_and_integrate_cornell(benchmark::State& state) {
   hemicube_rasterizer raster(sc);
   hemicube_integrator integrator(n);
   hemicube_buffer buf;
-  struct pt { glm::vec3 x, n; };
-  std::vector<pt> pts;
-  for (int k = 0; k < 64; ++k) {
-    const float u = (float(k % 8) + 0.5f) / 8.0f, v = (float(k / 8) + 0.5f) / 8.0f;
-    pts.push_back({{0.556f * u, 0.001f, 0.559f * v}, {0, 1, 0}});          // floor
-    pts.push_back({{0.556f * u, 0.5488f * v, 0.558f}, {0, 0, -1}});        // back wall
-  }
+  const bench::sample_points pts = bench::cornell_floor_and_back_wall();
   std::size_t i = 0;
   for (auto _ : state) {
-    const pt& p = pts[i++ % pts.size()];
-    raster.render(p.x, make_frame(p.n), n, buf);
+    const std::size_t k = i++ % pts.points.size();
+    raster.render(pts.points[k], pts.frames[k], n, buf);
     benchmark::DoNotOptimize(integrator.integrate(buf));
   }
   state.SetItemsProcessed(state.iterations());  // hemicubes

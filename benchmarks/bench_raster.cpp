@@ -12,12 +12,13 @@
 #include "hemilight/raster.hpp"
 #include "hemilight/reference_scenes.hpp"
 
+#include "bench_points.hpp"
+
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -33,36 +34,13 @@ struct bench_scene {
   std::vector<frame> frames;
 };
 
-// Area-weighted random points on the front faces of a scene.
+// Area-weighted random points on the front faces of a scene (bench_points.hpp).
 void make_points(bench_scene& b) {
   const scene_mesh m = b.build();
   b.built = scene::create(m.desc());
-  std::vector<double> cumulative(m.triangle_count());
-  double total = 0;
-  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
-    const glm::dvec3 a(m.positions[m.indices[3 * i]]), p(m.positions[m.indices[3 * i + 1]]), c(m.positions[m.indices[3 * i + 2]]);
-    total += glm::length(glm::cross(p - a, c - a));
-    cumulative[i] = total;
-  }
-  std::mt19937 rng(2024);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const float lift = 1e-4f * b.built->size();
-  while (b.points.size() < 256) {
-    const double x = u(rng) * total;
-    const std::size_t i = static_cast<std::size_t>(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin());
-    if (i >= m.triangle_count()) continue;
-    const glm::vec3 a = m.positions[m.indices[3 * i]], p = m.positions[m.indices[3 * i + 1]], c = m.positions[m.indices[3 * i + 2]];
-    glm::vec3 n = glm::cross(p - a, c - a);
-    if (glm::length(n) == 0.0f) continue;
-    n = glm::normalize(n);
-    double s = u(rng), t = u(rng);
-    if (s + t > 1) {
-      s = 1 - s;
-      t = 1 - t;
-    }
-    b.points.push_back(a + static_cast<float>(s) * (p - a) + static_cast<float>(t) * (c - a) + lift * n);
-    b.frames.push_back(make_frame(n));
-  }
+  bench::sample_points p = bench::surface_points(m, 256, 1e-4f * b.built->size());
+  b.points = std::move(p.points);
+  b.frames = std::move(p.frames);
 }
 
 std::vector<bench_scene>& scenes() {
