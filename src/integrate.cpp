@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -391,11 +392,15 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
       const __m256 p = _mm256_loadu_ps(vz + i), x = _mm256_loadu_ps(vx + i), y = _mm256_loadu_ps(vy + i);
       pt = _mm256_add_ps(pt, p);
       hs = _mm256_fmadd_ps(p, iv, hs);
-      // Back-face texels: bytes with bit 1 set, widened to lane masks.
-      __m128i fl = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(flags + i));
-      fl = _mm_cmpeq_epi8(_mm_and_si128(fl, back_bit), back_bit);
-      const __m256 is_back = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(fl));
-      bk = _mm256_add_ps(bk, _mm256_and_ps(is_back, p));
+      // Back-face texels: bytes with bit 1 set, widened to lane masks (most groups have none).
+      std::uint64_t eight_flags;
+      std::memcpy(&eight_flags, flags + i, 8);
+      if (eight_flags & 0x0202020202020202ull) {
+        __m128i fl = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(flags + i));
+        fl = _mm_cmpeq_epi8(_mm_and_si128(fl, back_bit), back_bit);
+        const __m256 is_back = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(fl));
+        bk = _mm256_add_ps(bk, _mm256_and_ps(is_back, p));
+      }
       const __m256 lr = _mm256_loadu_ps(r + i), lg = _mm256_loadu_ps(g + i), lb = _mm256_loadu_ps(b + i);
       // Black groups (every bit of the three channels zero) add exactly nothing below; most of
       // an emission-only hemicube is black, so they skip the sums and tell the wall pass.
