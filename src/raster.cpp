@@ -375,10 +375,10 @@ struct depth_spans_avx2 {
 
 // The span walk of draw_fixed (see there), depth mode, AVX2. flatten: walk_rows and the span
 // functor are inlined here (an always_inline functor could not be: walk_rows is not AVX2 code).
-HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(int nl, int nr, const edge_walk* left, const edge_walk* right,
-                                           std::int64_t y0, std::int64_t y1, std::int64_t x_begin, std::int64_t x_end,
-                                           float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
-                                           float dzdx, std::uint32_t draw, raster_statistics& stats) noexcept {
+HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(
+    int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
+    std::int64_t x_begin, std::int64_t x_end, float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
+    float dzdx, std::uint32_t draw, raster_statistics& stats) noexcept {
   depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
   if (nl == 1 && nr == 1)
     walk_rows<1, 1>(left, right, y0, y1, x_begin, x_end, span);
