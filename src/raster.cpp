@@ -423,8 +423,10 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       a = _mm256_add_epi32(a, dy[0]);
       b = _mm256_add_epi32(b, dy[1]);
       c = _mm256_add_epi32(c, dy[2]);
+      // No test for an empty row: the depth test then stores back what it loaded, and a branch
+      // here mispredicted often enough (slivers, box corners) to cost more than the stores: without
+      // it and the one below, the room renders ~13% faster (interleaved timings; more instructions).
       const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
-      if (_mm256_movemask_ps(mask) == 0) continue;
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
       const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
       depth_test8(depth + i, ids + i, _mm256_max_ps(_mm256_add_ps(zr, zx), zmin), mask, id);
@@ -442,8 +444,8 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       a = _mm256_add_epi32(a, step[0]);
       b = _mm256_add_epi32(b, step[1]);
       c = _mm256_add_epi32(c, step[2]);
+      // No test for an empty group either (see the one-group loop above).
       const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
-      if (_mm256_movemask_ps(mask) == 0) continue;
       const std::size_t i = r + static_cast<std::size_t>(x);
       if (count_mode) {
         __m256i* cp = reinterpret_cast<__m256i*>(counts + i);
