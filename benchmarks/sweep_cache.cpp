@@ -20,6 +20,8 @@
 //     --gradients LIST    any of yes,no (default yes,no)
 //     --threads T         worker threads (default 0 = all cores)
 //     --second-opinion F  cache_options::second_opinion (default: the option's default; 0 = off)
+//     --nearby-opinion F  cache_options::nearby_opinion (default: the option's default; 0 = off)
+//     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --variant NAME      written to the last CSV column (default "default"): which cache options
 //   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
@@ -184,6 +186,8 @@ int main(int argc, char** argv) {
   std::string variant = "default";
   int worst_k = 0;
   float second_opinion = cache_options{}.second_opinion;
+  float nearby_opinion = cache_options{}.nearby_opinion;
+  float sole_reach = cache_options{}.sole_record_reach;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
   std::vector<std::string> scene_keys{"cornell", "hexagon", "sky"};
@@ -218,6 +222,14 @@ int main(int argc, char** argv) {
       const std::string v = value();
       second_opinion = std::strtof(v.c_str(), nullptr);
       if (!(second_opinion >= 0.0f && second_opinion < 1e6f)) usage(("bad --second-opinion '" + v + "'").c_str());
+    } else if (arg == "--nearby-opinion") {
+      const std::string v = value();
+      nearby_opinion = std::strtof(v.c_str(), nullptr);
+      if (!(nearby_opinion >= 0.0f && nearby_opinion <= 16.0f)) usage(("bad --nearby-opinion '" + v + "'").c_str());
+    } else if (arg == "--sole-reach") {
+      const std::string v = value();
+      sole_reach = std::strtof(v.c_str(), nullptr);
+      if (!(sole_reach > 0.0f && sole_reach <= 1.0f)) usage(("bad --sole-reach '" + v + "'").c_str());
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
     else if (arg == "--threads") thread_arg = to_int(value(), "threads");
     else if (arg == "--gradients") {
@@ -391,6 +403,8 @@ int main(int argc, char** argv) {
           o.error_threshold = a;
           o.use_gradients = gradients;
           o.second_opinion = second_opinion;
+          o.nearby_opinion = nearby_opinion;
+          o.sole_record_reach = sole_reach;
           o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);

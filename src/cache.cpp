@@ -242,6 +242,9 @@ struct coverage_detail {
   float floor = 0.0f;
   int records = 0;
   float first_order = 0.0f;
+  float max_weight = 0.0f;       // largest weight of a covering record
+  std::uint32_t last = 0;        // index of the last covering record (the only one when records == 1)
+  float last_prediction = 0.0f;  // its luminance prediction at the point
 };
 
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
@@ -278,6 +281,9 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
     if (detail) {
       const float li = luminance(r.irradiance);
       ++detail->records;
+      detail->last = i;
+      detail->max_weight = std::max(detail->max_weight, w);
+      detail->last_prediction = l;
       detail->first_order = std::max(detail->first_order, std::fabs(l - li) / std::max({li, detail->floor, 1e-30f}));
     }
     at_record = at_record || r.position == x;
@@ -358,6 +364,10 @@ void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t 
                            std::to_string(o.max_radius));
   if (!(o.second_opinion >= 0.0f) || !std::isfinite(o.second_opinion))
     throw_invalid_argument(fn + "second_opinion is " + std::to_string(o.second_opinion) + "; it must be finite and >= 0 (0 = off)");
+  if (!(o.sole_record_reach > 0.0f && o.sole_record_reach <= 1.0f))
+    throw_invalid_argument(fn + "sole_record_reach is " + std::to_string(o.sole_record_reach) + "; it must be in (0, 1] (1 = off)");
+  if (!(o.nearby_opinion >= 0.0f && o.nearby_opinion <= 16.0f))
+    throw_invalid_argument(fn + "nearby_opinion is " + std::to_string(o.nearby_opinion) + "; it must be in [0, 16] (0 = off)");
   if (!(o.invalid_backface_fraction >= 0.0f && o.invalid_backface_fraction <= 1.0f))
     throw_invalid_argument(fn + "invalid_backface_fraction is " + std::to_string(o.invalid_backface_fraction) +
                            "; it must be in [0, 1]");
@@ -618,6 +628,9 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   const float finest = a * o.min_radius;
   // Invalid samples: position and exclusion radius (0.9 x their min distance).
   std::vector<std::pair<glm::vec3, float>> invalid_balls;
+  // Per point: the index of the record placed there, or -1 (for nearby_opinion).
+  std::vector<std::int32_t> record_at_point(count, -1);
+  const float nearby_reach = o.nearby_opinion * finest;
 
   for (;;) {
     // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
@@ -638,8 +651,10 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         coverage_detail detail;
         detail.floor = floor_e;
         const bool second_opinion = o.second_opinion > 0.0f;
+        const bool nearby_opinion = o.nearby_opinion > 0.0f;
+        const bool sole_reach = o.sole_record_reach < 1.0f;
         const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own, nullptr, nullptr,
-                                    second_opinion ? &detail : nullptr);
+                                    second_opinion || nearby_opinion || sole_reach ? &detail : nullptr);
         bool ok = w > 0.0f;
         bool leans_on_floor = false;
         if (ok && o.refine_disagreement && !own) {
@@ -653,6 +668,28 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         if (ok && second_opinion && !own && detail.records == 1) {
           ok = detail.first_order <= o.second_opinion * a;
           leans_on_floor = leans_on_floor || (ok && floor_e > 0.0f);  // the floor moves: re-check
+        }
+        // Sole record reach: a point that one record covers must lie inside sole_record_reach of
+        // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
+        if (ok && sole_reach && !own && detail.records == 1 && o.weight == cache_weight::ward)
+          ok = detail.max_weight >= 1.0f / (o.sole_record_reach * a);
+        // Nearby opinion: records near a point that one record covers, which do not cover it
+        // themselves, must predict the same there within a (a hard shadow edge between two rows
+        // of points is invisible to the covering record's gradient, not to a record beyond it).
+        if (ok && nearby_opinion && !own && detail.records == 1) {
+          const glm::vec3 x = positions[i], nx = normals[i];
+          const float la = std::max(detail.last_prediction, 0.0f);
+          const float tolerance = a * std::max(la, floor_e);
+          grid_of_points.for_each_in_sphere(x, nearby_reach, [&](std::uint32_t j) {
+            const std::int32_t k = record_at_point[j];
+            if (!ok || k < 0 || std::uint32_t(k) == detail.last) return;
+            const cache_record& rb = records[std::size_t(k)];
+            if (glm::dot(rb.normal, nx) <= 0.9f || record_is_behind(rb, x, nx)) return;
+            const float lb = luminance(glm::max(extrapolate(rb, x, nx, o.use_gradients), glm::vec3(0.0f)));
+            if (std::fabs(lb - la) > tolerance) ok = false;
+          });
+          // Records added near the point later can change the answer (and the floor moves): re-check.
+          leans_on_floor = true;
         }
         covered[i] = ok ? 1 : 0;
         fragile[i] = leans_on_floor ? 1 : 0;
@@ -747,6 +784,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       }
       r.radius = std::clamp(radius, o.min_radius, o.max_radius);
       records.push_back(r);
+      record_at_point[i] = static_cast<std::int32_t>(records.size() - 1);
     }
     // Points within an invalid sample's exclusion ball are inside geometry too.
     if (!invalid_balls.empty()) {

@@ -21,9 +21,12 @@
 // a x max_radius down to a x min_radius), renders the seeds' hemicubes in parallel, and appends
 // the new records in seed order. A point counts as covered when a record's weight passes 1/a
 // and (refine_disagreement) the covering records' predictions agree within a, and
-// (second_opinion) a point covered by one record only is not extrapolated far from it. Samples that see more than invalid_backface_fraction back faces
-// (the point is inside geometry) never become records; their points, and points within 0.9 x the
-// invalid sample's min distance, are filled at the end from the nearest valid records.
+// (second_opinion) a point covered by one record only is not extrapolated far from it, nor
+// (sole_record_reach) from the rim of its reach, and (nearby_opinion) records near such a point
+// that do not cover it agree with that record there. Samples that see more than
+// invalid_backface_fraction back faces (the point is inside geometry) never become records;
+// their points, and points within 0.9 x the invalid sample's min distance, are filled at the end
+// from the nearest valid records.
 #pragma once
 
 #include "hemilight/integrate.hpp"
@@ -126,6 +129,25 @@ struct cache_options {
   /// (docs/cache.md: Cornell box walls on a 128 x 128 grid, N = 256, a = 0.2: 7.6% -> 1.3% RMS
   /// for 20% instead of 16% of the points).
   float second_opinion = 0.25f;
+  /// Opinion of nearby records for points covered by a single record (other than its own point):
+  /// such a point counts as uncovered while some record within nearby_opinion x a x min_radius of
+  /// it (a x min_radius: the finest seed spacing, about one point spacing) that does not cover it,
+  /// with a similar normal (n . n_j > 0.9) and not behind, predicts there (E_j plus its gradient
+  /// terms, clamped at 0) a luminance that differs from the covering record's prediction by more
+  /// than a x max(that prediction, 5% of the mean record E). The covering record's gradient cannot
+  /// see a hard shadow edge crossed between two rows of points (docs/cache.md: a floor point in a
+  /// block's umbra covered by a lit record one row away, 1059% error at N = 512); a record on the
+  /// other side of the edge can. Dimensionless, in [0, 16]; 0 = off. Default 2 (records one or
+  /// two rows of points away).
+  float nearby_opinion = 2.0f;
+  /// A point covered by a single record (other than its own point) counts as covered only inside
+  /// this fraction of that record's reach: Ward weight >= 1 / (sole_record_reach x a) (ignored with
+  /// the Tabellion-Lamorlette weight). At the automatic min_radius = spacing / a the grid neighbours
+  /// of a record at min_radius lie exactly on its reach (weight 1/a), where float rounding decided
+  /// whether that one record alone, with no second opinion, extrapolated to them (docs/cache.md: the
+  /// Cornell box wall tops at N = 512, 2.9% -> 0.8% RMS at a = 0.3). Points covered by two or more
+  /// records are unaffected. Dimensionless, in (0, 1]; 1 = off. Default 0.99.
+  float sole_record_reach = 0.99f;
   cache_weight weight = cache_weight::ward;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
   /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
@@ -220,7 +242,8 @@ struct cache_result {
 /// Throws error(invalid_argument) naming the first bad input: count == 0, NULL arrays, a NaN/Inf
 /// position, a normal whose length is not 1 within 1e-3 (zero normals included), options out of
 /// range (error_threshold not in (0, 1], negative or NaN radii, min_radius > max_radius when both
-/// are given, second_opinion negative or not finite, invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned
+/// are given, second_opinion negative or not finite, nearby_opinion not in [0, 16],
+/// sole_record_reach not in (0, 1], invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned
 /// false. Exceptions thrown by the sampler propagate unchanged. Cost: one sampler call per
 /// record and invalid sample, plus O(count x log records) for coverage and interpolation.
 cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
