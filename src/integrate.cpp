@@ -370,12 +370,16 @@ HEMILIGHT_TARGET_AVX2_FMA inline double hsum(__m256 v) noexcept {
 
 // Pass 1 with the vector sums: inv[i] = 1 / dist[i]; s1 = (E_r, E_g, E_b, sum P, sum P / r,
 // sum P back); phi = per channel (sum L x, sum L y), always (six FMAs per step; the caller
-// ignores them without g_r or directional outputs); lit[k] = whether any radiance of texels
-// 8k..8k+7 is non-zero (bitwise; count / 8 rounded up entries); returns min dist.
+// ignores them without g_r or directional outputs); returns min dist. With LitMap (for the wall
+// pass): lit[k] = whether any radiance of texels 8k..8k+7 is non-zero (bitwise; count / 8
+// rounded up entries), and black groups (all zero) skip the sums, which they would not change;
+// *black = how many groups are black. Without it (no wall pass follows), neither costs anything.
+template <bool LitMap>
 HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, const float* b, const float* dist,
                                                 const std::uint8_t* flags, const float* vx, const float* vy,
-                                                const float* vz, float* inv, std::uint8_t* lit, std::size_t count,
-                                                double* s1, double* phi) noexcept {
+                                                const float* vz, float* inv, std::uint8_t* lit, std::size_t* black,
+                                                std::size_t count, double* s1, double* phi) noexcept {
+  std::size_t black_groups = 0;
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m128i back_bit = _mm_set1_epi8(2);  // texel_back_face
   __m256 min_d = _mm256_set1_ps(std::numeric_limits<float>::infinity());
@@ -402,12 +406,17 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
         bk = _mm256_add_ps(bk, _mm256_and_ps(is_back, p));
       }
       const __m256 lr = _mm256_loadu_ps(r + i), lg = _mm256_loadu_ps(g + i), lb = _mm256_loadu_ps(b + i);
-      // Black groups (every bit of the three channels zero) add exactly nothing below; most of
-      // an emission-only hemicube is black, so they skip the sums and tell the wall pass.
-      const __m256i any = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(lr, lg), lb));
-      const bool is_lit = !_mm256_testz_si256(any, any);
-      lit[i >> 3] = is_lit;
-      if (!is_lit) continue;
+      if constexpr (LitMap) {
+        // Black groups (every bit of the three channels zero) add exactly nothing below; most of
+        // an emission-only hemicube is black, so they skip the sums and tell the wall pass.
+        const __m256i any = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(lr, lg), lb));
+        const bool is_lit = !_mm256_testz_si256(any, any);
+        lit[i >> 3] = is_lit;
+        if (!is_lit) {
+          ++black_groups;
+          continue;
+        }
+      }
       e0 = _mm256_fmadd_ps(lr, p, e0);
       a0 = _mm256_fmadd_ps(lr, x, a0);
       a1 = _mm256_fmadd_ps(lr, y, a1);
@@ -426,9 +435,9 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
   _mm256_store_ps(m, min_d);
   float md = m[0];
   for (float v : m) md = v < md ? v : md;
-  if (i < count) lit[i >> 3] = 0;
+  if (LitMap && i < count) lit[i >> 3] = 0;
   for (; i < count; ++i) {  // tail (count is a multiple of 4, not always of 8)
-    lit[i >> 3] |= r[i] != 0.0f || g[i] != 0.0f || b[i] != 0.0f;
+    if (LitMap) lit[i >> 3] |= r[i] != 0.0f || g[i] != 0.0f || b[i] != 0.0f;
     inv[i] = 1.0f / dist[i];
     md = dist[i] < md ? dist[i] : md;
     const double p = vz[i];
@@ -445,14 +454,17 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
     phi[4] += double(b[i]) * vx[i];
     phi[5] += double(b[i]) * vy[i];
   }
+  if (LitMap) *black = black_groups;
   return md;
 }
 
 // Both wall passes inside faces (right neighbour i + 1, coefficients rx, ry, over i < count - 1;
 // the texel above i + row, coefficients ux, uy, over i < count - row) into acc[6], as
-// wall_sums_impl does for each. lit: texel_pass_avx2's black-group map; a group whose texels
-// and right and upper neighbours are all black has zero radiance differences and is skipped
-// (it would add exactly +-0 to every sum: the result is the same bits).
+// wall_sums_impl does for each. With CheckLit, lit: texel_pass_avx2's black-group map; a group
+// whose texels and right and upper neighbours are all black has zero radiance differences and
+// is skipped (it would add exactly +-0 to every sum: the result is the same bits). Without it
+// (no black group: a lit hemicube) the test would only cost.
+template <bool CheckLit>
 HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, const float* b, const float* inv,
                                               const std::uint8_t* lit, const float* rx, const float* ry,
                                               const float* ux, const float* uy, std::size_t row,
@@ -465,7 +477,7 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
     __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0;
     for (i = b0; i < b1; i += 8) {
       // Texels i..i+8 (right walls) and i+row..i+row+7 (upper walls) all black: nothing to add.
-      if (!(lit[i >> 3] | lit[(i >> 3) + 1] | lit[(i + row) >> 3] | lit[(i + row + 7) >> 3])) continue;
+      if (CheckLit && !(lit[i >> 3] | lit[(i >> 3) + 1] | lit[(i + row) >> 3] | lit[(i + row + 7) >> 3])) continue;
       const __m256 iv = _mm256_loadu_ps(inv + i);
       const __m256 wr = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + 1)), cp);
       const __m256 wu = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + row)), cp);
@@ -544,9 +556,23 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
 #else
   const bool avx2 = false;
 #endif
+  // When the wall pass (classified or great-arc g_t) follows, pass 1 maps the black groups for
+  // it: if the last mapped hemicube had at least 1/8 of its groups black (emission-only
+  // hemicubes), and every 16th hemicube anyway. Skipping black groups never changes a result, so
+  // this history only changes the speed: lit hemicubes (bounce passes) skip the mapping's cost.
+  const bool wall_pass = options_.translation == translation_estimator::classified ||
+                         options_.translation == translation_estimator::great_arc;
+  const bool map_black = wall_pass && (map_black_ || ++unmapped_ >= 16);
+  std::size_t black_groups = 0;
   if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
-    min_d = texel_pass_avx2(r, g, b, dist, flags, vx, vy, vz, inv, lit_.data(), count, s1, phi);
+    if (map_black) {
+      min_d = texel_pass_avx2<true>(r, g, b, dist, flags, vx, vy, vz, inv, lit_.data(), &black_groups, count, s1, phi);
+      map_black_ = black_groups * 8 >= count / 8;
+      unmapped_ = 0;
+    } else {
+      min_d = texel_pass_avx2<false>(r, g, b, dist, flags, vx, vy, vz, inv, nullptr, nullptr, count, s1, phi);
+    }
     have_phi = true;
 #endif
   } else if constexpr (std::is_same<Inner, float>::value) {
@@ -608,10 +634,14 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     };
     if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
-      wall_pass_avx2(r, g, b, inv, lit_.data(), arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
-                     arc ? t.right_great_arc_y.data() : t.right_classified_y.data(),
-                     arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
-                     arc ? t.up_great_arc_y.data() : t.up_classified_y.data(), row, count, cap, acc);
+      const float* cr[4] = {arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
+                            arc ? t.right_great_arc_y.data() : t.right_classified_y.data(),
+                            arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
+                            arc ? t.up_great_arc_y.data() : t.up_classified_y.data()};
+      if (black_groups > 0)
+        wall_pass_avx2<true>(r, g, b, inv, lit_.data(), cr[0], cr[1], cr[2], cr[3], row, count, cap, acc);
+      else
+        wall_pass_avx2<false>(r, g, b, inv, lit_.data(), cr[0], cr[1], cr[2], cr[3], row, count, cap, acc);
 #endif
     } else {
       walls(1, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
@@ -620,8 +650,9 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
             arc ? t.up_great_arc_y.data() : t.up_classified_y.data());
     }
     for (const integration_table::wall& w : t.border_walls) {  // 6 N walls across face borders
-      // Equal radiance on both sides adds exactly zero (most walls of an emission-only hemicube).
-      if (r[w.a] == r[w.b] && g[w.a] == g[w.b] && b[w.a] == b[w.b]) continue;
+      // Equal radiance on both sides adds exactly zero (most walls of an emission-only hemicube,
+      // which has black groups; a lit one would only pay for the test).
+      if (black_groups > 0 && r[w.a] == r[w.b] && g[w.a] == g[w.b] && b[w.a] == b[w.b]) continue;
       const double iw = std::min(std::max(inv[w.a], inv[w.b]), cap);
       const float* c = arc ? w.great_arc : w.classified;
       const double wx = c[0] * iw, wy = c[1] * iw;

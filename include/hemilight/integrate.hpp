@@ -142,6 +142,8 @@ class hemicube_integrator {
   std::shared_ptr<const integration_table> table_;
   std::vector<float> inv_r_;  // scratch: 1/distance per texel
   std::vector<std::uint8_t> lit_;  // scratch (AVX2 kernels): per group of 8 texels, any radiance non-zero
+  bool map_black_ = true;  // map black groups in the next hemicube (the last mapped one had many)
+  int unmapped_ = 0;       // hemicubes since the last mapped one
 };
 
 /// Convenience: integrate one buffer with a temporary integrator (fetches the cached table;
