@@ -11,7 +11,9 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
                          DIR/cache_resolution.png and DIR/cache_resolution.md (the table of
                          interpolated hemicube fractions at the targets and gradient savings);
                          the same for cache_resolution_k128.csv (hexagon ceiling and Cornell box,
-                         128 x 128 grid). Rows may carry a `variant` column (sweep_cache --variant: which
+                         128 x 128 grid) and cache_cornell_rules.csv (docs/cache.md, the single-record
+                         rules: variant base = before them, c1 = the defaults with them, nearby_only /
+                         sole_reach_only = the ablation). Rows may carry a `variant` column (sweep_cache --variant: which
                          cache options); with more than one variant, each gets its own curves (marker and
                          line style) and its own rows in the .md table.
 """
@@ -162,7 +164,7 @@ def table(rows, path):
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 if os.path.exists(f"{out}/cache_sweep.csv"):
     chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
-for name in ("cache_resolution", "cache_resolution_k128"):
+for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules"):
     if os.path.exists(f"{out}/{name}.csv"):
         rows = load_csv(f"{out}/{name}.csv")
         if not rows:
