@@ -632,22 +632,21 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
       else
         wall_sums_impl<Inner>(r, g, b, inv, cx, cy, step, count - step, cap, acc);
     };
+    // The estimator's coefficients of the right and upper walls (x, y).
+    const float* rx = arc ? t.right_great_arc_x.data() : t.right_classified_x.data();
+    const float* ry = arc ? t.right_great_arc_y.data() : t.right_classified_y.data();
+    const float* ux = arc ? t.up_great_arc_x.data() : t.up_classified_x.data();
+    const float* uy = arc ? t.up_great_arc_y.data() : t.up_classified_y.data();
     if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
-      const float* cr[4] = {arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
-                            arc ? t.right_great_arc_y.data() : t.right_classified_y.data(),
-                            arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
-                            arc ? t.up_great_arc_y.data() : t.up_classified_y.data()};
       if (black_groups > 0)
-        wall_pass_avx2<true>(r, g, b, inv, lit_.data(), cr[0], cr[1], cr[2], cr[3], row, count, cap, acc);
+        wall_pass_avx2<true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc);
       else
-        wall_pass_avx2<false>(r, g, b, inv, lit_.data(), cr[0], cr[1], cr[2], cr[3], row, count, cap, acc);
+        wall_pass_avx2<false>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc);
 #endif
     } else {
-      walls(1, arc ? t.right_great_arc_x.data() : t.right_classified_x.data(),
-            arc ? t.right_great_arc_y.data() : t.right_classified_y.data());
-      walls(row, arc ? t.up_great_arc_x.data() : t.up_classified_x.data(),
-            arc ? t.up_great_arc_y.data() : t.up_classified_y.data());
+      walls(1, rx, ry);
+      walls(row, ux, uy);
     }
     for (const integration_table::wall& w : t.border_walls) {  // 6 N walls across face borders
       // Equal radiance on both sides adds exactly zero (most walls of an emission-only hemicube,

@@ -326,16 +326,23 @@ HEMILIGHT_TARGET_AVX2 inline void depth_test8(float* depth, std::uint32_t* ids, 
 }
 
 // Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
-HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
-                                     std::uint32_t draw) noexcept {
-  const __m256 zr = _mm256_set1_ps(zrow), dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
-  const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), end = _mm256_set1_epi32(hi + 1);
-  for (int x = lo; x <= hi; x += 8) {
-    const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
+// The depth test of span_avx2 with its constants given (zr: the row's depth, dz: its step per
+// texel, zmin = FLT_MIN, id: the record in every lane), shared with the span walk's functor.
+HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(float* drow, std::uint32_t* irow,
+                                                                               int lo, int hi, __m256 zr, __m256 dz,
+                                                                               __m256 zmin, __m256 id) noexcept {
+  const __m256i end = _mm256_set1_epi32(hi + 1), eight = _mm256_set1_epi32(8);
+  __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
     const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
     depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
   }
+}
+
+HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
+                                     std::uint32_t draw) noexcept {
+  span_body_avx2(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN),
+                 _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw))));
 }
 
 // The exact span walk's rows in depth mode (draw_fixed): walk_rows with span_avx2's depth test
@@ -347,29 +354,19 @@ struct depth_spans_avx2 {
   std::size_t n;
   double z00, dzdy;
   __m256 dz, zmin, id;
-  __m256i lane, eight;
   std::size_t spans = 0, fragments = 0;
 
   HEMILIGHT_TARGET_AVX2 depth_spans_avx2(float* depth_, std::uint32_t* ids_, int n_, double z00_, double dzdy_,
                                          float dzdx, std::uint32_t draw) noexcept
       : depth(depth_), ids(ids_), n(static_cast<std::size_t>(n_)), z00(z00_), dzdy(dzdy_),
         dz(_mm256_set1_ps(dzdx)), zmin(_mm256_set1_ps(FLT_MIN)),
-        id(_mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)))),
-        lane(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), eight(_mm256_set1_epi32(8)) {}
+        id(_mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)))) {}
 
   HEMILIGHT_TARGET_AVX2 void operator()(int y, int lo, int hi) noexcept {
     ++spans;
     fragments += static_cast<std::size_t>(hi - lo + 1);
     const std::size_t row = static_cast<std::size_t>(y) * n;
-    const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * y));
-    const __m256i end = _mm256_set1_epi32(hi + 1);
-    float* drow = depth + row;
-    std::uint32_t* irow = ids + row;
-    __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), lane);
-    for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
-      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-      depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
-    }
+    span_body_avx2(depth + row, ids + row, lo, hi, _mm256_set1_ps(static_cast<float>(z00 + dzdy * y)), dz, zmin, id);
   }
 };
 
