@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -82,6 +83,16 @@ void hemilight_cache_options_init(hemilight_cache_options* options) {
   options->thread_count = 0;
   options->progress = nullptr;
   options->progress_user = nullptr;
+  const hemilight::cache_options d;
+  options->weight = HEMILIGHT_CACHE_WEIGHT_WARD;
+  options->gradient_radius_limit = d.gradient_radius_limit ? 1 : 0;
+  options->neighbour_clamp = d.neighbour_clamp ? 1 : 0;
+  options->shrink_disagreeing = d.shrink_disagreeing ? 1 : 0;
+  options->refine_disagreement = d.refine_disagreement ? 1 : 0;
+  options->second_opinion = d.second_opinion;
+  options->nearby_opinion = d.nearby_opinion;
+  options->sole_record_reach = d.sole_record_reach;
+  options->invalid_backface_fraction = d.invalid_backface_fraction;
 }
 
 hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions, const float* normals,
@@ -102,6 +113,16 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
       return invalid(fn, "options->use_gradients is " + std::to_string(options->use_gradients) + "; it must be 0 or 1");
     if (options->thread_count < 0)
       return invalid(fn, "options->thread_count is " + std::to_string(options->thread_count) + "; it must be >= 0");
+    const std::pair<const char*, int> switches[] = {{"gradient_radius_limit", options->gradient_radius_limit},
+                                                    {"neighbour_clamp", options->neighbour_clamp},
+                                                    {"shrink_disagreeing", options->shrink_disagreeing},
+                                                    {"refine_disagreement", options->refine_disagreement}};
+    for (const auto& sw : switches)
+      if (sw.second != 0 && sw.second != 1)
+        return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
+    if (options->weight != HEMILIGHT_CACHE_WEIGHT_WARD && options->weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE)
+      return invalid(fn, "options->weight is " + std::to_string(static_cast<int>(options->weight)) +
+                             "; it must be HEMILIGHT_CACHE_WEIGHT_WARD (0) or HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE (1)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     hemilight::cache_options o;
     o.error_threshold = options->error_threshold;
@@ -109,6 +130,17 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     o.max_radius = options->max_radius;
     o.use_gradients = options->use_gradients == 1;
     o.thread_count = options->thread_count;
+    o.weight = options->weight == HEMILIGHT_CACHE_WEIGHT_WARD ? hemilight::cache_weight::ward
+                                                               : hemilight::cache_weight::tabellion_lamorlette;
+    o.gradient_radius_limit = options->gradient_radius_limit == 1;
+    o.neighbour_clamp = options->neighbour_clamp == 1;
+    o.shrink_disagreeing = options->shrink_disagreeing == 1;
+    o.refine_disagreement = options->refine_disagreement == 1;
+    // Range-checked (with the field named) by cache_irradiance.
+    o.second_opinion = options->second_opinion;
+    o.nearby_opinion = options->nearby_opinion;
+    o.sole_record_reach = options->sole_record_reach;
+    o.invalid_backface_fraction = options->invalid_backface_fraction;
     if (options->progress) {
       const hemilight_progress_fn progress = options->progress;
       void* user = options->progress_user;

@@ -42,7 +42,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 4
+#define HEMILIGHT_VERSION_MINOR 5
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {
@@ -189,6 +189,12 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance(const hemilight_scene
  * writes nothing). */
 typedef int (*hemilight_progress_fn)(void* user, float fraction);
 
+/* Interpolation weight of the irradiance cache. */
+typedef enum hemilight_cache_weight {
+  HEMILIGHT_CACHE_WEIGHT_WARD = 0,                /* 1 / (d / R + sqrt(1 - n.n_i)), used where > 1 / a */
+  HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE = 1 /* 1 - max(d / (R / 2), angle term) / (2a), used where > 0 */
+} hemilight_cache_weight;
+
 typedef struct hemilight_cache_options {
   int resolution;         /* hemicube N, even, 2..4096 (default 64) */
   float error_threshold;  /* Ward's a, (0, 1]: larger = fewer hemicubes, more error (default 0.2) */
@@ -198,6 +204,21 @@ typedef struct hemilight_cache_options {
   int thread_count;       /* 0 = all cores (default 0) */
   hemilight_progress_fn progress; /* may be NULL (default NULL) */
   void* progress_user;    /* passed to progress */
+  /* Since 0.5: the placement rules and radius limits of include/hemilight/cache.hpp
+   * (cache_options), each switchable so that its effect can be measured (docs/cache.md). */
+  hemilight_cache_weight weight;  /* interpolation weight (default HEMILIGHT_CACHE_WEIGHT_WARD) */
+  int gradient_radius_limit;      /* 0 or 1: R <= E / |translation gradient| (default 1) */
+  int neighbour_clamp;            /* 0 or 1: R_i <= R_j + |x_i - x_j| (default 1) */
+  int shrink_disagreeing;         /* 0 or 1: shrink neighbours whose gradients disagree (default 1) */
+  int refine_disagreement;        /* 0 or 1: points whose covering records disagree by more than a stay
+                                     open (default 1) */
+  float second_opinion;           /* >= 0, 0 = off: a single covering record's first-order term must stay
+                                     under second_opinion x a (default 0.25) */
+  float nearby_opinion;           /* [0, 16], 0 = off: nearby records that do not cover a singly covered
+                                     point must agree with it, within this many finest spacings (default 2) */
+  float sole_record_reach;        /* (0, 1], 1 = off: a singly covered point must lie inside this fraction
+                                     of the record's reach (default 0.99) */
+  float invalid_backface_fraction; /* [0, 1]: samples seeing more back faces are invalid (default 0.1) */
 } hemilight_cache_options;
 
 /* Fills options with the defaults above. NULL is ignored. */

@@ -153,6 +153,92 @@ static void test_cache(void) {
   free(out);
 }
 
+/* The placement rules and radius limits of hemilight_cache_options (since 0.5): their documented
+ * defaults, that they reach the cache (switching the refinement rules off renders fewer hemicubes
+ * under a shadow-casting quad: those rules only ever keep points open), the Tabellion-Lamorlette
+ * weight under a uniform sky (pi L exactly, as with Ward's), and a named error for each bad value. */
+static void test_cache_rules(void) {
+  const float sky[3] = {1.0f, 1.0f, 1.0f};
+  /* An occluder 0.9 x 0.9 at height 0.3 over the middle of the points, facing down (black). */
+  const float quad_pos[] = {0.5f, 0.5f, 0.3f, 1.4f, 0.5f, 0.3f, 1.4f, 1.4f, 0.3f, 0.5f, 1.4f, 0.3f};
+  const uint32_t quad_idx[] = {0, 2, 1, 0, 3, 2};
+  const float black[6] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  hemilight_scene* empty = NULL;
+  hemilight_scene* shadow = NULL;
+  hemilight_cache_options o;
+  hemilight_cache_stats with_rules, without_rules;
+  enum { side = 20, count = side * side };
+  float* pos = (float*)malloc(sizeof(float) * 3 * count);
+  float* nrm = (float*)malloc(sizeof(float) * 3 * count);
+  float* out = (float*)malloc(sizeof(float) * 3 * count);
+  int i, ok = 1;
+  if (!pos || !nrm || !out) {
+    CHECK(0);
+    free(pos);
+    free(nrm);
+    free(out);
+    return;
+  }
+  for (i = 0; i < count; ++i) {
+    pos[3 * i] = (float)(i % side) * 0.1f;
+    pos[3 * i + 1] = (float)(i / side) * 0.1f;
+    pos[3 * i + 2] = 0.0f;
+    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
+    nrm[3 * i + 2] = 1.0f;
+  }
+  hemilight_cache_options_init(&o);
+  CHECK(o.weight == HEMILIGHT_CACHE_WEIGHT_WARD && o.gradient_radius_limit == 1 && o.neighbour_clamp == 1 &&
+        o.shrink_disagreeing == 1 && o.refine_disagreement == 1);
+  CHECK(o.second_opinion == 0.25f && o.nearby_opinion == 2.0f && o.sole_record_reach == 0.99f &&
+        o.invalid_backface_fraction == 0.1f);
+  o.resolution = 32;
+  CHECK(hemilight_scene_create(quad_pos, 4, quad_idx, 2, black, sky, &shadow) == HEMILIGHT_OK);
+  CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &with_rules) == HEMILIGHT_OK);
+  o.refine_disagreement = 0;
+  o.second_opinion = 0.0f;
+  o.nearby_opinion = 0.0f;
+  o.sole_record_reach = 1.0f;
+  CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &without_rules) == HEMILIGHT_OK);
+  CHECK(without_rules.hemicubes < with_rules.hemicubes);
+
+  hemilight_cache_options_init(&o);
+  o.resolution = 16;
+  o.weight = HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE;
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &empty) == HEMILIGHT_OK);
+  CHECK(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL) == HEMILIGHT_OK);
+  for (i = 0; i < count; ++i) ok = ok && fabs(out[3 * i] / pi - 1.0) < 1e-5;
+  CHECK(ok);
+
+  out[0] = -1.0f;
+  hemilight_cache_options_init(&o);
+  o.gradient_radius_limit = 2;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "gradient_radius_limit is 2");
+  hemilight_cache_options_init(&o);
+  o.refine_disagreement = -1;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "refine_disagreement");
+  hemilight_cache_options_init(&o);
+  o.weight = (hemilight_cache_weight)7;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "weight is 7");
+  hemilight_cache_options_init(&o);
+  o.second_opinion = -1.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "second_opinion");
+  hemilight_cache_options_init(&o);
+  o.nearby_opinion = 17.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "nearby_opinion");
+  hemilight_cache_options_init(&o);
+  o.sole_record_reach = 0.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "sole_record_reach");
+  hemilight_cache_options_init(&o);
+  o.invalid_backface_fraction = NAN;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "invalid_backface_fraction");
+  CHECK(out[0] == -1.0f); /* nothing written on any failure */
+  hemilight_scene_release(empty);
+  hemilight_scene_release(shadow);
+  free(pos);
+  free(nrm);
+  free(out);
+}
+
 static void test_environment(void) {
   /* A uniform environment of radiance (1, 2, 3) must give pi (1, 2, 3); an environment bright only
    * on its +Y face gives a normal +Y more than a normal -Y. */
@@ -188,6 +274,7 @@ int main(void) {
   test_sample();
   test_environment();
   test_cache();
+  test_cache_rules();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }
