@@ -99,6 +99,7 @@ integration_table::integration_table(int n) : n_(n) {
                                 &right_great_arc_x, &right_great_arc_y, &up_great_arc_x, &up_great_arc_y,
                                 &right_classified_x, &right_classified_y, &up_classified_x, &up_classified_y})
     v->assign(count, 0.0f);
+  extrapolation_neighbours.assign(count, 0);
 
   const double s = 2.0 / n;
   for (std::size_t i = 0; i < count; ++i) {
@@ -118,6 +119,9 @@ integration_table::integration_table(int n) : n_(n) {
 
     // Walls inside the face: to the right (x + 1) and up (y + 1) neighbours.
     const hemicube_texel t = hemicube_texel_from_index(n, i);
+    const int height = hemicube_face_height(n, t.face);
+    extrapolation_neighbours[i] = static_cast<std::uint8_t>((t.x > 0 ? 1 : 0) | (t.x + 2 < n ? 2 : 0) |
+                                                            (t.y > 0 ? 4 : 0) | (t.y + 2 < height ? 8 : 0));
     const glm::dvec2 lo = hemicube_texel_min_corner(n, t);
     auto point = [&](double u, double w) { return glm::normalize(hemicube_face_point(t.face, u, w)); };
     if (t.x + 1 < n) {
@@ -193,6 +197,7 @@ hemicube_integrator::hemicube_integrator(int resolution, const integrate_options
   table_ = integration_table::get(resolution);  // validates the resolution
   const std::size_t count = hemicube_texel_count(resolution);
   inv_r_.resize(count);
+  if (options.extrapolate_wall_depth) wall_inv_.resize(2 * count);
   lit_.resize(count / 8 + 2);
 }
 
@@ -230,6 +235,125 @@ inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const 
     const Inner sums[6] = {a0, a1, a2, a3, a4, a5};
     for (int k = 0; k < 6; ++k) acc[k] += double(sums[k]);
   }
+}
+
+// wall_sums_impl with the inverse distance of each wall given (wall_inv[i]: the wall between
+// texel i and i + step), for extrapolate_wall_depth.
+template <class Inner>
+inline __attribute__((always_inline)) void wall_sums_given_impl(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
+                                 const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
+  for (std::size_t b0 = 0; b0 < end; b0 += block) {
+    const std::size_t b1 = std::min(end, b0 + block);
+    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
+#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Inner w = Inner(wall_inv[i] < cap ? wall_inv[i] : cap);
+      const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
+      const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
+                  db = Inner(b[i + step]) - Inner(b[i]);
+      a0 += dr * wx;
+      a1 += dr * wy;
+      a2 += dg * wx;
+      a3 += dg * wy;
+      a4 += db * wx;
+      a5 += db * wy;
+    }
+    const Inner sums[6] = {a0, a1, a2, a3, a4, a5};
+    for (int k = 0; k < 6; ++k) acc[k] += double(sums[k]);
+  }
+}
+
+// The inverse distance of the wall between texels a and b (inv: 1/distance per texel): the
+// nearer texel's, extrapolated half a texel towards the wall from its neighbour on the far side
+// (`before` of a, `after` of b; has_before / has_after: 1 when it lies in the same face, else 0)
+// when that neighbour's depth is closer to it than the other texel's (the wall is the
+// discontinuity, not the neighbour), clamped to [1/2, 2] x the centre's. Branch-free, so that
+// the loops below vectorise.
+inline float extrapolated_wall_inv(float ia, float ib, float before, float after, bool has_before,
+                                   bool has_after) noexcept {
+  const bool a_nearer = ia >= ib;
+  const float near = a_nearer ? ia : ib, far = a_nearer ? ib : ia;
+  const float beside = a_nearer ? before : after;
+  const bool usable = (a_nearer ? has_before : has_after) && std::fabs(near - beside) <= std::fabs(near - far);
+  const float e = near + 0.5f * (near - beside);
+  const float clamped = e < 0.5f * near ? 0.5f * near : (e > 2.0f * near ? 2.0f * near : e);
+  return usable ? clamped : near;
+}
+
+// wall_inv[i] for the walls between texel i and i + step, i < count - step (nb: the table's
+// extrapolation_neighbours; bits `before_bit` and `after_bit` for this direction).
+inline __attribute__((always_inline)) void extrapolated_walls_impl(const float* inv, const std::uint8_t* nb,
+                                                                   std::size_t step, unsigned before_bit,
+                                                                   unsigned after_bit, std::size_t count,
+                                                                   float* wall_inv) {
+  const std::size_t end = count - step;
+  // Texels whose `before` (i - step) or `after` (i + 2 step) would lie outside the buffer have
+  // no such neighbour in their face either; they are done one at a time.
+  const auto one = [&](std::size_t i) {
+    const bool hb = (nb[i] & before_bit) != 0, ha = (nb[i] & after_bit) != 0;
+    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], hb ? inv[i - step] : 0.0f, ha ? inv[i + 2 * step] : 0.0f, hb, ha);
+  };
+  const std::size_t lo = std::min(step, end), hi = end > step ? end - step : lo;
+  for (std::size_t i = 0; i < lo; ++i) one(i);
+#pragma omp simd
+  for (std::size_t i = lo; i < hi; ++i)
+    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], inv[i - step], inv[i + 2 * step], (nb[i] & before_bit) != 0,
+                                        (nb[i] & after_bit) != 0);
+  for (std::size_t i = std::max(lo, hi); i < end; ++i) one(i);
+}
+
+#if HEMILIGHT_INTEGRATE_AVX2
+// extrapolated_walls_impl, eight walls per step (the same operations; the compiler may fuse a
+// multiply-add in one path and not the other, so the last bit can differ).
+HEMILIGHT_TARGET_AVX2_FMA void extrapolated_walls_avx2(const float* inv, const std::uint8_t* nb, std::size_t step,
+                                                       unsigned before_bit, unsigned after_bit, std::size_t count,
+                                                       float* wall_inv) noexcept {
+  const std::size_t end = count - step;
+  const auto one = [&](std::size_t i) {
+    const bool hb = (nb[i] & before_bit) != 0, ha = (nb[i] & after_bit) != 0;
+    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], hb ? inv[i - step] : 0.0f, ha ? inv[i + 2 * step] : 0.0f, hb, ha);
+  };
+  const std::size_t lo = std::min(step, end), hi = end > step ? end - step : lo;
+  for (std::size_t i = 0; i < lo; ++i) one(i);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), half = _mm256_set1_ps(0.5f),
+               two = _mm256_set1_ps(2.0f);
+  const __m128i bb = _mm_set1_epi8(static_cast<char>(before_bit)), ab = _mm_set1_epi8(static_cast<char>(after_bit));
+  std::size_t i = lo;
+  for (; i + 8 <= hi; i += 8) {
+    const __m256 ia = _mm256_loadu_ps(inv + i), ib = _mm256_loadu_ps(inv + i + step);
+    const __m256 before = _mm256_loadu_ps(inv + i - step), after = _mm256_loadu_ps(inv + i + 2 * step);
+    const __m128i bits = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(nb + i));
+    const __m256 hb = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, bb), bb)));
+    const __m256 ha = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, ab), ab)));
+    const __m256 a_nearer = _mm256_cmp_ps(ia, ib, _CMP_GE_OQ);
+    const __m256 near = _mm256_blendv_ps(ib, ia, a_nearer), far = _mm256_blendv_ps(ia, ib, a_nearer);
+    const __m256 beside = _mm256_blendv_ps(after, before, a_nearer);
+    const __m256 has = _mm256_blendv_ps(ha, hb, a_nearer);
+    const __m256 usable = _mm256_and_ps(has, _mm256_cmp_ps(_mm256_and_ps(_mm256_sub_ps(near, beside), abs_mask),
+                                                           _mm256_and_ps(_mm256_sub_ps(near, far), abs_mask), _CMP_LE_OQ));
+    // near + 0.5 (near - beside) with the scalar's two roundings (no FMA), then the clamp.
+    const __m256 e = _mm256_add_ps(near, _mm256_mul_ps(half, _mm256_sub_ps(near, beside)));
+    const __m256 lo_b = _mm256_mul_ps(half, near), hi_b = _mm256_mul_ps(two, near);
+    const __m256 clamped = _mm256_blendv_ps(_mm256_blendv_ps(e, hi_b, _mm256_cmp_ps(e, hi_b, _CMP_GT_OQ)), lo_b,
+                                            _mm256_cmp_ps(e, lo_b, _CMP_LT_OQ));
+    _mm256_storeu_ps(wall_inv + i, _mm256_blendv_ps(near, clamped, usable));
+  }
+  for (; i < hi; ++i) one(i);
+  for (i = std::max(lo, hi); i < end; ++i) one(i);
+}
+#endif
+
+void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t step, unsigned before_bit, unsigned after_bit,
+                        std::size_t count, float* wall_inv) {
+  extrapolated_walls_impl(inv, nb, step, before_bit, after_bit, count, wall_inv);
+}
+
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target_clones("avx2", "default")))
+#endif
+void wall_sums_given_float(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
+                           const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
+  wall_sums_given_impl<float>(r, g, b, wall_inv, cx, cy, step, end, cap, acc);
 }
 
 // Inverts the distances and sums pass 1 (E per channel, total projected solid angle, harmonic
@@ -464,11 +588,16 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
 // whose texels and right and upper neighbours are all black has zero radiance differences and
 // is skipped (it would add exactly +-0 to every sum: the result is the same bits). Without it
 // (no black group: a lit hemicube) the test would only cost.
-template <bool CheckLit>
+// With Given, the walls' inverse distances come from wall_inv (right walls, then upper walls:
+// extrapolate_wall_depth) instead of the larger of the two texels'.
+template <bool CheckLit, bool Given = false>
 HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, const float* b, const float* inv,
                                               const std::uint8_t* lit, const float* rx, const float* ry,
                                               const float* ux, const float* uy, std::size_t row,
-                                              std::size_t count, float cap, double* acc) noexcept {
+                                              std::size_t count, float cap, double* acc,
+                                              const float* wall_inv = nullptr) noexcept {
+  const float* wall_r = wall_inv;
+  const float* wall_u = Given ? wall_inv + count : nullptr;
   const std::size_t both = count - row;  // texels with both walls
   const __m256 cp = _mm256_set1_ps(cap);
   std::size_t i = 0;
@@ -478,9 +607,15 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
     for (i = b0; i < b1; i += 8) {
       // Texels i..i+8 (right walls) and i+row..i+row+7 (upper walls) all black: nothing to add.
       if (CheckLit && !(lit[i >> 3] | lit[(i >> 3) + 1] | lit[(i + row) >> 3] | lit[(i + row + 7) >> 3])) continue;
-      const __m256 iv = _mm256_loadu_ps(inv + i);
-      const __m256 wr = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + 1)), cp);
-      const __m256 wu = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + row)), cp);
+      __m256 wr, wu;
+      if (Given) {
+        wr = _mm256_min_ps(_mm256_loadu_ps(wall_r + i), cp);
+        wu = _mm256_min_ps(_mm256_loadu_ps(wall_u + i), cp);
+      } else {
+        const __m256 iv = _mm256_loadu_ps(inv + i);
+        wr = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + 1)), cp);
+        wu = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + row)), cp);
+      }
       const __m256 wrx = _mm256_mul_ps(_mm256_loadu_ps(rx + i), wr), wry = _mm256_mul_ps(_mm256_loadu_ps(ry + i), wr);
       const __m256 wux = _mm256_mul_ps(_mm256_loadu_ps(ux + i), wu), wuy = _mm256_mul_ps(_mm256_loadu_ps(uy + i), wu);
       __m256 l = _mm256_loadu_ps(r + i);
@@ -503,7 +638,7 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
   }
   // Tails: the rest of the texels with both walls, then the right walls of the last row.
   const auto wall = [&](std::size_t k, std::size_t step, float cx, float cy) {
-    const float near_inv = inv[k] > inv[k + step] ? inv[k] : inv[k + step];
+    const float near_inv = Given ? (step == 1 ? wall_r[k] : wall_u[k]) : inv[k] > inv[k + step] ? inv[k] : inv[k + step];
     const double w = near_inv < cap ? near_inv : cap;
     const double wx = cx * w, wy = cy * w;
     acc[0] += (double(r[k + step]) - r[k]) * wx;
@@ -637,7 +772,33 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     const float* ry = arc ? t.right_great_arc_y.data() : t.right_classified_y.data();
     const float* ux = arc ? t.up_great_arc_x.data() : t.up_classified_x.data();
     const float* uy = arc ? t.up_great_arc_y.data() : t.up_classified_y.data();
-    if (avx2) {
+    if (options_.extrapolate_wall_depth) {
+      // Per-wall inverse distances first (right walls, then upper walls), then the sums.
+      float* wr = wall_inv_.data();
+      float* wu = wr + count;
+      const std::uint8_t* nb = t.extrapolation_neighbours.data();
+#if HEMILIGHT_INTEGRATE_AVX2
+      if (avx2) {
+        extrapolated_walls_avx2(inv, nb, 1, 1u, 2u, count, wr);
+        extrapolated_walls_avx2(inv, nb, row, 4u, 8u, count, wu);
+        if (black_groups > 0)
+          wall_pass_avx2<true, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, wr);
+        else
+          wall_pass_avx2<false, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, wr);
+      } else
+#endif
+      {
+        extrapolated_walls(inv, nb, 1, 1u, 2u, count, wr);
+        extrapolated_walls(inv, nb, row, 4u, 8u, count, wu);
+        if constexpr (std::is_same<Inner, float>::value) {
+          wall_sums_given_float(r, g, b, wr, rx, ry, 1, count - 1, cap, acc);
+          wall_sums_given_float(r, g, b, wu, ux, uy, row, count - row, cap, acc);
+        } else {
+          wall_sums_given_impl<Inner>(r, g, b, wr, rx, ry, 1, count - 1, cap, acc);
+          wall_sums_given_impl<Inner>(r, g, b, wu, ux, uy, row, count - row, cap, acc);
+        }
+      }
+    } else if (avx2) {
 #if HEMILIGHT_INTEGRATE_AVX2
       if (black_groups > 0)
         wall_pass_avx2<true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc);

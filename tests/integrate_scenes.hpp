@@ -92,6 +92,25 @@ inline closed_form_scene beside_wall_under_sky() {
   return s;
 }
 
+/// A point on a wall (normal +x) just under the plane of a horizontal emitter (radiance 1, facing
+/// down, 0.05 to 0.35 in front of the wall, 0.3 wide), sky 0: the emitter is seen edge-on, as the
+/// Cornell box's walls see its light just under the ceiling. E grows about linearly with the
+/// depth under the emitter's plane; the emitter's outline in the hemicube is a sliver about
+/// depth / 0.05 rad tall at its near edge.
+inline closed_form_scene emitter_seen_edge_on(double depth) {
+  closed_form_scene s;
+  s.name = "emitter seen edge-on, " + std::to_string(depth) + " under its plane";
+  const std::vector<glm::dvec3> quad = {{0.05, depth, -0.15}, {0.35, depth, -0.15}, {0.35, depth, 0.15}, {0.05, depth, 0.15}};
+  add_quad(s.tris, quad[0], quad[1], quad[2], quad[3], glm::vec3(1.0f));
+  s.position = {0.0, 0.0, 0.0};
+  s.normal = {1.0, 0.0, 0.0};
+  s.irradiance = [quad](const glm::dvec3& x, const glm::dvec3& n) {
+    if (x.y >= quad[0].y) return 0.0;  // at or above the plane: only its back (or nothing) is seen
+    return glm::dot(n, polygon_vector_irradiance(quad, x, 1.0));
+  };
+  return s;
+}
+
 /// A lit room 2 x 2 x 2 (inward-facing quads of different radiance, a bright panel set into the
 /// ceiling), the point on the floor 0.15 from the dim left wall. Every quad is convex and fully
 /// visible from inside the room, so E(x, n) = sum_q L_q n . Phi(q clipped to the horizon of

@@ -52,6 +52,13 @@ struct integrate_options {
   /// 0.1 x the harmonic mean distance of this hemicube (walls nearer than that are treated as
   /// that far, which bounds |g_t| by about 10 x (sum over walls of |dL| x coefficient) / R).
   float min_wall_distance = 0.0f;
+  /// Wall distances of the classified and great-arc estimators: false takes the nearer texel's
+  /// centre distance (Ward and Heckbert); true extrapolates the nearer texel's inverse distance
+  /// half a texel to the wall, from its neighbour on the far side (when that neighbour's depth is
+  /// closer to it than the other texel's, i.e. the wall is the discontinuity), clamped to [1/2, 2]
+  /// x the centre's. The centre's distance is biased where the depth changes fast across a texel:
+  /// a plane seen at a grazing angle, an emitter seen edge-on (docs/integration.md).
+  bool extrapolate_wall_depth = false;
   bool directional = false;  ///< also compute L1 spherical harmonics and the Half-Life 2 basis irradiance
   bool double_precision = false;  ///< accumulate in double instead of float (slower; for checks)
   /// Float path: use the hand-written AVX2 + FMA kernels where the CPU has both (checked at run
@@ -111,6 +118,9 @@ class integration_table {
   std::vector<float> right_great_arc_x, right_great_arc_y, up_great_arc_x, up_great_arc_y;
   std::vector<float> right_classified_x, right_classified_y, up_classified_x, up_classified_y;
   std::vector<wall> border_walls;  ///< walls across face borders (6 N of them)
+  /// Per texel, which neighbours the wall-depth extrapolation may use (in the same face):
+  /// bit 0 x - 1, bit 1 x + 2, bit 2 y - 1, bit 3 y + 2.
+  std::vector<std::uint8_t> extrapolation_neighbours;
 
  private:
   int n_;
@@ -143,6 +153,7 @@ class hemicube_integrator {
   integrate_options options_;
   std::shared_ptr<const integration_table> table_;
   std::vector<float> inv_r_;  // scratch: 1/distance per texel
+  std::vector<float> wall_inv_;  // scratch (extrapolate_wall_depth): 1/distance of each right wall, then each upper wall
   std::vector<std::uint8_t> lit_;  // scratch (AVX2 kernels): per group of 8 texels, any radiance non-zero
   bool map_black_ = true;  // map black groups in the next hemicube (the last mapped one had many)
   int unmapped_ = 0;       // hemicubes since the last mapped one
