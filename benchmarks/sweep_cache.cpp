@@ -23,6 +23,7 @@
 //     --nearby-opinion F  cache_options::nearby_opinion (default: the option's default; 0 = off)
 //     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
 //     --worst K           print the K points of largest error against the per-point reference
+//     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
 //     --variant NAME      written to the last CSV column (default "default"): which cache options
 //   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
 //   (stride 1, 1 roll), so reruns with other cache options do not render it again.
@@ -188,6 +189,7 @@ int main(int argc, char** argv) {
   float second_opinion = cache_options{}.second_opinion;
   float nearby_opinion = cache_options{}.nearby_opinion;
   float sole_reach = cache_options{}.sole_record_reach;
+  bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
   std::vector<std::string> scene_keys{"cornell", "hexagon", "sky"};
@@ -230,6 +232,10 @@ int main(int argc, char** argv) {
       const std::string v = value();
       sole_reach = std::strtof(v.c_str(), nullptr);
       if (!(sole_reach > 0.0f && sole_reach <= 1.0f)) usage(("bad --sole-reach '" + v + "'").c_str());
+    } else if (arg == "--extrapolate-wall-depth") {
+      const std::string v = value();
+      if (v != "yes" && v != "no") usage(("bad --extrapolate-wall-depth '" + v + "' (yes, no)").c_str());
+      extrapolate_wall_depth = v == "yes";
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
     else if (arg == "--threads") thread_arg = to_int(value(), "threads");
     else if (arg == "--gradients") {
@@ -374,6 +380,7 @@ int main(int argc, char** argv) {
     for (int resolution : resolutions) {
       hemicube_sampler_options so;
       so.resolution = resolution;
+      so.integrate.extrapolate_wall_depth = extrapolate_wall_depth;
       const irradiance_sampler sampler = make_hemicube_sampler(sc, so, threads);
       // Per-point reference: a hemicube at every point (luminance, backface fraction; stride 1,
       // one roll = no nudge, the same sampler calls as the cache makes).

@@ -196,7 +196,9 @@ hemicube_integrator::hemicube_integrator(int resolution, const integrate_options
                            "; it must be finite and >= 0 (0 = automatic)");
   table_ = integration_table::get(resolution);  // validates the resolution
   const std::size_t count = hemicube_texel_count(resolution);
-  inv_r_.resize(count);
+  // Padded by zeros, a row before and a row and a group after: the extrapolating wall pass reads
+  // the neighbours of every texel of a group (those outside the face are masked out).
+  inv_r_.resize(count + 2 * static_cast<std::size_t>(resolution) + 8);
   if (options.extrapolate_wall_depth) wall_inv_.resize(2 * count);
   lit_.resize(count / 8 + 2);
 }
@@ -302,46 +304,6 @@ inline __attribute__((always_inline)) void extrapolated_walls_impl(const float* 
   for (std::size_t i = std::max(lo, hi); i < end; ++i) one(i);
 }
 
-#if HEMILIGHT_INTEGRATE_AVX2
-// extrapolated_walls_impl, eight walls per step (the same operations; the compiler may fuse a
-// multiply-add in one path and not the other, so the last bit can differ).
-HEMILIGHT_TARGET_AVX2_FMA void extrapolated_walls_avx2(const float* inv, const std::uint8_t* nb, std::size_t step,
-                                                       unsigned before_bit, unsigned after_bit, std::size_t count,
-                                                       float* wall_inv) noexcept {
-  const std::size_t end = count - step;
-  const auto one = [&](std::size_t i) {
-    const bool hb = (nb[i] & before_bit) != 0, ha = (nb[i] & after_bit) != 0;
-    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], hb ? inv[i - step] : 0.0f, ha ? inv[i + 2 * step] : 0.0f, hb, ha);
-  };
-  const std::size_t lo = std::min(step, end), hi = end > step ? end - step : lo;
-  for (std::size_t i = 0; i < lo; ++i) one(i);
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), half = _mm256_set1_ps(0.5f),
-               two = _mm256_set1_ps(2.0f);
-  const __m128i bb = _mm_set1_epi8(static_cast<char>(before_bit)), ab = _mm_set1_epi8(static_cast<char>(after_bit));
-  std::size_t i = lo;
-  for (; i + 8 <= hi; i += 8) {
-    const __m256 ia = _mm256_loadu_ps(inv + i), ib = _mm256_loadu_ps(inv + i + step);
-    const __m256 before = _mm256_loadu_ps(inv + i - step), after = _mm256_loadu_ps(inv + i + 2 * step);
-    const __m128i bits = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(nb + i));
-    const __m256 hb = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, bb), bb)));
-    const __m256 ha = _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, ab), ab)));
-    const __m256 a_nearer = _mm256_cmp_ps(ia, ib, _CMP_GE_OQ);
-    const __m256 near = _mm256_blendv_ps(ib, ia, a_nearer), far = _mm256_blendv_ps(ia, ib, a_nearer);
-    const __m256 beside = _mm256_blendv_ps(after, before, a_nearer);
-    const __m256 has = _mm256_blendv_ps(ha, hb, a_nearer);
-    const __m256 usable = _mm256_and_ps(has, _mm256_cmp_ps(_mm256_and_ps(_mm256_sub_ps(near, beside), abs_mask),
-                                                           _mm256_and_ps(_mm256_sub_ps(near, far), abs_mask), _CMP_LE_OQ));
-    // near + 0.5 (near - beside) with the scalar's two roundings (no FMA), then the clamp.
-    const __m256 e = _mm256_add_ps(near, _mm256_mul_ps(half, _mm256_sub_ps(near, beside)));
-    const __m256 lo_b = _mm256_mul_ps(half, near), hi_b = _mm256_mul_ps(two, near);
-    const __m256 clamped = _mm256_blendv_ps(_mm256_blendv_ps(e, hi_b, _mm256_cmp_ps(e, hi_b, _CMP_GT_OQ)), lo_b,
-                                            _mm256_cmp_ps(e, lo_b, _CMP_LT_OQ));
-    _mm256_storeu_ps(wall_inv + i, _mm256_blendv_ps(near, clamped, usable));
-  }
-  for (; i < hi; ++i) one(i);
-  for (i = std::max(lo, hi); i < end; ++i) one(i);
-}
-#endif
 
 void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t step, unsigned before_bit, unsigned after_bit,
                         std::size_t count, float* wall_inv) {
@@ -588,16 +550,41 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
 // whose texels and right and upper neighbours are all black has zero radiance differences and
 // is skipped (it would add exactly +-0 to every sum: the result is the same bits). Without it
 // (no black group: a lit hemicube) the test would only cost.
-// With Given, the walls' inverse distances come from wall_inv (right walls, then upper walls:
-// extrapolate_wall_depth) instead of the larger of the two texels'.
-template <bool CheckLit, bool Given = false>
+// extrapolated_wall_inv for eight walls (texels i.. against i + step..; hb, ha: lane masks of
+// the neighbours' presence). The same operations (the compiler may fuse a multiply-add here and
+// not in the portable path, so the last bit can differ).
+HEMILIGHT_TARGET_AVX2_FMA inline __attribute__((always_inline)) __m256 extrapolated8(__m256 ia, __m256 ib, __m256 before,
+                                                                                   __m256 after, __m256 hb, __m256 ha) noexcept {
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), half = _mm256_set1_ps(0.5f),
+               two = _mm256_set1_ps(2.0f);
+  const __m256 a_nearer = _mm256_cmp_ps(ia, ib, _CMP_GE_OQ);
+  const __m256 near = _mm256_blendv_ps(ib, ia, a_nearer), far = _mm256_blendv_ps(ia, ib, a_nearer);
+  const __m256 beside = _mm256_blendv_ps(after, before, a_nearer);
+  const __m256 usable = _mm256_and_ps(_mm256_blendv_ps(ha, hb, a_nearer),
+                                      _mm256_cmp_ps(_mm256_and_ps(_mm256_sub_ps(near, beside), abs_mask),
+                                                    _mm256_and_ps(_mm256_sub_ps(near, far), abs_mask), _CMP_LE_OQ));
+  const __m256 e = _mm256_add_ps(near, _mm256_mul_ps(half, _mm256_sub_ps(near, beside)));
+  const __m256 lo = _mm256_mul_ps(half, near), hi = _mm256_mul_ps(two, near);
+  const __m256 clamped = _mm256_blendv_ps(_mm256_blendv_ps(e, hi, _mm256_cmp_ps(e, hi, _CMP_GT_OQ)), lo,
+                                          _mm256_cmp_ps(e, lo, _CMP_LT_OQ));
+  return _mm256_blendv_ps(near, clamped, usable);
+}
+
+// Lanes of the eight bytes `bits` that have bit `bit` set, as a float mask.
+HEMILIGHT_TARGET_AVX2_FMA inline __attribute__((always_inline)) __m256 bit_mask8(__m128i bits, int bit) noexcept {
+  const __m128i m = _mm_set1_epi8(static_cast<char>(bit));
+  return _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, m), m)));
+}
+
+// With Extrapolate, each wall's inverse distance is extrapolated_wall_inv's (nb: the table's
+// extrapolation_neighbours; inv must be readable from -row to count + row + 8: the integrator
+// pads it with zeros) instead of the larger of the two texels'.
+template <bool CheckLit, bool Extrapolate = false>
 HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, const float* b, const float* inv,
                                               const std::uint8_t* lit, const float* rx, const float* ry,
                                               const float* ux, const float* uy, std::size_t row,
                                               std::size_t count, float cap, double* acc,
-                                              const float* wall_inv = nullptr) noexcept {
-  const float* wall_r = wall_inv;
-  const float* wall_u = Given ? wall_inv + count : nullptr;
+                                              const std::uint8_t* nb = nullptr) noexcept {
   const std::size_t both = count - row;  // texels with both walls
   const __m256 cp = _mm256_set1_ps(cap);
   std::size_t i = 0;
@@ -607,12 +594,15 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
     for (i = b0; i < b1; i += 8) {
       // Texels i..i+8 (right walls) and i+row..i+row+7 (upper walls) all black: nothing to add.
       if (CheckLit && !(lit[i >> 3] | lit[(i >> 3) + 1] | lit[(i + row) >> 3] | lit[(i + row + 7) >> 3])) continue;
+      const __m256 iv = _mm256_loadu_ps(inv + i);
       __m256 wr, wu;
-      if (Given) {
-        wr = _mm256_min_ps(_mm256_loadu_ps(wall_r + i), cp);
-        wu = _mm256_min_ps(_mm256_loadu_ps(wall_u + i), cp);
+      if (Extrapolate) {
+        const __m128i bits = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(nb + i));
+        wr = _mm256_min_ps(extrapolated8(iv, _mm256_loadu_ps(inv + i + 1), _mm256_loadu_ps(inv + i - 1),
+                                         _mm256_loadu_ps(inv + i + 2), bit_mask8(bits, 1), bit_mask8(bits, 2)), cp);
+        wu = _mm256_min_ps(extrapolated8(iv, _mm256_loadu_ps(inv + i + row), _mm256_loadu_ps(inv + i - row),
+                                         _mm256_loadu_ps(inv + i + 2 * row), bit_mask8(bits, 4), bit_mask8(bits, 8)), cp);
       } else {
-        const __m256 iv = _mm256_loadu_ps(inv + i);
         wr = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + 1)), cp);
         wu = _mm256_min_ps(_mm256_max_ps(iv, _mm256_loadu_ps(inv + i + row)), cp);
       }
@@ -638,7 +628,12 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
   }
   // Tails: the rest of the texels with both walls, then the right walls of the last row.
   const auto wall = [&](std::size_t k, std::size_t step, float cx, float cy) {
-    const float near_inv = Given ? (step == 1 ? wall_r[k] : wall_u[k]) : inv[k] > inv[k + step] ? inv[k] : inv[k + step];
+    float near_inv = inv[k] > inv[k + step] ? inv[k] : inv[k + step];
+    if (Extrapolate) {
+      const unsigned before_bit = step == 1 ? 1u : 4u, after_bit = step == 1 ? 2u : 8u;
+      const bool hb = (nb[k] & before_bit) != 0, ha = (nb[k] & after_bit) != 0;
+      near_inv = extrapolated_wall_inv(inv[k], inv[k + step], hb ? inv[k - step] : 0.0f, ha ? inv[k + 2 * step] : 0.0f, hb, ha);
+    }
     const double w = near_inv < cap ? near_inv : cap;
     const double wx = cx * w, wy = cy * w;
     acc[0] += (double(r[k + step]) - r[k]) * wx;
@@ -676,7 +671,7 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
   const float* b = buffer.channel(2);
   const float* dist = buffer.distance.data();
   const std::uint8_t* flags = buffer.flags.data();
-  float* inv = inv_r_.data();
+  float* inv = inv_r_.data() + row;  // see the padding in the constructor
   const float* vx = t.vx.data();
   const float* vy = t.vy.data();
   const float* vz = t.vz.data();
@@ -773,18 +768,17 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
     const float* ux = arc ? t.up_great_arc_x.data() : t.up_classified_x.data();
     const float* uy = arc ? t.up_great_arc_y.data() : t.up_classified_y.data();
     if (options_.extrapolate_wall_depth) {
-      // Per-wall inverse distances first (right walls, then upper walls), then the sums.
+      // AVX2: extrapolated inside the wall pass; portable: per-wall inverse distances first
+      // (right walls, then upper walls), then the sums.
       float* wr = wall_inv_.data();
       float* wu = wr + count;
       const std::uint8_t* nb = t.extrapolation_neighbours.data();
 #if HEMILIGHT_INTEGRATE_AVX2
-      if (avx2) {
-        extrapolated_walls_avx2(inv, nb, 1, 1u, 2u, count, wr);
-        extrapolated_walls_avx2(inv, nb, row, 4u, 8u, count, wu);
+      if (avx2) {  // computed in the wall pass itself, only for the groups it does not skip
         if (black_groups > 0)
-          wall_pass_avx2<true, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, wr);
+          wall_pass_avx2<true, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, nb);
         else
-          wall_pass_avx2<false, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, wr);
+          wall_pass_avx2<false, true>(r, g, b, inv, lit_.data(), rx, ry, ux, uy, row, count, cap, acc, nb);
       } else
 #endif
       {
