@@ -13,7 +13,9 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
                          the same for cache_resolution_k128.csv (hexagon ceiling and Cornell box,
                          128 x 128 grid) and cache_cornell_rules.csv (docs/cache.md, the single-record
                          rules: variant base = before them, c1 = the defaults with them, nearby_only /
-                         sole_reach_only = the ablation). Rows may carry a `variant` column (sweep_cache --variant: which
+                         sole_reach_only = the ablation), cache_session5.csv (defaults against
+                         extrapolate_wall_depth, and N = 1024) and cache_finest_spacing.csv (a scratch
+                         build's coarser finest records, tried and dropped). Rows may carry a `variant` column (sweep_cache --variant: which
                          cache options); with more than one variant, each gets its own curves (marker and
                          line style) and its own rows in the .md table.
 """
@@ -164,7 +166,7 @@ def table(rows, path):
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 if os.path.exists(f"{out}/cache_sweep.csv"):
     chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
-for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules"):
+for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules", "cache_session5", "cache_finest_spacing"):
     if os.path.exists(f"{out}/{name}.csv"):
         rows = load_csv(f"{out}/{name}.csv")
         if not rows:

@@ -16,7 +16,7 @@ rows = load_csv(f"{out}/integrate_sweep.csv")
 scenes = list(dict.fromkeys(r["scene"] for r in rows))
 fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.6), sharey=True)
 for ax, scene in zip(axes, scenes):
-    for est, style in (("simple", "s:"), ("classified", "^--"), ("great_arc", "o-")):
+    for est, style in (("simple", "s:"), ("classified", "^--"), ("great_arc", "o-"), ("great_arc_extrapolated", "D-")):
         pts = sorted((r["N"], r["g_t_rel_err"]) for r in rows if r["scene"] == scene and r["estimator"] == est)
         ax.loglog([p[0] for p in pts], [max(p[1], 1e-6) for p in pts], style, label=f"g_t {est}")
     pts = sorted((r["N"], r["E_rel_err"]) for r in rows if r["scene"] == scene and r["estimator"] == "great_arc")

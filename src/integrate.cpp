@@ -212,8 +212,10 @@ namespace {
 constexpr std::size_t block = 1024;
 
 // Sum over the walls between texel i and i + step of (L_b - L_a) * coefficient * 1 / r_wall, per
-// channel and coefficient component, into acc[6]. Hot loop of the integrator.
-template <class Inner>
+// channel and coefficient component, into acc[6]. Hot loop of the integrator. 1 / r_wall is the
+// larger of inv[i], inv[i + step], or with Given, inv[i] itself (the walls' own inverse
+// distances: extrapolate_wall_depth).
+template <class Inner, bool Given = false>
 inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const float* g, const float* b, const float* inv,
                                                           const float* cx, const float* cy, std::size_t step,
                                                           std::size_t end, float cap, double* acc) {
@@ -222,34 +224,8 @@ inline __attribute__((always_inline)) void wall_sums_impl(const float* r, const 
     Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
 #pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
     for (std::size_t i = b0; i < b1; ++i) {
-      const float near_inv = inv[i] > inv[i + step] ? inv[i] : inv[i + step];
+      const float near_inv = Given ? inv[i] : inv[i] > inv[i + step] ? inv[i] : inv[i + step];
       const Inner w = Inner(near_inv < cap ? near_inv : cap);
-      const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
-      const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
-                  db = Inner(b[i + step]) - Inner(b[i]);
-      a0 += dr * wx;
-      a1 += dr * wy;
-      a2 += dg * wx;
-      a3 += dg * wy;
-      a4 += db * wx;
-      a5 += db * wy;
-    }
-    const Inner sums[6] = {a0, a1, a2, a3, a4, a5};
-    for (int k = 0; k < 6; ++k) acc[k] += double(sums[k]);
-  }
-}
-
-// wall_sums_impl with the inverse distance of each wall given (wall_inv[i]: the wall between
-// texel i and i + step), for extrapolate_wall_depth.
-template <class Inner>
-inline __attribute__((always_inline)) void wall_sums_given_impl(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
-                                 const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
-  for (std::size_t b0 = 0; b0 < end; b0 += block) {
-    const std::size_t b1 = std::min(end, b0 + block);
-    Inner a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0;
-#pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5)
-    for (std::size_t i = b0; i < b1; ++i) {
-      const Inner w = Inner(wall_inv[i] < cap ? wall_inv[i] : cap);
       const Inner wx = Inner(cx[i]) * w, wy = Inner(cy[i]) * w;
       const Inner dr = Inner(r[i + step]) - Inner(r[i]), dg = Inner(g[i + step]) - Inner(g[i]),
                   db = Inner(b[i + step]) - Inner(b[i]);
@@ -315,7 +291,7 @@ __attribute__((target_clones("avx2", "default")))
 #endif
 void wall_sums_given_float(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
                            const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
-  wall_sums_given_impl<float>(r, g, b, wall_inv, cx, cy, step, end, cap, acc);
+  wall_sums_impl<float, true>(r, g, b, wall_inv, cx, cy, step, end, cap, acc);
 }
 
 // Inverts the distances and sums pass 1 (E per channel, total projected solid angle, harmonic
@@ -788,8 +764,8 @@ irradiance_sample hemicube_integrator::run(const hemicube_buffer& buffer) {
           wall_sums_given_float(r, g, b, wr, rx, ry, 1, count - 1, cap, acc);
           wall_sums_given_float(r, g, b, wu, ux, uy, row, count - row, cap, acc);
         } else {
-          wall_sums_given_impl<Inner>(r, g, b, wr, rx, ry, 1, count - 1, cap, acc);
-          wall_sums_given_impl<Inner>(r, g, b, wu, ux, uy, row, count - row, cap, acc);
+          wall_sums_impl<Inner, true>(r, g, b, wr, rx, ry, 1, count - 1, cap, acc);
+          wall_sums_impl<Inner, true>(r, g, b, wu, ux, uy, row, count - row, cap, acc);
         }
       }
     } else if (avx2) {

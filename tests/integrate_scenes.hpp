@@ -8,6 +8,7 @@
 #include "raycast_reference.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <functional>
 #include <string>
 
@@ -99,7 +100,9 @@ inline closed_form_scene beside_wall_under_sky() {
 /// depth / 0.05 rad tall at its near edge.
 inline closed_form_scene emitter_seen_edge_on(double depth) {
   closed_form_scene s;
-  s.name = "emitter seen edge-on, " + std::to_string(depth) + " under its plane";
+  char name[64];
+  std::snprintf(name, sizeof name, "emitter seen edge-on %.3g mm under its plane", 1000.0 * depth);
+  s.name = name;
   const std::vector<glm::dvec3> quad = {{0.05, depth, -0.15}, {0.35, depth, -0.15}, {0.35, depth, 0.15}, {0.05, depth, 0.15}};
   add_quad(s.tris, quad[0], quad[1], quad[2], quad[3], glm::vec3(1.0f));
   s.position = {0.0, 0.0, 0.0};

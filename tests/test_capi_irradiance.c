@@ -95,6 +95,18 @@ static int stop_at_once(void* user, float fraction) {
   return 0;
 }
 
+/* side x side points 0.1 apart in the plane z = 0, normals +z (3 side^2 floats each). */
+static void grid_points(float* pos, float* nrm, int side) {
+  int i;
+  for (i = 0; i < side * side; ++i) {
+    pos[3 * i] = (float)(i % side) * 0.1f;
+    pos[3 * i + 1] = (float)(i / side) * 0.1f;
+    pos[3 * i + 2] = 0.0f;
+    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
+    nrm[3 * i + 2] = 1.0f;
+  }
+}
+
 static void test_cache(void) {
   const float sky[3] = {0.5f, 1.0f, 2.0f};
   hemilight_scene* empty = NULL;
@@ -112,13 +124,7 @@ static void test_cache(void) {
     free(out);
     return;
   }
-  for (i = 0; i < count; ++i) {
-    pos[3 * i] = (float)(i % side) * 0.1f;
-    pos[3 * i + 1] = (float)(i / side) * 0.1f;
-    pos[3 * i + 2] = 0.0f;
-    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
-    nrm[3 * i + 2] = 1.0f;
-  }
+  grid_points(pos, nrm, side);
   hemilight_cache_options_init(&o);
   CHECK(o.resolution == 64 && o.error_threshold == 0.2f && o.use_gradients == 1 && o.thread_count == 0 && o.progress == NULL);
   hemilight_cache_options_init(NULL); /* ignored */
@@ -179,13 +185,7 @@ static void test_cache_rules(void) {
     free(out);
     return;
   }
-  for (i = 0; i < count; ++i) {
-    pos[3 * i] = (float)(i % side) * 0.1f;
-    pos[3 * i + 1] = (float)(i / side) * 0.1f;
-    pos[3 * i + 2] = 0.0f;
-    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
-    nrm[3 * i + 2] = 1.0f;
-  }
+  grid_points(pos, nrm, side);
   hemilight_cache_options_init(&o);
   CHECK(o.weight == HEMILIGHT_CACHE_WEIGHT_WARD && o.gradient_radius_limit == 1 && o.neighbour_clamp == 1 &&
         o.shrink_disagreeing == 1 && o.refine_disagreement == 1);
