@@ -24,6 +24,8 @@
 //     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
+//     --record-regions    Cornell box: print where the records are (floor / walls, dark or lit, the
+//                         walls' rows under the emitter's plane) and how many sit at min_radius
 //     --variant NAME      written to the last CSV column (default "default"): which cache options
 //   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
 //   (stride 1, 1 roll), so reruns with other cache options do not render it again.
@@ -190,6 +192,7 @@ int main(int argc, char** argv) {
   float nearby_opinion = cache_options{}.nearby_opinion;
   float sole_reach = cache_options{}.sole_record_reach;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
+  bool record_regions = false;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
   std::vector<std::string> scene_keys{"cornell", "hexagon", "sky"};
@@ -236,6 +239,8 @@ int main(int argc, char** argv) {
       const std::string v = value();
       if (v != "yes" && v != "no") usage(("bad --extrapolate-wall-depth '" + v + "' (yes, no)").c_str());
       extrapolate_wall_depth = v == "yes";
+    } else if (arg == "--record-regions") {
+      record_regions = true;
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
     else if (arg == "--threads") thread_arg = to_int(value(), "threads");
     else if (arg == "--gradients") {
@@ -441,6 +446,26 @@ int main(int argc, char** argv) {
                           ps.p[i].x, ps.p[i].y, ps.p[i].z, ps.n[i].x, ps.n[i].y, ps.n[i].z, ref[i].luminance,
                           lum(r.irradiance[i]), 100.0 * errs[j].first);
             }
+          }
+          if (record_regions && ps.key == "cornell") {
+            // Where the records are (docs/cache.md, session 5): the floor and the walls, dark
+            // (E < 0.3 x the mean record E) or not, and the walls' rows under the emitter's plane.
+            double mean_e = 0.0;
+            for (const cache_record& rec : r.records) mean_e += double(lum(rec.irradiance));
+            mean_e /= double(std::max<std::size_t>(r.records.size(), 1));
+            const char* names[6] = {"floor, dark", "floor, lit", "walls, top 3 rows", "walls, 6 rows below them",
+                                    "walls, dark", "walls, rest"};
+            std::size_t in[6] = {}, at_min[6] = {};
+            for (const cache_record& rec : r.records) {
+              const bool dark = double(lum(rec.irradiance)) < 0.3 * mean_e;
+              const int wall_row = int(rec.position.y / 0.5488f * float(k));
+              const int c = rec.normal.y > 0.5f ? (dark ? 0 : 1) : wall_row >= k - 3 ? 2 : wall_row >= k - 9 ? 3 : dark ? 4 : 5;
+              ++in[c];
+              if (rec.radius <= r.stats.min_radius * 1.0001f) ++at_min[c];
+            }
+            for (int c = 0; c < 6; ++c)
+              std::printf("    records, %-26s %6zu = %5.2f%% of the points (%zu at min_radius)\n", names[c], in[c],
+                          100.0 * double(in[c]) / double(count), at_min[c]);
           }
           double total = 0.0, total_max = 0.0;
           vs_converged([&](std::size_t i) { return lum(r.irradiance[i]); }, total, total_max);
