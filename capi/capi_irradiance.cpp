@@ -93,6 +93,7 @@ void hemilight_cache_options_init(hemilight_cache_options* options) {
   options->nearby_opinion = d.nearby_opinion;
   options->sole_record_reach = d.sole_record_reach;
   options->invalid_backface_fraction = d.invalid_backface_fraction;
+  options->extrapolate_wall_depth = hemilight::integrate_options{}.extrapolate_wall_depth ? 1 : 0;
 }
 
 hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions, const float* normals,
@@ -116,7 +117,8 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     const std::pair<const char*, int> switches[] = {{"gradient_radius_limit", options->gradient_radius_limit},
                                                     {"neighbour_clamp", options->neighbour_clamp},
                                                     {"shrink_disagreeing", options->shrink_disagreeing},
-                                                    {"refine_disagreement", options->refine_disagreement}};
+                                                    {"refine_disagreement", options->refine_disagreement},
+                                                    {"extrapolate_wall_depth", options->extrapolate_wall_depth}};
     for (const auto& sw : switches)
       if (sw.second != 0 && sw.second != 1)
         return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
@@ -149,6 +151,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     hemilight::hemicube_sampler_options so;
     so.resolution = options->resolution;
     so.raster.sky = scene->sky;
+    so.integrate.extrapolate_wall_depth = options->extrapolate_wall_depth == 1;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
     hemilight::cache_result r;

@@ -219,6 +219,9 @@ typedef struct hemilight_cache_options {
   float sole_record_reach;        /* (0, 1], 1 = off: a singly covered point must lie inside this fraction
                                      of the record's reach (default 0.99) */
   float invalid_backface_fraction; /* [0, 1]: samples seeing more back faces are invalid (default 0.1) */
+  int extrapolate_wall_depth;     /* 0 or 1: the hemicubes' translation gradients take each texel wall's
+                                     depth extrapolated from the nearer texel (more accurate where planes
+                                     are seen at grazing angles; docs/integration.md) (default 0) */
 } hemilight_cache_options;
 
 /* Fills options with the defaults above. NULL is ignored. */

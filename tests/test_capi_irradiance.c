@@ -190,7 +190,7 @@ static void test_cache_rules(void) {
   CHECK(o.weight == HEMILIGHT_CACHE_WEIGHT_WARD && o.gradient_radius_limit == 1 && o.neighbour_clamp == 1 &&
         o.shrink_disagreeing == 1 && o.refine_disagreement == 1);
   CHECK(o.second_opinion == 0.25f && o.nearby_opinion == 2.0f && o.sole_record_reach == 0.99f &&
-        o.invalid_backface_fraction == 0.1f);
+        o.invalid_backface_fraction == 0.1f && o.extrapolate_wall_depth == 0);
   o.resolution = 32;
   CHECK(hemilight_scene_create(quad_pos, 4, quad_idx, 2, black, sky, &shadow) == HEMILIGHT_OK);
   CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &with_rules) == HEMILIGHT_OK);
@@ -200,6 +200,23 @@ static void test_cache_rules(void) {
   o.sole_record_reach = 1.0f;
   CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &without_rules) == HEMILIGHT_OK);
   CHECK(without_rules.hemicubes < with_rules.hemicubes);
+  {
+    /* extrapolate_wall_depth reaches the hemicubes: the same points give other records. */
+    hemilight_cache_stats extrapolated;
+    float* out2 = (float*)malloc(sizeof(float) * 3 * count);
+    int differs = 0;
+    hemilight_cache_options_init(&o);
+    o.resolution = 32;
+    CHECK(out2 != NULL);
+    if (out2) {
+      CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, NULL) == HEMILIGHT_OK);
+      o.extrapolate_wall_depth = 1;
+      CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &extrapolated) == HEMILIGHT_OK);
+      for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
+      CHECK(differs);
+      free(out2);
+    }
+  }
 
   hemilight_cache_options_init(&o);
   o.resolution = 16;
@@ -213,6 +230,9 @@ static void test_cache_rules(void) {
   hemilight_cache_options_init(&o);
   o.gradient_radius_limit = 2;
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "gradient_radius_limit is 2");
+  hemilight_cache_options_init(&o);
+  o.extrapolate_wall_depth = 3;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "extrapolate_wall_depth is 3");
   hemilight_cache_options_init(&o);
   o.refine_disagreement = -1;
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "refine_disagreement");
