@@ -280,7 +280,6 @@ inline __attribute__((always_inline)) void extrapolated_walls_impl(const float* 
   for (std::size_t i = std::max(lo, hi); i < end; ++i) one(i);
 }
 
-
 void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t step, unsigned before_bit, unsigned after_bit,
                         std::size_t count, float* wall_inv) {
   extrapolated_walls_impl(inv, nb, step, before_bit, after_bit, count, wall_inv);
@@ -520,12 +519,6 @@ HEMILIGHT_TARGET_AVX2_FMA float texel_pass_avx2(const float* r, const float* g, 
   return md;
 }
 
-// Both wall passes inside faces (right neighbour i + 1, coefficients rx, ry, over i < count - 1;
-// the texel above i + row, coefficients ux, uy, over i < count - row) into acc[6], as
-// wall_sums_impl does for each. With CheckLit, lit: texel_pass_avx2's black-group map; a group
-// whose texels and right and upper neighbours are all black has zero radiance differences and
-// is skipped (it would add exactly +-0 to every sum: the result is the same bits). Without it
-// (no black group: a lit hemicube) the test would only cost.
 // extrapolated_wall_inv for eight walls (texels i.. against i + step..; hb, ha: lane masks of
 // the neighbours' presence). The same operations (the compiler may fuse a multiply-add here and
 // not in the portable path, so the last bit can differ).
@@ -552,6 +545,12 @@ HEMILIGHT_TARGET_AVX2_FMA inline __attribute__((always_inline)) __m256 bit_mask8
   return _mm256_castsi256_ps(_mm256_cvtepi8_epi32(_mm_cmpeq_epi8(_mm_and_si128(bits, m), m)));
 }
 
+// Both wall passes inside faces (right neighbour i + 1, coefficients rx, ry, over i < count - 1;
+// the texel above i + row, coefficients ux, uy, over i < count - row) into acc[6], as
+// wall_sums_impl does for each. With CheckLit, lit: texel_pass_avx2's black-group map; a group
+// whose texels and right and upper neighbours are all black has zero radiance differences and
+// is skipped (it would add exactly +-0 to every sum: the result is the same bits). Without it
+// (no black group: a lit hemicube) the test would only cost.
 // With Extrapolate, each wall's inverse distance is extrapolated_wall_inv's (nb: the table's
 // extrapolation_neighbours; inv must be readable from -row to count + row + 8: the integrator
 // pads it with zeros) instead of the larger of the two texels'.

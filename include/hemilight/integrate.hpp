@@ -89,7 +89,7 @@ struct irradiance_sample {
 };
 
 /// Per-resolution weights of the integrator, computed once in double and stored as float.
-/// Memory: 68 bytes per texel plus 6 N walls (N = 64: 0.8 MiB, N = 256: 13 MiB, N = 1024: 204 MiB).
+/// Memory: 69 bytes per texel plus 6 N walls (N = 64: 0.8 MiB, N = 256: 13 MiB, N = 1024: 204 MiB).
 class integration_table {
  public:
   /// The shared table of resolution N (cached like hemicube_table: up to N = 512 for the
