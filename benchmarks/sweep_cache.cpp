@@ -222,7 +222,10 @@ int main(int argc, char** argv) {
     else if (arg == "--check-stride") check_stride = to_int(value(), "check stride");
     else if (arg == "--truth-cache") truth_dir = value();
     else if (arg == "--append") append = true;
-    else if (arg == "--variant") variant = value();
+    else if (arg == "--variant") {
+      variant = value();
+      if (variant.find_first_of(",\"\n") != std::string::npos) usage("--variant must not contain commas, quotes or newlines (it is a CSV field)");
+    }
     else if (arg == "--second-opinion") {
       const std::string v = value();
       second_opinion = std::strtof(v.c_str(), nullptr);
