@@ -122,8 +122,11 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     for (const auto& sw : switches)
       if (sw.second != 0 && sw.second != 1)
         return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
-    if (options->weight != HEMILIGHT_CACHE_WEIGHT_WARD && options->weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE)
-      return invalid(fn, "options->weight is " + std::to_string(static_cast<int>(options->weight)) +
+    // Read as an int: a C caller may store any int in an enum field (a C++ load of such a value is
+    // undefined behaviour).
+    const int weight = hemilight::capi::enum_value(options->weight);
+    if (weight != HEMILIGHT_CACHE_WEIGHT_WARD && weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE)
+      return invalid(fn, "options->weight is " + std::to_string(weight) +
                              "; it must be HEMILIGHT_CACHE_WEIGHT_WARD (0) or HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE (1)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     hemilight::cache_options o;
@@ -132,7 +135,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     o.max_radius = options->max_radius;
     o.use_gradients = options->use_gradients == 1;
     o.thread_count = options->thread_count;
-    o.weight = options->weight == HEMILIGHT_CACHE_WEIGHT_WARD ? hemilight::cache_weight::ward
+    o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD ? hemilight::cache_weight::ward
                                                                : hemilight::cache_weight::tabellion_lamorlette;
     o.gradient_radius_limit = options->gradient_radius_limit == 1;
     o.neighbour_clamp = options->neighbour_clamp == 1;
