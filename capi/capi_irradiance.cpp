@@ -110,11 +110,10 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     if (!hemilight::is_valid_hemicube_resolution(options->resolution))
       return invalid(fn, "options->resolution " + std::to_string(options->resolution) +
                              " is invalid: it must be even and in [2, 4096]");
-    if (options->use_gradients != 0 && options->use_gradients != 1)
-      return invalid(fn, "options->use_gradients is " + std::to_string(options->use_gradients) + "; it must be 0 or 1");
     if (options->thread_count < 0)
       return invalid(fn, "options->thread_count is " + std::to_string(options->thread_count) + "; it must be >= 0");
-    const std::pair<const char*, int> switches[] = {{"gradient_radius_limit", options->gradient_radius_limit},
+    const std::pair<const char*, int> switches[] = {{"use_gradients", options->use_gradients},
+                                                    {"gradient_radius_limit", options->gradient_radius_limit},
                                                     {"neighbour_clamp", options->neighbour_clamp},
                                                     {"shrink_disagreeing", options->shrink_disagreeing},
                                                     {"refine_disagreement", options->refine_disagreement},

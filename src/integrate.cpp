@@ -259,30 +259,15 @@ inline float extrapolated_wall_inv(float ia, float ib, float before, float after
 }
 
 // wall_inv[i] for the walls between texel i and i + step, i < count - step (nb: the table's
-// extrapolation_neighbours; bits `before_bit` and `after_bit` for this direction).
-inline __attribute__((always_inline)) void extrapolated_walls_impl(const float* inv, const std::uint8_t* nb,
-                                                                   std::size_t step, unsigned before_bit,
-                                                                   unsigned after_bit, std::size_t count,
-                                                                   float* wall_inv) {
-  const std::size_t end = count - step;
-  // Texels whose `before` (i - step) or `after` (i + 2 step) would lie outside the buffer have
-  // no such neighbour in their face either; they are done one at a time.
-  const auto one = [&](std::size_t i) {
-    const bool hb = (nb[i] & before_bit) != 0, ha = (nb[i] & after_bit) != 0;
-    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], hb ? inv[i - step] : 0.0f, ha ? inv[i + 2 * step] : 0.0f, hb, ha);
-  };
-  const std::size_t lo = std::min(step, end), hi = end > step ? end - step : lo;
-  for (std::size_t i = 0; i < lo; ++i) one(i);
-#pragma omp simd
-  for (std::size_t i = lo; i < hi; ++i)
-    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], inv[i - step], inv[i + 2 * step], (nb[i] & before_bit) != 0,
-                                        (nb[i] & after_bit) != 0);
-  for (std::size_t i = std::max(lo, hi); i < end; ++i) one(i);
-}
-
+// extrapolation_neighbours; bits `before_bit` and `after_bit` for this direction). inv is padded
+// (see the integrator's constructor), so i - step and i + 2 step can be read for every i; where
+// they lie outside the face their bit is clear and they are not used.
 void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t step, unsigned before_bit, unsigned after_bit,
                         std::size_t count, float* wall_inv) {
-  extrapolated_walls_impl(inv, nb, step, before_bit, after_bit, count, wall_inv);
+#pragma omp simd
+  for (std::size_t i = 0; i < count - step; ++i)
+    wall_inv[i] = extrapolated_wall_inv(inv[i], inv[i + step], inv[i - step], inv[i + 2 * step], (nb[i] & before_bit) != 0,
+                                        (nb[i] & after_bit) != 0);
 }
 
 #if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
@@ -606,8 +591,8 @@ HEMILIGHT_TARGET_AVX2_FMA void wall_pass_avx2(const float* r, const float* g, co
     float near_inv = inv[k] > inv[k + step] ? inv[k] : inv[k + step];
     if (Extrapolate) {
       const unsigned before_bit = step == 1 ? 1u : 4u, after_bit = step == 1 ? 2u : 8u;
-      const bool hb = (nb[k] & before_bit) != 0, ha = (nb[k] & after_bit) != 0;
-      near_inv = extrapolated_wall_inv(inv[k], inv[k + step], hb ? inv[k - step] : 0.0f, ha ? inv[k + 2 * step] : 0.0f, hb, ha);
+      near_inv = extrapolated_wall_inv(inv[k], inv[k + step], inv[k - step], inv[k + 2 * step], (nb[k] & before_bit) != 0,
+                                       (nb[k] & after_bit) != 0);
     }
     const double w = near_inv < cap ? near_inv : cap;
     const double wx = cx * w, wy = cy * w;

@@ -213,6 +213,21 @@ inline void walk_rows(const edge_walk* left_in, const edge_walk* right_in, std::
   }
 }
 
+// walk_rows for the edge counts a triangle with area has: one left and one right bound (with a
+// horizontal edge), or one and two, or two and one. Fixed counts keep the walk in registers.
+template <class Span>
+inline void walk_rows_of(int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
+                         std::int64_t x_begin, std::int64_t x_end, Span& span) {
+  if (nl == 1 && nr == 1)
+    walk_rows<1, 1>(left, right, y0, y1, x_begin, x_end, span);
+  else if (nl == 1 && nr == 2)
+    walk_rows<1, 2>(left, right, y0, y1, x_begin, x_end, span);
+  else if (nl == 2 && nr == 1)
+    walk_rows<2, 1>(left, right, y0, y1, x_begin, x_end, span);
+  else
+    assert(false && "a triangle with area has a left and a right edge");
+}
+
 #if HEMILIGHT_RASTER_SSE2
 // Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
 constexpr std::int64_t simd_extent = 32 * sub_one;
@@ -377,12 +392,7 @@ HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(
     std::int64_t x_begin, std::int64_t x_end, float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
     float dzdx, std::uint32_t draw, raster_statistics& stats) noexcept {
   depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
-  if (nl == 1 && nr == 1)
-    walk_rows<1, 1>(left, right, y0, y1, x_begin, x_end, span);
-  else if (nl == 1 && nr == 2)
-    walk_rows<1, 2>(left, right, y0, y1, x_begin, x_end, span);
-  else if (nl == 2 && nr == 1)
-    walk_rows<2, 1>(left, right, y0, y1, x_begin, x_end, span);
+  walk_rows_of(nl, nr, left, right, y0, y1, x_begin, x_end, span);
   stats.spans += span.spans;
   stats.fragments += span.fragments;
 }
@@ -1553,8 +1563,6 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
       e.r_step = ey[k] - e.q_step * e.m;
     }
   }
-  // A triangle with area has a left and a right bound: (1, 1) with a horizontal edge, else
-  // (1, 2) or (2, 1). Fixed counts keep the walk in registers.
   assert((nl == 1 && nr == 1) || (nl == 1 && nr == 2) || (nl == 2 && nr == 1));
 #if HEMILIGHT_RASTER_AVX2
   if (M == mode::depth && avx2_) {
@@ -1562,14 +1570,7 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
     return;
   }
 #endif
-  if (nl == 1 && nr == 1)
-    walk_rows<1, 1>(left, right, y_first, y_last, x_begin, x_end, span);
-  else if (nl == 1 && nr == 2)
-    walk_rows<1, 2>(left, right, y_first, y_last, x_begin, x_end, span);
-  else if (nl == 2 && nr == 1)
-    walk_rows<2, 1>(left, right, y_first, y_last, x_begin, x_end, span);
-  else
-    assert(false && "a triangle with area has a left and a right edge");
+  walk_rows_of(nl, nr, left, right, y_first, y_last, x_begin, x_end, span);
 }
 
 void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,

@@ -95,16 +95,29 @@ static int stop_at_once(void* user, float fraction) {
   return 0;
 }
 
-/* side x side points 0.1 apart in the plane z = 0, normals +z (3 side^2 floats each). */
-static void grid_points(float* pos, float* nrm, int side) {
+/* side x side points 0.1 apart in the plane z = 0, normals +z, and room for their irradiance:
+ * 3 side^2 floats each. Returns 0 (after a failed check, nothing allocated) if out of memory. */
+static int grid_points(float** pos, float** nrm, float** out, int side) {
+  const size_t floats = 3 * (size_t)side * (size_t)side;
   int i;
-  for (i = 0; i < side * side; ++i) {
-    pos[3 * i] = (float)(i % side) * 0.1f;
-    pos[3 * i + 1] = (float)(i / side) * 0.1f;
-    pos[3 * i + 2] = 0.0f;
-    nrm[3 * i] = nrm[3 * i + 1] = 0.0f;
-    nrm[3 * i + 2] = 1.0f;
+  *pos = (float*)malloc(sizeof(float) * floats);
+  *nrm = (float*)malloc(sizeof(float) * floats);
+  *out = (float*)malloc(sizeof(float) * floats);
+  if (!*pos || !*nrm || !*out) {
+    CHECK(0);
+    free(*pos);
+    free(*nrm);
+    free(*out);
+    return 0;
   }
+  for (i = 0; i < side * side; ++i) {
+    (*pos)[3 * i] = (float)(i % side) * 0.1f;
+    (*pos)[3 * i + 1] = (float)(i / side) * 0.1f;
+    (*pos)[3 * i + 2] = 0.0f;
+    (*nrm)[3 * i] = (*nrm)[3 * i + 1] = 0.0f;
+    (*nrm)[3 * i + 2] = 1.0f;
+  }
+  return 1;
 }
 
 static void test_cache(void) {
@@ -113,18 +126,9 @@ static void test_cache(void) {
   hemilight_cache_options o;
   hemilight_cache_stats stats;
   enum { side = 20, count = side * side };
-  float* pos = (float*)malloc(sizeof(float) * 3 * count);
-  float* nrm = (float*)malloc(sizeof(float) * 3 * count);
-  float* out = (float*)malloc(sizeof(float) * 3 * count);
+  float *pos = NULL, *nrm = NULL, *out = NULL;
   int i, ok = 1, calls = 0;
-  if (!pos || !nrm || !out) {
-    CHECK(0);
-    free(pos);
-    free(nrm);
-    free(out);
-    return;
-  }
-  grid_points(pos, nrm, side);
+  if (!grid_points(&pos, &nrm, &out, side)) return;
   hemilight_cache_options_init(&o);
   CHECK(o.resolution == 64 && o.error_threshold == 0.2f && o.use_gradients == 1 && o.thread_count == 0 && o.progress == NULL);
   hemilight_cache_options_init(NULL); /* ignored */
@@ -174,18 +178,9 @@ static void test_cache_rules(void) {
   hemilight_cache_options o;
   hemilight_cache_stats with_rules, without_rules;
   enum { side = 20, count = side * side };
-  float* pos = (float*)malloc(sizeof(float) * 3 * count);
-  float* nrm = (float*)malloc(sizeof(float) * 3 * count);
-  float* out = (float*)malloc(sizeof(float) * 3 * count);
+  float *pos = NULL, *nrm = NULL, *out = NULL;
   int i, ok = 1;
-  if (!pos || !nrm || !out) {
-    CHECK(0);
-    free(pos);
-    free(nrm);
-    free(out);
-    return;
-  }
-  grid_points(pos, nrm, side);
+  if (!grid_points(&pos, &nrm, &out, side)) return;
   hemilight_cache_options_init(&o);
   CHECK(o.weight == HEMILIGHT_CACHE_WEIGHT_WARD && o.gradient_radius_limit == 1 && o.neighbour_clamp == 1 &&
         o.shrink_disagreeing == 1 && o.refine_disagreement == 1);
