@@ -36,6 +36,22 @@ std::string vec_str(const glm::vec3& v) {
 // The largest distance at which a record can have a positive weight: a R for both weightings.
 float coverage_radius(const cache_record& r, const cache_options& o) { return o.error_threshold * r.radius; }
 
+// The weight the coverage tests use: Ward's w where it passes 1/a (for both Ward weightings, so
+// ward_continuous places the same records as ward), the Tabellion-Lamorlette w where positive;
+// else 0. record_weight (the interpolation's weight) is this, less 1/a for ward_continuous.
+float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+  const float d = glm::length(x - r.position);
+  const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
+  if (o.weight != cache_weight::tabellion_lamorlette) {
+    const float denom = d / r.radius + ndot;
+    const float w = denom > 1.0f / max_weight ? 1.0f / denom : max_weight;
+    return w > 1.0f / o.error_threshold ? w : 0.0f;
+  }
+  const float k = 1.0f / (2.0f * o.error_threshold);
+  const float w = 1.0f - k * std::max(d / (0.5f * r.radius), ndot / 0.12326f);
+  return w > 0.0f ? w : 0.0f;
+}
+
 glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3& n, bool gradients) {
   glm::vec3 e = r.irradiance;
   if (gradients) {
@@ -527,16 +543,9 @@ std::array<glm::vec3, 3> hl2_from_cone(const hl2_cone& c, const frame& f) noexce
 }
 
 float record_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
-  const float d = glm::length(x - r.position);
-  const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
-  if (o.weight == cache_weight::ward) {
-    const float denom = d / r.radius + ndot;
-    const float w = denom > 1.0f / max_weight ? 1.0f / denom : max_weight;
-    return w > 1.0f / o.error_threshold ? w : 0.0f;
-  }
-  const float k = 1.0f / (2.0f * o.error_threshold);
-  const float w = 1.0f - k * std::max(d / (0.5f * r.radius), ndot / 0.12326f);
-  return w > 0.0f ? w : 0.0f;
+  const float w = coverage_weight(r, x, n, o);
+  // w > 1/a here, so w - 1/a > 0 (IEEE subtraction of two different floats is never 0).
+  return o.weight == cache_weight::ward_continuous && w > 0.0f ? w - 1.0f / o.error_threshold : w;
 }
 
 bool record_is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) {
@@ -632,6 +641,11 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   std::vector<std::int32_t> record_at_point(count, -1);
   const float nearby_reach = o.nearby_opinion * finest;
 
+  // The coverage tests weigh records with Ward's own weight under ward_continuous too, so that
+  // both place the same records (only the final interpolation differs; cache.hpp).
+  cache_options coverage_options = o;
+  if (coverage_options.weight == cache_weight::ward_continuous) coverage_options.weight = cache_weight::ward;
+  coverage_options.progress = nullptr;
   for (;;) {
     // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
     // when a record's weight passes the threshold and, with refine_disagreement, the covering
@@ -653,8 +667,8 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         const bool second_opinion = o.second_opinion > 0.0f;
         const bool nearby_opinion = o.nearby_opinion > 0.0f;
         const bool sole_reach = o.sole_record_reach < 1.0f;
-        const float w = interpolate(records, bvh, positions[i], normals[i], o, value, &spread, &own, nullptr, nullptr,
-                                    second_opinion || nearby_opinion || sole_reach ? &detail : nullptr);
+        const float w = interpolate(records, bvh, positions[i], normals[i], coverage_options, value, &spread, &own,
+                                    nullptr, nullptr, second_opinion || nearby_opinion || sole_reach ? &detail : nullptr);
         bool ok = w > 0.0f;
         bool leans_on_floor = false;
         if (ok && o.refine_disagreement && !own) {
@@ -671,7 +685,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
         }
         // Sole record reach: a point that one record covers must lie inside sole_record_reach of
         // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
-        if (ok && sole_reach && !own && detail.records == 1 && o.weight == cache_weight::ward)
+        if (ok && sole_reach && !own && detail.records == 1 && coverage_options.weight == cache_weight::ward)
           ok = detail.max_weight >= 1.0f / (o.sole_record_reach * a);
         // Nearby opinion: records near a point that one record covers, which do not cover it
         // themselves, must predict the same there within a (a hard shadow edge between two rows

@@ -10,6 +10,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -70,6 +71,59 @@ TEST_CASE("cache weights: Tabellion-Lamorlette weight", "[cache]") {
   CHECK(record_weight(r, {1.0f, 0, 0}, {0, 0, 1}, o) == 0.0f);
   const float c10 = std::cos(10.0f * 3.14159265f / 180.0f);
   CHECK(record_weight(r, {0, 0, 0}, {std::sqrt(1 - c10 * c10), 0, c10}, o) == Approx(0.0f).margin(1e-3));
+}
+
+TEST_CASE("cache weights: ward_continuous is Ward's weight less 1/a", "[cache]") {
+  cache_options o;
+  o.error_threshold = 0.2f;  // Ward: used where w > 5
+  o.weight = cache_weight::ward_continuous;
+  const cache_record r = make_record({0, 0, 0}, {0, 0, 1}, 1.0f, 2.0f);
+  // Same normal: Ward's w = R / d. d = 0.2 -> 10 - 5 = 5; d = 0.399 (just inside the reach
+  // a R = 0.4) -> 2 / 0.399 - 5 = 0.0125 (small, still positive); d = 0.5 -> 0.
+  CHECK(record_weight(r, {0.2f, 0, 0}, {0, 0, 1}, o) == Approx(5.0f));
+  CHECK(record_weight(r, {0.399f, 0, 0}, {0, 0, 1}, o) == Approx(2.0f / 0.399f - 5.0f).epsilon(1e-4));
+  CHECK(record_weight(r, {0.399f, 0, 0}, {0, 0, 1}, o) > 0.0f);
+  CHECK(record_weight(r, {0.5f, 0, 0}, {0, 0, 1}, o) == 0.0f);
+  // Tilted normal, same point: 1 / sqrt(1 - 0.99) - 5 = 5.
+  const float s99 = std::sqrt(1.0f - 0.99f * 0.99f);
+  CHECK(record_weight(r, {0, 0, 0}, {s99, 0, 0.99f}, o) == Approx(5.0f).epsilon(1e-3));
+  // Its own position and normal: capped (1e12 - 5), finite.
+  CHECK(std::isfinite(record_weight(r, {0, 0, 0}, {0, 0, 1}, o)));
+  CHECK(record_weight(r, {0, 0, 0}, {0, 0, 1}, o) >= 1e11f);
+}
+
+TEST_CASE("cache: ward_continuous interpolation has no jump where a record's reach ends; ward's does", "[cache]") {
+  // Records A (E = 1) at x = 0 and B (E = 2) at x = 0.3, R = 1, a = 0.2: B's reach (a R = 0.2)
+  // ends at x = 0.1, where A's Ward weight is 10. Ward: crossing x = 0.1 takes E from 1 to
+  // (10 x 1 + 5 x 2) / 15 = 4/3 at once. ward_continuous: B enters with weight ~25 (x - 0.1)
+  // beside A's 5, so E changes by about 25 eps / 5 = 5 eps = 5e-4 over the step of 2 eps.
+  const std::vector<cache_record> records = {make_record({0, 0, 0}, {0, 0, 1}, 1.0f, 1.0f),
+                                             make_record({0.3f, 0, 0}, {0, 0, 1}, 2.0f, 1.0f)};
+  cache_options ward;
+  ward.error_threshold = 0.2f;
+  cache_options continuous = ward;
+  continuous.weight = cache_weight::ward_continuous;
+  const float eps = 1e-4f;
+  const glm::vec3 n(0, 0, 1), before(0.1f - eps, 0, 0), after(0.1f + eps, 0, 0);
+  const float jump_ward = interpolate_records(records, after, n, ward).x - interpolate_records(records, before, n, ward).x;
+  const float jump_cont =
+      interpolate_records(records, after, n, continuous).x - interpolate_records(records, before, n, continuous).x;
+  CHECK(jump_ward == Approx(1.0f / 3.0f).epsilon(0.01));
+  // Expected ~5e-4 (above); 2e-3 leaves room for the float distances at x ~ 0.1 (ulp ~7e-9).
+  CHECK(std::fabs(jump_cont) < 2e-3f);
+  // Along the whole segment [0, 0.2] (A's reach) in steps of 1e-4, no step of the continuous
+  // interpolant jumps: its exact slope peaks at 40/3 per unit at x = 0.15 (both weights 5/3), i.e.
+  // 1.33e-3 per step, so a bound of 2e-3 per step holds it with float rounding to spare and fails
+  // on any jump over 2e-3 (Ward's is 1/3).
+  float worst_step = 0.0f, last = interpolate_records(records, {0, 0, 0}, n, continuous).x;
+  for (int k = 1; k < 2000; ++k) {
+    const float e = interpolate_records(records, {float(k) * 1e-4f, 0, 0}, n, continuous).x;
+    worst_step = std::max(worst_step, std::fabs(e - last));
+    last = e;
+  }
+  CHECK(worst_step < 2e-3f);
+  // Both reproduce the records at their own points.
+  CHECK(interpolate_records(records, records[1].position, n, continuous).x == Approx(2.0f).epsilon(1e-6));
 }
 
 TEST_CASE("cache: the behind test rejects records the point lies behind", "[cache]") {
@@ -191,6 +245,33 @@ TEST_CASE("cache: bitwise identical for one and two threads", "[cache]") {
     CHECK(one.records[i].radius == two.records[i].radius);
   }
   CHECK(one.stats.hemicubes == two.stats.hemicubes);
+}
+
+TEST_CASE("cache: ward_continuous places exactly the records ward places", "[cache]") {
+  // Its coverage tests use Ward's weight, so placement and statistics are the same; only the
+  // interpolated values differ (and each record's own point keeps its hemicube's value).
+  const closed_form_scene s = lit_room();
+  std::vector<glm::vec3> p, n;
+  floor_grid(-0.95f, 0.95f, -0.95f, 0.95f, 0.05f, p, n);
+  cache_options o;
+  o.error_threshold = 0.3f;
+  const cache_result ward = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
+  o.weight = cache_weight::ward_continuous;
+  const cache_result cont = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
+  REQUIRE(ward.records.size() == cont.records.size());
+  for (std::size_t i = 0; i < ward.records.size(); ++i) {
+    CHECK(ward.records[i].position == cont.records[i].position);
+    CHECK(ward.records[i].radius == cont.records[i].radius);
+  }
+  CHECK(ward.stats.hemicubes == cont.stats.hemicubes);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) differ += ward.irradiance[i] != cont.irradiance[i] ? 1u : 0u;
+  CHECK(differ > p.size() / 4);  // most points lie where several records' reaches overlap
+  for (const cache_record& r : cont.records) {
+    const std::size_t i = std::size_t(std::find(p.begin(), p.end(), r.position) - p.begin());
+    REQUIRE(i < p.size());
+    CHECK(cont.irradiance[i].x == Approx(r.irradiance.x).epsilon(1e-6));
+  }
 }
 
 TEST_CASE("cache: cancellation throws and returns nothing", "[cache]") {
