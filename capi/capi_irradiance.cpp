@@ -124,9 +124,11 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     // Read as an int: a C caller may store any int in an enum field (a C++ load of such a value is
     // undefined behaviour).
     const int weight = hemilight::capi::enum_value(options->weight);
-    if (weight != HEMILIGHT_CACHE_WEIGHT_WARD && weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE)
+    if (weight != HEMILIGHT_CACHE_WEIGHT_WARD && weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE &&
+        weight != HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS)
       return invalid(fn, "options->weight is " + std::to_string(weight) +
-                             "; it must be HEMILIGHT_CACHE_WEIGHT_WARD (0) or HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE (1)");
+                             "; it must be HEMILIGHT_CACHE_WEIGHT_WARD (0), HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE (1) "
+                             "or HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS (2)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     hemilight::cache_options o;
     o.error_threshold = options->error_threshold;
@@ -134,8 +136,9 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     o.max_radius = options->max_radius;
     o.use_gradients = options->use_gradients == 1;
     o.thread_count = options->thread_count;
-    o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD ? hemilight::cache_weight::ward
-                                                               : hemilight::cache_weight::tabellion_lamorlette;
+    o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD                   ? hemilight::cache_weight::ward
+               : weight == HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE ? hemilight::cache_weight::tabellion_lamorlette
+                                                                       : hemilight::cache_weight::ward_continuous;
     o.gradient_radius_limit = options->gradient_radius_limit == 1;
     o.neighbour_clamp = options->neighbour_clamp == 1;
     o.shrink_disagreeing = options->shrink_disagreeing == 1;

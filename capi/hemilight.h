@@ -42,7 +42,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 5
+#define HEMILIGHT_VERSION_MINOR 6
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {
@@ -191,8 +191,12 @@ typedef int (*hemilight_progress_fn)(void* user, float fraction);
 
 /* Interpolation weight of the irradiance cache. */
 typedef enum hemilight_cache_weight {
-  HEMILIGHT_CACHE_WEIGHT_WARD = 0,                /* 1 / (d / R + sqrt(1 - n.n_i)), used where > 1 / a */
-  HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE = 1 /* 1 - max(d / (R / 2), angle term) / (2a), used where > 0 */
+  HEMILIGHT_CACHE_WEIGHT_WARD = 0,                 /* 1 / (d / R + sqrt(1 - n.n_i)), used where > 1 / a */
+  HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE = 1, /* 1 - max(d / (R / 2), angle term) / (2a), used where > 0 */
+  HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS = 2       /* since 0.6: Ward's weight less 1 / a, used where Ward's
+                                                      > 1 / a: the same records as WARD, but each one's weight
+                                                      falls to 0 at the edge of its reach, so the result is
+                                                      continuous there (lower error, docs/cache.md) */
 } hemilight_cache_weight;
 
 typedef struct hemilight_cache_options {

@@ -209,6 +209,20 @@ static void test_cache_rules(void) {
       CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &extrapolated) == HEMILIGHT_OK);
       for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
       CHECK(differs);
+      /* HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS reaches the interpolation: the same hemicubes as
+       * WARD (its placement is Ward's), other values. */
+      {
+        hemilight_cache_stats ward_stats, continuous_stats;
+        hemilight_cache_options_init(&o);
+        o.resolution = 32;
+        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &ward_stats) == HEMILIGHT_OK);
+        o.weight = HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS;
+        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &continuous_stats) == HEMILIGHT_OK);
+        CHECK(ward_stats.hemicubes == continuous_stats.hemicubes && ward_stats.records == continuous_stats.records);
+        differs = 0;
+        for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
+        CHECK(differs);
+      }
       free(out2);
     }
   }
