@@ -14,8 +14,9 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
                          128 x 128 grid) and cache_cornell_rules.csv (docs/cache.md, the single-record
                          rules: variant base = before them, c1 = the defaults with them, nearby_only /
                          sole_reach_only = the ablation), cache_session5.csv (defaults against
-                         extrapolate_wall_depth, and N = 1024) and cache_finest_spacing.csv (a scratch
-                         build's coarser finest records, tried and dropped). Rows may carry a `variant` column (sweep_cache --variant: which
+                         extrapolate_wall_depth, and N = 1024), cache_finest_spacing.csv (a scratch
+                         build's coarser finest records, tried and dropped) and cache_weights.csv
+                         (cache_weight::ward against ward_continuous; bash benchmarks/run.sh cache_weights). Rows may carry a `variant` column (sweep_cache --variant: which
                          cache options); with more than one variant, each gets its own curves (marker and
                          line style) and its own rows in the .md table.
 """
@@ -166,7 +167,8 @@ def table(rows, path):
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 if os.path.exists(f"{out}/cache_sweep.csv"):
     chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
-for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules", "cache_session5", "cache_finest_spacing"):
+for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules", "cache_session5", "cache_finest_spacing",
+             "cache_weights"):
     if os.path.exists(f"{out}/{name}.csv"):
         rows = load_csv(f"{out}/{name}.csv")
         if not rows:

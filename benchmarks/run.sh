@@ -4,6 +4,8 @@
 #   bash benchmarks/run.sh NAME...    only these (e.g. geometry raster)
 #   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
+#   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
+#                                     ward_continuous (docs/cache.md, session 6; not run by default)
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
 # benchmarks/plot_NAME.py (if any) draws docs/bench/NAME.png from the CSV(s).
@@ -24,6 +26,32 @@ if [ ${#names[@]} -eq 0 ]; then
   done
 fi
 for n in "${names[@]}"; do
+  if [ "$n" = cache_weights ]; then
+    # cache_weight::ward against ward_continuous (and each with integrate_options::
+    # extrapolate_wall_depth) on the 128 grid, with gradients: docs/cache.md, session 6. The same
+    # records for both weights; only the interpolation differs. ~15 min on 2 cores here
+    # (the per-point references at N = 512 and 1024 dominate; kept in build-bench/cache_truth).
+    echo "== sweep_cache (interpolation weights)"
+    csv=docs/bench/cache_weights.csv truth="$build/cache_truth"
+    rm -f "$csv"; mkdir -p "$truth"
+    for w in ward ward_continuous; do
+      for x in no yes; do
+        v=$w; [ "$x" = yes ] && v="$w+extrapolate"
+        c=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --weight "$w"
+           --extrapolate-wall-depth "$x" --variant "$v")
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 76 --scenes cornell --n 64,256,512 \
+          --a 0.2,0.3,0.5,0.55,0.7,1.0
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 28 --scenes hexagon --n 64,256,512 \
+          --a 0.2,0.3,0.5,1.0
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 2048 --stride 76 --scenes cornell --n 1024 \
+          --a 0.5,0.55,0.6
+      done
+      "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes,no --truth-cache "$truth" --weight "$w" \
+        --converged 512 --stride 7 --scenes sky --n 64 --a 0.1,0.2,0.3,0.5 --variant "$w"
+    done
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
   if [ "$n" = cache_resolution ]; then
     echo "== sweep_cache (resolution study)"
     csv=docs/bench/cache_resolution.csv truth="$build/cache_truth" a=0.05,0.1,0.2,0.3,0.5

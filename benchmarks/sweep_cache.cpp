@@ -22,10 +22,13 @@
 //     --second-opinion F  cache_options::second_opinion (default: the option's default; 0 = off)
 //     --nearby-opinion F  cache_options::nearby_opinion (default: the option's default; 0 = off)
 //     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
+//     --weight W          cache_options::weight: ward, ward_continuous or tabellion_lamorlette
+//                         (default: the option's default)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
 //     --record-regions    Cornell box: print where the records are (floor / walls, dark or lit, the
-//                         walls' rows under the emitter's plane) and how many sit at min_radius
+//                         walls' rows under the emitter's plane), how many sit at min_radius, and
+//                         each region's points, share of the squared error and RMS (per point)
 //     --variant NAME      written to the last CSV column (default "default"): which cache options
 //   With --truth-cache the per-point reference (a hemicube at every point) is kept there too
 //   (stride 1, 1 roll), so reruns with other cache options do not render it again.
@@ -191,6 +194,7 @@ int main(int argc, char** argv) {
   float second_opinion = cache_options{}.second_opinion;
   float nearby_opinion = cache_options{}.nearby_opinion;
   float sole_reach = cache_options{}.sole_record_reach;
+  cache_weight weight = cache_options{}.weight;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
   bool record_regions = false;
   std::vector<int> resolutions{64};
@@ -234,6 +238,12 @@ int main(int argc, char** argv) {
       const std::string v = value();
       nearby_opinion = std::strtof(v.c_str(), nullptr);
       if (!(nearby_opinion >= 0.0f && nearby_opinion <= 16.0f)) usage(("bad --nearby-opinion '" + v + "'").c_str());
+    } else if (arg == "--weight") {
+      const std::string v = value();
+      if (v == "ward") weight = cache_weight::ward;
+      else if (v == "ward_continuous") weight = cache_weight::ward_continuous;
+      else if (v == "tabellion_lamorlette") weight = cache_weight::tabellion_lamorlette;
+      else usage(("bad --weight '" + v + "' (ward, ward_continuous, tabellion_lamorlette)").c_str());
     } else if (arg == "--sole-reach") {
       const std::string v = value();
       sole_reach = std::strtof(v.c_str(), nullptr);
@@ -420,6 +430,7 @@ int main(int argc, char** argv) {
           o.second_opinion = second_opinion;
           o.nearby_opinion = nearby_opinion;
           o.sole_record_reach = sole_reach;
+          o.weight = weight;
           o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
@@ -458,17 +469,35 @@ int main(int argc, char** argv) {
             mean_e /= double(std::max<std::size_t>(r.records.size(), 1));
             const char* names[6] = {"floor, dark", "floor, lit", "walls, top 3 rows", "walls, 6 rows below them",
                                     "walls, dark", "walls, rest"};
-            std::size_t in[6] = {}, at_min[6] = {};
+            const auto region = [&](const glm::vec3& p, const glm::vec3& n, double e) {
+              const bool dark = e < 0.3 * mean_e;
+              const int wall_row = int(p.y / 0.5488f * float(k));
+              return n.y > 0.5f ? (dark ? 0 : 1) : wall_row >= k - 3 ? 2 : wall_row >= k - 9 ? 3 : dark ? 4 : 5;
+            };
+            std::size_t in[6] = {}, at_min[6] = {}, points[6] = {};
             for (const cache_record& rec : r.records) {
-              const bool dark = double(lum(rec.irradiance)) < 0.3 * mean_e;
-              const int wall_row = int(rec.position.y / 0.5488f * float(k));
-              const int c = rec.normal.y > 0.5f ? (dark ? 0 : 1) : wall_row >= k - 3 ? 2 : wall_row >= k - 9 ? 3 : dark ? 4 : 5;
+              const int c = region(rec.position, rec.normal, double(lum(rec.irradiance)));
               ++in[c];
               if (rec.radius <= r.stats.min_radius * 1.0001f) ++at_min[c];
             }
+            // Each region's share of the squared error against the per-point reference (points
+            // classified like the records, "dark" by their reference E), so the RMS can be read
+            // region by region: sqrt(share x RMS^2 x valid / points in region) is its own RMS.
+            double sq[6] = {};
+            for (std::size_t i = 0; i < count; ++i) {
+              if (ref[i].backface > 0.1f || !r.valid[i]) continue;
+              const double e_ref = ref[i].luminance;
+              const double err = std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean);
+              const int c = region(ps.p[i], ps.n[i], e_ref);
+              sq[c] += err * err;
+              ++points[c];
+            }
             for (int c = 0; c < 6; ++c)
-              std::printf("    records, %-26s %6zu = %5.2f%% of the points (%zu at min_radius)\n", names[c], in[c],
-                          100.0 * double(in[c]) / double(count), at_min[c]);
+              std::printf("    records, %-26s %6zu = %5.2f%% of the points (%zu at min_radius); %6zu points, "
+                          "%5.1f%% of the squared error, RMS %.3f%%\n",
+                          names[c], in[c], 100.0 * double(in[c]) / double(count), at_min[c], points[c],
+                          sum > 0.0 ? 100.0 * sq[c] / sum : 0.0,
+                          100.0 * std::sqrt(sq[c] / double(std::max<std::size_t>(points[c], 1))));
           }
           double total = 0.0, total_max = 0.0;
           vs_converged([&](std::size_t i) { return lum(r.irradiance[i]); }, total, total_max);
