@@ -120,8 +120,17 @@ def chart(rows, path):
             if col == 0:
                 ax.set_ylabel(ylabel)
             ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=6, ncol=2)
-    fig.tight_layout()
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    if len(labels) > 10:
+        # Many curves (several variants): the legend goes below the panels, where it hides none of them.
+        rows_of_legend = math.ceil(len(labels) / 4)
+        bottom = min(0.45, 0.03 * rows_of_legend + 0.02)
+        fig.set_size_inches(fig.get_size_inches()[0], fig.get_size_inches()[1] / (1 - bottom))
+        fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
+        fig.tight_layout(rect=(0, bottom, 1, 1))
+    else:
+        axes[0][0].legend(fontsize=6, ncol=2)
+        fig.tight_layout()
     fig.savefig(path, dpi=110)
     print(f"wrote {path}")
 

@@ -49,6 +49,9 @@ for n in "${names[@]}"; do
       "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes,no --truth-cache "$truth" --weight "$w" \
         --converged 512 --stride 7 --scenes sky --n 64 --a 0.1,0.2,0.3,0.5 --variant "$w"
     done
+    # the Cornell 1% target at N = 1024: the two a between the rows that bracket it
+    "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 \
+      --weight ward_continuous --variant ward_continuous --converged 2048 --stride 76 --scenes cornell --n 1024 --a 0.57,0.58
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
     continue
   fi
