@@ -14,7 +14,7 @@
 //                         converged N) and report the converged reference's own RMS error against
 //                         it, so "converged" can be verified (default: no check)
 //     --check-stride S    (default 4)
-//     --truth-cache DIR   keep the converged (and check) luminances in DIR/*.bin keyed by scene,
+//     --truth-cache DIR   keep the converged (and check) luminances in DIR/*.bin (DIR is created) keyed by scene,
 //                         grid, N and stride, so split runs do not render them twice
 //     --append            append rows to out.csv (header only if the file is empty)
 //     --gradients LIST    any of yes,no (default yes,no)
@@ -60,6 +60,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -323,6 +324,12 @@ int main(int argc, char** argv) {
     sets.push_back(std::move(ps));
   }
 
+  if (!truth_dir.empty()) {
+    // Without the folder nothing would be kept, silently, and every run would render its references again.
+    std::error_code ec;
+    std::filesystem::create_directories(truth_dir, ec);
+    if (ec) usage(("cannot create --truth-cache folder '" + truth_dir + "': " + ec.message()).c_str());
+  }
   const int threads = resolve_thread_count(thread_arg);
   for (point_set& ps : sets) {
     const std::size_t count = ps.p.size();
