@@ -43,6 +43,16 @@ irradiance_sampler raycast_sampler(const closed_form_scene& s, int n) {
   };
 }
 
+// Both results placed the same records (positions and radii, in order) from the same hemicubes.
+void check_same_records(const cache_result& a, const cache_result& b) {
+  REQUIRE(a.records.size() == b.records.size());
+  for (std::size_t i = 0; i < a.records.size(); ++i) {
+    CHECK(a.records[i].position == b.records[i].position);
+    CHECK(a.records[i].radius == b.records[i].radius);
+  }
+  CHECK(a.stats.hemicubes == b.stats.hemicubes);
+}
+
 }  // namespace
 
 TEST_CASE("cache weights: Ward's weight and threshold on hand-built records", "[cache]") {
@@ -238,13 +248,8 @@ TEST_CASE("cache: bitwise identical for one and two threads", "[cache]") {
   const cache_result one = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
   o.thread_count = 2;
   const cache_result two = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
-  REQUIRE(one.records.size() == two.records.size());
+  check_same_records(one, two);
   CHECK(std::memcmp(one.irradiance.data(), two.irradiance.data(), sizeof(glm::vec3) * p.size()) == 0);
-  for (std::size_t i = 0; i < one.records.size(); ++i) {
-    CHECK(one.records[i].position == two.records[i].position);
-    CHECK(one.records[i].radius == two.records[i].radius);
-  }
-  CHECK(one.stats.hemicubes == two.stats.hemicubes);
 }
 
 TEST_CASE("cache: ward_continuous places exactly the records ward places", "[cache]") {
@@ -258,12 +263,7 @@ TEST_CASE("cache: ward_continuous places exactly the records ward places", "[cac
   const cache_result ward = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
   o.weight = cache_weight::ward_continuous;
   const cache_result cont = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
-  REQUIRE(ward.records.size() == cont.records.size());
-  for (std::size_t i = 0; i < ward.records.size(); ++i) {
-    CHECK(ward.records[i].position == cont.records[i].position);
-    CHECK(ward.records[i].radius == cont.records[i].radius);
-  }
-  CHECK(ward.stats.hemicubes == cont.stats.hemicubes);
+  check_same_records(ward, cont);
   std::size_t differ = 0;
   for (std::size_t i = 0; i < p.size(); ++i) differ += ward.irradiance[i] != cont.irradiance[i] ? 1u : 0u;
   CHECK(differ > p.size() / 4);  // most points lie where several records' reaches overlap
