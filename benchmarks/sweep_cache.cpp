@@ -441,12 +441,16 @@ int main(int argc, char** argv) {
           o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
+          // Relative error of each point against the per-point reference; -1 where left out (inside
+          // geometry, or filled).
+          std::vector<double> err_of(count, -1.0);
           double sum = 0.0, worst = 0.0;
           std::size_t m = 0;
           for (std::size_t i = 0; i < count; ++i) {
             if (ref[i].backface > 0.1f || !r.valid[i]) continue;
             const double e_ref = ref[i].luminance;
             const double err = std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean);
+            err_of[i] = err;
             sum += err * err;
             worst = std::max(worst, err);
             ++m;
@@ -454,11 +458,8 @@ int main(int argc, char** argv) {
           const double rms = std::sqrt(sum / double(std::max<std::size_t>(m, 1)));
           if (worst_k > 0) {  // the worst points against the per-point reference
             std::vector<std::pair<double, std::size_t>> errs;
-            for (std::size_t i = 0; i < count; ++i) {
-              if (ref[i].backface > 0.1f || !r.valid[i]) continue;
-              const double e_ref = ref[i].luminance;
-              errs.push_back({std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean), i});
-            }
+            for (std::size_t i = 0; i < count; ++i)
+              if (err_of[i] >= 0.0) errs.push_back({err_of[i], i});
             const std::size_t kk = std::min<std::size_t>(std::size_t(worst_k), errs.size());
             std::partial_sort(errs.begin(), errs.begin() + std::ptrdiff_t(kk), errs.end(), std::greater<>());
             for (std::size_t j = 0; j < kk; ++j) {
@@ -492,11 +493,9 @@ int main(int argc, char** argv) {
             // region by region: sqrt(share x RMS^2 x valid / points in region) is its own RMS.
             double sq[6] = {};
             for (std::size_t i = 0; i < count; ++i) {
-              if (ref[i].backface > 0.1f || !r.valid[i]) continue;
-              const double e_ref = ref[i].luminance;
-              const double err = std::fabs(lum(r.irradiance[i]) - e_ref) / std::max(e_ref, 0.05 * mean);
-              const int c = region(ps.p[i], ps.n[i], e_ref);
-              sq[c] += err * err;
+              if (err_of[i] < 0.0) continue;
+              const int c = region(ps.p[i], ps.n[i], ref[i].luminance);
+              sq[c] += err_of[i] * err_of[i];
               ++points[c];
             }
             for (int c = 0; c < 6; ++c)
