@@ -93,19 +93,19 @@ struct cache_record {
   hl2_cone cone;
 };
 
-/// Weighting of records.
+/// Weighting of records. The values match hemilight_cache_weight of the C ABI (0, 1, 2).
 enum class cache_weight {
   ward,                  ///< w = 1 / (d / R + sqrt(1 - n.n_i)), used where w > 1/a
+  /// w = 1 - k max(d / (R/2), sqrt(1 - n.n_i) / 0.12326) with k = 1 / (2a), used where w > 0.
+  /// k is tied to a so that both weights reach as far in space (d < a R); 0.12326 = sqrt(1 - cos 10 deg).
+  tabellion_lamorlette,
   /// Ward's weight less 1/a, w - 1/a, used where w > 1/a: the same records cover the same points
   /// as with `ward` (placement and statistics are identical), but a record's weight falls to 0 at
   /// the edge of its reach instead of jumping from 1/a to 0 there, so the interpolated irradiance
   /// is continuous where a record's reach ends. Ward's own weight (and its jump) remains inside
   /// the coverage tests. docs/cache.md (session 6): Cornell box N = 512, a = 0.5, 1.16% -> 1.02%
   /// RMS at the same 10.6% of the points; hexagon ceiling a = 0.5, 1.28% -> 1.03%.
-  ward_continuous,
-  /// w = 1 - k max(d / (R/2), sqrt(1 - n.n_i) / 0.12326) with k = 1 / (2a), used where w > 0.
-  /// k is tied to a so that both weights reach as far in space (d < a R); 0.12326 = sqrt(1 - cos 10 deg).
-  tabellion_lamorlette,
+  ward_continuous,  // last, so the earlier values stay as they were (and match the C ABI's numbering)
 };
 
 /// Options of the irradiance cache. Lengths are in scene units.
