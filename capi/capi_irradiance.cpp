@@ -94,6 +94,7 @@ void hemilight_cache_options_init(hemilight_cache_options* options) {
   options->sole_record_reach = d.sole_record_reach;
   options->invalid_backface_fraction = d.invalid_backface_fraction;
   options->extrapolate_wall_depth = hemilight::integrate_options{}.extrapolate_wall_depth ? 1 : 0;
+  options->second_order = d.second_order ? 1 : 0;
 }
 
 hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions, const float* normals,
@@ -117,7 +118,8 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
                                                     {"neighbour_clamp", options->neighbour_clamp},
                                                     {"shrink_disagreeing", options->shrink_disagreeing},
                                                     {"refine_disagreement", options->refine_disagreement},
-                                                    {"extrapolate_wall_depth", options->extrapolate_wall_depth}};
+                                                    {"extrapolate_wall_depth", options->extrapolate_wall_depth},
+                                                    {"second_order", options->second_order}};
     for (const auto& sw : switches)
       if (sw.second != 0 && sw.second != 1)
         return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
@@ -143,6 +145,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     o.neighbour_clamp = options->neighbour_clamp == 1;
     o.shrink_disagreeing = options->shrink_disagreeing == 1;
     o.refine_disagreement = options->refine_disagreement == 1;
+    o.second_order = options->second_order == 1;
     // Range-checked (with the field named) by cache_irradiance.
     o.second_opinion = options->second_opinion;
     o.nearby_opinion = options->nearby_opinion;

@@ -42,7 +42,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 6
+#define HEMILIGHT_VERSION_MINOR 7
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {
@@ -226,6 +226,10 @@ typedef struct hemilight_cache_options {
   int extrapolate_wall_depth;     /* 0 or 1: the hemicubes' translation gradients take each texel wall's
                                      depth extrapolated from the nearer texel (more accurate where planes
                                      are seen at grazing angles; docs/integration.md) (default 0) */
+  int second_order;               /* since 0.7; 0 or 1: after placement, each record gets a Hessian fitted
+                                     from its neighbours' gradients (scaled by how well it predicts their
+                                     values) and the interpolation adds its quadratic term; the same
+                                     records and hemicubes, lower error (docs/cache.md) (default 1) */
 } hemilight_cache_options;
 
 /* Fills options with the defaults above. NULL is ignored. */

@@ -52,16 +52,27 @@ float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3
   return w > 0.0f ? w : 0.0f;
 }
 
-glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3& n, bool gradients) {
+// A record's prediction at (x, n): order 0 = E_i, 1 = with the gradient terms, 2 = also with the
+// second-order term 1/2 dx^T H dx, clamped per channel to +-a E_i (the error a allows: a record
+// whose irradiance is 0, in an umbra, stays 0 instead of bending towards its lit neighbours).
+glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3& n, int order, float a = 1.0f) {
   glm::vec3 e = r.irradiance;
-  if (gradients) {
+  if (order >= 1) {
     const glm::vec3 rot = glm::cross(r.normal, n);
     const glm::vec3 dx = x - r.position;
     for (int c = 0; c < 3; ++c)
       e[c] += glm::dot(rot, r.rotation_gradient[std::size_t(c)]) + glm::dot(dx, r.translation_gradient[std::size_t(c)]);
+    if (order >= 2)
+      for (int c = 0; c < 3; ++c) {
+        const float limit = a * r.irradiance[c];
+        e[c] += std::clamp(0.5f * glm::dot(dx, r.hessian[std::size_t(c)] * dx), -limit, limit);
+      }
   }
   return e;
 }
+
+// The order of the predictions that options ask for.
+int prediction_order(const cache_options& o) { return !o.use_gradients ? 0 : (o.second_order ? 2 : 1); }
 
 // A bounding-volume hierarchy over the records' coverage spheres, rebuilt after every round
 // (records are only added between rounds, so queries never race with insertion). Query cost
@@ -251,6 +262,90 @@ class point_grid {
   std::vector<std::uint32_t> start_, points_;
 };
 
+// Second-order terms (fit_record_hessians in cache.hpp). For record i, in its tangent frame
+// (t, b): the symmetric H2 = [[h11, h12], [h12, h22]] that best maps the neighbours' offsets
+// (dt, db) to their gradient differences (per channel), two equations per neighbour:
+//     h11 dt + h12 db = dg.t,   h12 dt + h22 db = dg.b.
+// The normal matrix depends only on the offsets, so the three channels share it.
+void fit_hessians(std::vector<cache_record>& records, const cache_options& o, int threads) {
+  const std::size_t count = records.size();
+  std::vector<glm::vec3> where(count);
+  for (std::size_t i = 0; i < count; ++i) where[i] = records[i].position;
+  point_grid grid;
+  grid.build(where.data(), count);
+  std::vector<std::array<glm::mat3, 3>> fitted(count);
+  parallel_for(count, threads, 64, [&](int, std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t> near;
+    std::vector<glm::vec3> miss;
+    for (std::size_t i = b; i < e; ++i) {
+      const cache_record& ri = records[i];
+      const frame f = make_frame(ri.normal);
+      near.clear();
+      grid.for_each_in_sphere(ri.position, 2.0f * o.error_threshold * ri.radius, [&](std::uint32_t j) {
+        if (j != i && glm::dot(ri.normal, records[j].normal) > 0.95f) near.push_back(j);
+      });
+      if (near.size() < 2) continue;
+      std::sort(near.begin(), near.end());  // a fixed summation order, whatever the grid's
+      double m[3][3] = {}, rhs[3][3] = {};  // normal matrix; right-hand side per channel
+      for (std::uint32_t j : near) {
+        const glm::vec3 d = records[j].position - ri.position;
+        const double dt = glm::dot(d, f.t), db = glm::dot(d, f.b);
+        m[0][0] += dt * dt;
+        m[0][1] += dt * db;
+        m[1][1] += dt * dt + db * db;
+        m[1][2] += dt * db;
+        m[2][2] += db * db;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const glm::vec3 dg = records[j].translation_gradient[c] - ri.translation_gradient[c];
+          const double gt = glm::dot(dg, f.t), gb = glm::dot(dg, f.b);
+          rhs[c][0] += dt * gt;
+          rhs[c][1] += db * gt + dt * gb;
+          rhs[c][2] += db * gb;
+        }
+      }
+      m[1][0] = m[0][1];
+      m[2][1] = m[1][2];
+      const double ridge = 1e-6 * (m[0][0] + m[1][1] + m[2][2]);
+      for (int k = 0; k < 3; ++k) m[k][k] += ridge;
+      // Solve by the adjugate (m is symmetric positive definite with the ridge).
+      const double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1], c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2],
+                   c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+      const double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+      if (!(det > 0.0)) continue;
+      const double inv[3][3] = {{c00 / det, (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det, (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det},
+                                {c01 / det, (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det, (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det},
+                                {c02 / det, (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det, (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det}};
+      // What the first-order prediction misses at each neighbour (the scale's data, below).
+      miss.clear();
+      for (std::uint32_t j : near) miss.push_back(records[j].irradiance - extrapolate(ri, records[j].position, records[j].normal, 1));
+      for (glm::length_t c = 0; c < 3; ++c) {
+        double h[3];
+        for (int k = 0; k < 3; ++k) h[k] = inv[k][0] * rhs[c][0] + inv[k][1] * rhs[c][1] + inv[k][2] * rhs[c][2];
+        // Scale s in [0, 1]: the least-squares factor of the quadratic term in the neighbours'
+        // irradiance beyond the first-order prediction (data the fit above did not use).
+        double rq = 0.0, qq = 0.0;
+        for (std::size_t k = 0; k < near.size(); ++k) {
+          const glm::vec3 d = records[near[k]].position - ri.position;
+          const double dt = glm::dot(d, f.t), db = glm::dot(d, f.b);
+          const double q = 0.5 * (h[0] * dt * dt + 2.0 * h[1] * dt * db + h[2] * db * db);
+          const double r = miss[k][c];
+          rq += r * q;
+          qq += q * q;
+        }
+        const double s = qq > 0.0 ? std::clamp(rq / qq, 0.0, 1.0) : 0.0;
+        if (!(s > 0.0) || !std::isfinite(s * (std::fabs(h[0]) + std::fabs(h[1]) + std::fabs(h[2])))) continue;
+        // World space: H = s T H2 T^T with T = [t b] (glm is column-major: hm[col][row]).
+        glm::mat3 hm(0.0f);
+        for (int p = 0; p < 3; ++p)
+          for (int q = 0; q < 3; ++q)
+            hm[q][p] = float(s * (h[0] * f.t[p] * f.t[q] + h[1] * (f.t[p] * f.b[q] + f.b[p] * f.t[q]) + h[2] * f.b[p] * f.b[q]));
+        fitted[i][std::size_t(c)] = hm;
+      }
+    }
+  });
+  for (std::size_t i = 0; i < count; ++i) records[i].hessian = fitted[i];
+}
+
 // What the placement's coverage test needs beyond the value: how many records cover the point and
 // the largest first-order term |lum(prediction) - lum(E_i)| of a covering record relative to
 // max(lum(E_i), floor) (floor given in).
@@ -278,11 +373,12 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   if (cone) cone_sum.reference = make_frame(n).t;
   float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
+  const int order = prediction_order(o);
   bvh.query(x, [&](std::uint32_t i) {
     const cache_record& r = records[i];
     const float w = record_weight(r, x, n, o);
     if (w <= 0.0f || record_is_behind(r, x, n)) return;
-    const glm::vec3 e = extrapolate(r, x, n, o.use_gradients);
+    const glm::vec3 e = extrapolate(r, x, n, order, o.error_threshold);
     sum += w * e;
     wsum += w;
     if (sh)
@@ -559,11 +655,22 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
   for (const cache_record& r : records) {
     const float w = record_weight(r, x, n, o);
     if (w <= 0.0f || record_is_behind(r, x, n)) continue;
-    sum += w * extrapolate(r, x, n, o.use_gradients);
+    sum += w * extrapolate(r, x, n, prediction_order(o), o.error_threshold);
     wsum += w;
   }
   if (weight_sum) *weight_sum = wsum;
   return wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
+}
+
+void fit_record_hessians(std::vector<cache_record>& records, const cache_options& o) {
+  if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
+    throw_invalid_argument("fit_record_hessians: options.error_threshold is " + std::to_string(o.error_threshold) +
+                           "; it must be in (0, 1]");
+  for (std::size_t i = 0; i < records.size(); ++i)
+    if (!(records[i].radius >= 0.0f) || !std::isfinite(records[i].radius))
+      throw_invalid_argument("fit_record_hessians: record " + std::to_string(i) + " has radius " +
+                             std::to_string(records[i].radius) + "; it must be finite and >= 0");
+  fit_hessians(records, o, resolve_thread_count(o.thread_count));
 }
 
 std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_record>& records, const glm::vec3& x,
@@ -646,6 +753,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   cache_options coverage_options = o;
   if (coverage_options.weight == cache_weight::ward_continuous) coverage_options.weight = cache_weight::ward;
   coverage_options.progress = nullptr;
+  coverage_options.second_order = false;  // the Hessians are fitted after placement
   for (;;) {
     // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
     // when a record's weight passes the threshold and, with refine_disagreement, the covering
@@ -699,7 +807,7 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
             if (!ok || k < 0 || std::uint32_t(k) == detail.last) return;
             const cache_record& rb = records[std::size_t(k)];
             if (glm::dot(rb.normal, nx) <= 0.9f || record_is_behind(rb, x, nx)) return;
-            const float lb = luminance(glm::max(extrapolate(rb, x, nx, o.use_gradients), glm::vec3(0.0f)));
+            const float lb = luminance(glm::max(extrapolate(rb, x, nx, o.use_gradients ? 1 : 0), glm::vec3(0.0f)));
             if (std::fabs(lb - la) > tolerance) ok = false;
           });
           // Records added near the point later can change the answer (and the floor moves): re-check.
@@ -842,8 +950,8 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
           if (o.shrink_disagreeing && glm::dot(ri.normal, rj.normal) > 0.9f && d > 0.0f) {
             // Each record's first-order prediction of the other's irradiance (luminance).
             const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
-            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, true));
-            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, true));
+            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
+            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
             const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
             if (err > a) {
               // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
@@ -870,6 +978,8 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
     if (spacing > finest) spacing = std::max(finest, 0.5f * spacing);
     else if (seeds.empty()) break;  // defensive: nothing could be placed
   }
+
+  if (o.second_order && o.use_gradients) fit_hessians(records, o, threads);
 
   // Final interpolation (parallel); points inside geometry or left uncovered are filled from the
   // nearest valid records (weights without the threshold: 1 / (d / R + sqrt(1 - n.n_i))).

@@ -185,7 +185,7 @@ static void test_cache_rules(void) {
   CHECK(o.weight == HEMILIGHT_CACHE_WEIGHT_WARD && o.gradient_radius_limit == 1 && o.neighbour_clamp == 1 &&
         o.shrink_disagreeing == 1 && o.refine_disagreement == 1);
   CHECK(o.second_opinion == 0.25f && o.nearby_opinion == 2.0f && o.sole_record_reach == 0.99f &&
-        o.invalid_backface_fraction == 0.1f && o.extrapolate_wall_depth == 0);
+        o.invalid_backface_fraction == 0.1f && o.extrapolate_wall_depth == 0 && o.second_order == 1);
   o.resolution = 32;
   CHECK(hemilight_scene_create(quad_pos, 4, quad_idx, 2, black, sky, &shadow) == HEMILIGHT_OK);
   CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &with_rules) == HEMILIGHT_OK);
@@ -223,6 +223,19 @@ static void test_cache_rules(void) {
         for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
         CHECK(differs);
       }
+      /* second_order reaches the interpolation: the same hemicubes and records, other values. */
+      {
+        hemilight_cache_stats second_stats, first_stats;
+        hemilight_cache_options_init(&o);
+        o.resolution = 32;
+        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &second_stats) == HEMILIGHT_OK);
+        o.second_order = 0;
+        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &first_stats) == HEMILIGHT_OK);
+        CHECK(second_stats.hemicubes == first_stats.hemicubes && second_stats.records == first_stats.records);
+        differs = 0;
+        for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
+        CHECK(differs);
+      }
       free(out2);
     }
   }
@@ -242,6 +255,9 @@ static void test_cache_rules(void) {
   hemilight_cache_options_init(&o);
   o.extrapolate_wall_depth = 3;
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "extrapolate_wall_depth is 3");
+  hemilight_cache_options_init(&o);
+  o.second_order = 2;
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "second_order is 2");
   hemilight_cache_options_init(&o);
   o.refine_disagreement = -1;
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "refine_disagreement");

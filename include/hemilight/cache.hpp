@@ -6,6 +6,9 @@
 //
 //     E(x, n) = sum_i w_i (E_i + (n_i x n) . g_r,i + (x - x_i) . g_t,i) / sum_i w_i,  clamped >= 0
 //
+// (with second_order, each record's prediction also has 1/2 (x - x_i)^T H_i (x - x_i), H_i fitted
+// after placement from the gradients of the records around it: fit_record_hessians)
+//
 // over the records with w_i > 1/a (Ward: w_i = 1 / (|x - x_i| / R_i + sqrt(1 - n . n_i))) that pass
 // the "behind" test (a record is skipped when x lies behind it: (x - x_i) . (n_i + n) / 2 < -eps).
 // With cache_weight::ward_continuous each such record is weighted w_i - 1/a instead, which falls
@@ -91,6 +94,11 @@ struct cache_record {
   std::array<glm::vec3, 4> sh_l1{};
   /// Irradiance on the HL2 cone (hl2_cone), the sample's cone. Zero unless directional.
   hl2_cone cone;
+  /// Second-order term per channel c (world space, symmetric, acting in the record's tangent
+  /// plane; units: irradiance per scene unit squared): the interpolation adds
+  /// 1/2 (x - x_i)^T hessian[c] (x - x_i) to the first-order prediction when
+  /// cache_options::second_order is on. Zero until fit_record_hessians fills it.
+  std::array<glm::mat3, 3> hessian{};
 };
 
 /// Weighting of records. The values match hemilight_cache_weight of the C ABI (0, 1, 2).
@@ -158,6 +166,15 @@ struct cache_options {
   /// records are unaffected. Dimensionless, in (0, 1]; 1 = off. Default 0.99.
   float sole_record_reach = 0.99f;
   cache_weight weight = cache_weight::ward;
+  /// Second-order interpolation (needs use_gradients): after placement, each record gets a Hessian
+  /// of E over its tangent plane fitted from its neighbours (fit_record_hessians), and the
+  /// interpolation adds 1/2 (x - x_i)^T H_i (x - x_i) to each record's first-order prediction.
+  /// Placement and statistics are unchanged (the same records); only the final values differ.
+  /// First-order predictions all miss a curved E the same way (below it where E is convex), so
+  /// averaging them does not cancel that error. docs/cache.md (session 7): Cornell box N = 512,
+  /// a = 0.5, 1.16% -> 0.85% RMS at the same 10.6% of the points; hexagon ceiling 1.28% -> 0.63%.
+  /// Cost: O(records x neighbours) once, and 3 quadratic forms per record and point.
+  bool second_order = true;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
   /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
   /// sh_l1; the sampler must compute it: make_hemicube_sampler with sh_l1 or
@@ -263,6 +280,24 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 /// *weight_sum if given (0 when no record covers the point: the result is then 0).
 glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& position,
                               const glm::vec3& normal, const cache_options& options, float* weight_sum = nullptr);
+
+/// Fits each record's `hessian` (per channel) from the records around it, as cache_irradiance
+/// does with cache_options::second_order:
+///  - neighbours: records j != i with |x_j - x_i| <= 2 a R_i (a = options.error_threshold) and
+///    n_i . n_j > 0.95;
+///  - the 2 x 2 symmetric Hessian in the record's tangent plane is the least-squares solution of
+///    P (g_t,j - g_t,i) = H P (x_j - x_i) over the neighbours (P: projection on the tangent plane),
+///    with a ridge of 1e-6 of the normal matrix's trace (neighbours on one line leave the direction
+///    across it at 0);
+///  - then it is scaled by s in [0, 1], the least-squares factor by which the quadratic term best
+///    predicts the neighbours' irradiance beyond the first-order prediction, E_j - (E_i +
+///    (n_i x n_j).g_r,i + (x_j - x_i).g_t,i). The values are data the fit did not use: where the
+///    gradients' differences are not a smooth quadratic (a shadow edge, a ceiling line), s goes
+///    to 0 and the record stays first-order.
+/// Records with fewer than 2 neighbours get 0. Deterministic for any thread count
+/// (options.thread_count; 0 = all cores). Throws error(invalid_argument) when error_threshold is not
+/// in (0, 1] or a record's radius is negative or not finite. Cost: O(records x neighbours).
+void fit_record_hessians(std::vector<cache_record>& records, const cache_options& options);
 
 /// Interpolates the records' L1 SH at one point with the weights of interpolate_records (plain
 /// weighted average, no gradients, not clamped); zero when no record covers the point. Brute
