@@ -6,6 +6,8 @@
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 #   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
 #                                     ward_continuous (docs/cache.md, session 6; not run by default)
+#   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
+#                                     both weights (docs/cache.md, session 7; ~25 min; not run by default)
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
 # benchmarks/plot_NAME.py (if any) draws docs/bench/NAME.png from the CSV(s).
@@ -26,9 +28,36 @@ if [ ${#names[@]} -eq 0 ]; then
   done
 fi
 for n in "${names[@]}"; do
+  if [ "$n" = cache_second_order ]; then
+    # cache_options::second_order (the default since session 7) against first order, each with
+    # cache_weight::ward and ward_continuous, on the 128 grid with gradients: docs/cache.md,
+    # session 7. The same records for all four; only the interpolation differs. ~25 min on 2 cores
+    # with the per-point references of cache_weights already in build-bench/cache_truth.
+    echo "== sweep_cache (second-order interpolation)"
+    csv=docs/bench/cache_second_order.csv truth="$build/cache_truth"
+    rm -f "$csv"; mkdir -p "$truth"
+    for w in ward ward_continuous; do
+      for so in no yes; do
+        v=$w; [ "$so" = yes ] && v="$w+second_order"
+        c=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --weight "$w" --second-order "$so"
+           --variant "$v")
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 76 --scenes cornell --n 64,512 \
+          --a 0.2,0.3,0.5,0.6,0.7,1.0
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 28 --scenes hexagon --n 64,512 \
+          --a 0.2,0.3,0.5,0.7,1.0
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 2048 --stride 76 --scenes cornell --n 1024 \
+          --a 0.5,0.58,0.65
+        "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 512 --stride 7 --scenes sky --n 64 \
+          --a 0.1,0.2,0.3,0.5
+      done
+    done
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
   if [ "$n" = cache_weights ]; then
     # cache_weight::ward against ward_continuous (and each with integrate_options::
-    # extrapolate_wall_depth) on the 128 grid, with gradients: docs/cache.md, session 6. The same
+    # extrapolate_wall_depth) on the 128 grid, with gradients: docs/cache.md, session 6 (first
+    # order, as measured then: --second-order no). The same
     # records for both weights; only the interpolation differs. ~15 min on 2 cores here
     # (the per-point references at N = 512 and 1024 dominate; kept in build-bench/cache_truth).
     echo "== sweep_cache (interpolation weights)"
@@ -38,7 +67,7 @@ for n in "${names[@]}"; do
       for x in no yes; do
         v=$w; [ "$x" = yes ] && v="$w+extrapolate"
         c=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --weight "$w"
-           --extrapolate-wall-depth "$x" --variant "$v")
+           --extrapolate-wall-depth "$x" --variant "$v" --second-order no)
         "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 76 --scenes cornell --n 64,256,512 \
           --a 0.2,0.3,0.5,0.55,0.7,1.0
         "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 1024 --stride 28 --scenes hexagon --n 64,256,512 \
@@ -46,11 +75,11 @@ for n in "${names[@]}"; do
         "$build/benchmarks/sweep_cache" "$csv" "${c[@]}" --converged 2048 --stride 76 --scenes cornell --n 1024 \
           --a 0.5,0.55,0.6
       done
-      "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes,no --truth-cache "$truth" --weight "$w" \
+      "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes,no --truth-cache "$truth" --weight "$w" --second-order no \
         --converged 512 --stride 7 --scenes sky --n 64 --a 0.1,0.2,0.3,0.5 --variant "$w"
     done
     # the Cornell 1% target at N = 1024: the two a between the rows that bracket it
-    "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 \
+    "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --second-order no \
       --weight ward_continuous --variant ward_continuous --converged 2048 --stride 76 --scenes cornell --n 1024 --a 0.57,0.58
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
     continue
@@ -59,7 +88,7 @@ for n in "${names[@]}"; do
     echo "== sweep_cache (resolution study)"
     csv=docs/bench/cache_resolution.csv truth="$build/cache_truth" a=0.05,0.1,0.2,0.3,0.5
     rm -f "$csv"; mkdir -p "$truth"
-    common=(--append --grid 64 --a "$a" --truth-cache "$truth" --rolls 4)
+    common=(--append --grid 64 --a "$a" --truth-cache "$truth" --rolls 4 --second-order no)  # first order, as in sessions 4-5
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes hexagon --n 64,128,256,512 \
       --converged 1024 --stride 7 --check 2048 --check-stride 4
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes cornell --n 64,128,256,512 \
@@ -72,7 +101,7 @@ for n in "${names[@]}"; do
     k128=docs/bench/cache_resolution_k128.csv
     rm -f "$k128"
     for so in 0.25 0; do
-      kc=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --converged 1024 --check 2048
+      kc=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --converged 1024 --check 2048 --second-order no
           --second-opinion "$so" --variant "second_opinion=$so")
       "$build/benchmarks/sweep_cache" "$k128" "${kc[@]}" --a 0.1,0.2,0.3,0.5,0.7,1.0 --scenes hexagon --n 256,512 \
         --stride 28 --check-stride 4

@@ -24,6 +24,7 @@
 //     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
 //     --weight W          cache_options::weight: ward, ward_continuous or tabellion_lamorlette
 //                         (default: the option's default)
+//     --second-order yes|no  cache_options::second_order (default: the option's default, yes)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
 //     --record-regions    Cornell box: print where the records are (floor / walls, dark or lit, the
@@ -197,6 +198,7 @@ int main(int argc, char** argv) {
   float sole_reach = cache_options{}.sole_record_reach;
   cache_weight weight = cache_options{}.weight;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
+  bool second_order = cache_options{}.second_order;
   bool record_regions = false;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
@@ -253,6 +255,10 @@ int main(int argc, char** argv) {
       const std::string v = value();
       if (v != "yes" && v != "no") usage(("bad --extrapolate-wall-depth '" + v + "' (yes, no)").c_str());
       extrapolate_wall_depth = v == "yes";
+    } else if (arg == "--second-order") {
+      const std::string v = value();
+      if (v != "yes" && v != "no") usage(("bad --second-order '" + v + "' (yes, no)").c_str());
+      second_order = v == "yes";
     } else if (arg == "--record-regions") {
       record_regions = true;
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
@@ -438,6 +444,7 @@ int main(int argc, char** argv) {
           o.nearby_opinion = nearby_opinion;
           o.sole_record_reach = sole_reach;
           o.weight = weight;
+          o.second_order = second_order;
           o.thread_count = threads;
           const double load = loadavg();
           const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
