@@ -123,6 +123,33 @@ class record_bvh {
       }
   }
 
+  // After radii changed but no record was added or moved: the same tree with new boxes. The
+  // tree's shape depends only on the positions (split() orders centres), so this gives exactly
+  // what build() would, in O(n) instead of O(n log n). Parents precede their children in nodes_,
+  // so one backward pass sees every child before its parent.
+  void refit(const std::vector<cache_record>& records, const cache_options& o) {
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      const float r = coverage_radius(records[i], o);
+      lo_[i] = records[i].position - glm::vec3(r);
+      hi_[i] = records[i].position + glm::vec3(r);
+    }
+    for (std::size_t k = nodes_.size(); k-- > 0;) {
+      node& nd = nodes_[k];
+      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+      if (nd.count > 0) {
+        for (std::uint32_t j = nd.first; j < nd.first + nd.count; ++j) {
+          lo = glm::min(lo, lo_[index_[j]]);
+          hi = glm::max(hi, hi_[index_[j]]);
+        }
+      } else {
+        lo = glm::min(nodes_[nd.first].lo, nodes_[nd.first + 1].lo);
+        hi = glm::max(nodes_[nd.first].hi, nodes_[nd.first + 1].hi);
+      }
+      nd.lo = lo;
+      nd.hi = hi;
+    }
+  }
+
   template <class F>
   void query(const glm::vec3& x, F&& f) const {
     if (nodes_.empty()) return;
@@ -925,7 +952,8 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
 
     // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
     // over pairs (new record, any record) within reach (deterministic).
-    if (records.size() > first_new && (o.neighbour_clamp || o.shrink_disagreeing)) {
+    const bool built = records.size() > first_new && (o.neighbour_clamp || o.shrink_disagreeing);
+    if (built) {
       bvh.build(records, o, threads);
       // Candidates of each new record: records whose coverage box holds x_i (the tree is not
       // rebuilt during the sequential pass below, so these are gathered first, in parallel).
@@ -973,7 +1001,9 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
       // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
       grid_of_points.for_each_in_sphere(records[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
     }
-    bvh.build(records, o, threads);
+    // Only radii changed since the build above (if there was one): refit its boxes.
+    if (built) bvh.refit(records, o);
+    else bvh.build(records, o, threads);
     ++stats.rounds;
     if (spacing > finest) spacing = std::max(finest, 0.5f * spacing);
     else if (seeds.empty()) break;  // defensive: nothing could be placed
