@@ -693,10 +693,16 @@ void fit_record_hessians(std::vector<cache_record>& records, const cache_options
   if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
     throw_invalid_argument("fit_record_hessians: options.error_threshold is " + std::to_string(o.error_threshold) +
                            "; it must be in (0, 1]");
-  for (std::size_t i = 0; i < records.size(); ++i)
-    if (!(records[i].radius >= 0.0f) || !std::isfinite(records[i].radius))
-      throw_invalid_argument("fit_record_hessians: record " + std::to_string(i) + " has radius " +
-                             std::to_string(records[i].radius) + "; it must be finite and >= 0");
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const cache_record& r = records[i];
+    const std::string which = "fit_record_hessians: record " + std::to_string(i);
+    if (!(r.radius >= 0.0f) || !std::isfinite(r.radius))
+      throw_invalid_argument(which + " has radius " + std::to_string(r.radius) + "; it must be finite and >= 0");
+    if (!std::isfinite(r.position.x) || !std::isfinite(r.position.y) || !std::isfinite(r.position.z))
+      throw_invalid_argument(which + " has position " + vec_str(r.position) + "; it must be finite");
+    if (!(std::fabs(glm::length(r.normal) - 1.0f) <= 1e-3f))
+      throw_invalid_argument(which + " has normal " + vec_str(r.normal) + "; it must have length 1 (within 1e-3)");
+  }
   fit_hessians(records, o, resolve_thread_count(o.thread_count));
 }
 

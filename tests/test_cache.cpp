@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 using namespace hemilight;
 using namespace hemilight::test;
@@ -275,6 +276,12 @@ TEST_CASE("cache: the second-order term is clamped to +-a E_i", "[cache]") {
   std::vector<cache_record> bad = {lit};
   bad[0].radius = std::nanf("");
   CHECK_THROWS_WITH(fit_record_hessians(bad, o), Catch::Contains("record 0 has radius"));
+  bad = {lit, lit};
+  bad[1].position.y = std::numeric_limits<float>::infinity();
+  CHECK_THROWS_WITH(fit_record_hessians(bad, o), Catch::Contains("record 1 has position"));
+  bad = {lit, lit};
+  bad[1].normal = glm::vec3(0.0f);
+  CHECK_THROWS_WITH(fit_record_hessians(bad, o), Catch::Contains("record 1 has normal"));
   o.error_threshold = 0.0f;
   CHECK_THROWS_WITH(fit_record_hessians(bad, o), Catch::Contains("error_threshold"));
 }

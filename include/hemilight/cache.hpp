@@ -298,8 +298,11 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
 ///    gradients' differences are not a smooth quadratic (a shadow edge, a ceiling line), s goes
 ///    to 0 and the record stays first-order.
 /// Records with fewer than 2 neighbours get 0. Deterministic for any thread count
-/// (options.thread_count; 0 = all cores). Throws error(invalid_argument) when error_threshold is not
-/// in (0, 1] or a record's radius is negative or not finite. Cost: O(records x neighbours).
+/// (options.thread_count; 0 = all cores). Throws error(invalid_argument), naming the first bad
+/// record, when error_threshold is not in (0, 1], a record's radius is negative or not finite, its
+/// position is not finite or its normal's length is not 1 within 1e-3; records are then unchanged.
+/// Irradiance and gradients are not checked: NaN in them gives that record a zero Hessian.
+/// Cost: O(records x neighbours).
 void fit_record_hessians(std::vector<cache_record>& records, const cache_options& options);
 
 /// Interpolates the records' L1 SH at one point with the weights of interpolate_records (plain
