@@ -167,6 +167,21 @@ static void test_cache(void) {
  * defaults, that they reach the cache (switching the refinement rules off renders fewer hemicubes
  * under a shadow-casting quad: those rules only ever keep points open), the Tabellion-Lamorlette
  * weight under a uniform sky (pi L exactly, as with Ward's), and a named error for each bad value. */
+/* Options a and b place the same records (the same hemicube and record counts) and give other
+ * values: what b changes reaches the interpolation only. out and out2 hold 3 * count floats. */
+static void check_interpolation_only(const hemilight_scene* scene, const float* pos, const float* nrm, size_t count,
+                                     const hemilight_cache_options* a, const hemilight_cache_options* b, float* out,
+                                     float* out2) {
+  hemilight_cache_stats sa, sb;
+  size_t i;
+  int differs = 0;
+  CHECK(hemilight_cache_irradiance(scene, pos, nrm, count, a, out, &sa) == HEMILIGHT_OK);
+  CHECK(hemilight_cache_irradiance(scene, pos, nrm, count, b, out2, &sb) == HEMILIGHT_OK);
+  CHECK(sa.hemicubes == sb.hemicubes && sa.records == sb.records);
+  for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
+  CHECK(differs);
+}
+
 static void test_cache_rules(void) {
   const float sky[3] = {1.0f, 1.0f, 1.0f};
   /* An occluder 0.9 x 0.9 at height 0.3 over the middle of the points, facing down (black). */
@@ -209,32 +224,18 @@ static void test_cache_rules(void) {
       CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &extrapolated) == HEMILIGHT_OK);
       for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
       CHECK(differs);
-      /* HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS reaches the interpolation: the same hemicubes as
-       * WARD (its placement is Ward's), other values. */
+      /* HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS (its placement is Ward's) and second_order (fitted
+       * after placement) reach the interpolation only. */
       {
-        hemilight_cache_stats ward_stats, continuous_stats;
-        hemilight_cache_options_init(&o);
-        o.resolution = 32;
-        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &ward_stats) == HEMILIGHT_OK);
-        o.weight = HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS;
-        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &continuous_stats) == HEMILIGHT_OK);
-        CHECK(ward_stats.hemicubes == continuous_stats.hemicubes && ward_stats.records == continuous_stats.records);
-        differs = 0;
-        for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
-        CHECK(differs);
-      }
-      /* second_order reaches the interpolation: the same hemicubes and records, other values. */
-      {
-        hemilight_cache_stats second_stats, first_stats;
-        hemilight_cache_options_init(&o);
-        o.resolution = 32;
-        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &second_stats) == HEMILIGHT_OK);
-        o.second_order = 0;
-        CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &first_stats) == HEMILIGHT_OK);
-        CHECK(second_stats.hemicubes == first_stats.hemicubes && second_stats.records == first_stats.records);
-        differs = 0;
-        for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
-        CHECK(differs);
+        hemilight_cache_options base, other;
+        hemilight_cache_options_init(&base);
+        base.resolution = 32;
+        other = base;
+        other.weight = HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS;
+        check_interpolation_only(shadow, pos, nrm, count, &base, &other, out, out2);
+        other = base;
+        other.second_order = 0;
+        check_interpolation_only(shadow, pos, nrm, count, &base, &other, out, out2);
       }
       free(out2);
     }
