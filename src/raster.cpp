@@ -311,11 +311,11 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 #endif
 
 // The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
-// the shade (ids[k] indexes shades) copied to the radiance planes and flags.
-inline void copy_shades(const std::uint32_t* ids, std::size_t count, const hemicube_rasterizer::shade* shades,
+// the shade (keys[k] indexes shades) copied to the radiance planes and flags.
+inline void copy_shades(const std::uint32_t* keys, std::size_t count, const hemicube_rasterizer::shade* shades,
                         float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
   for (std::size_t k = 0; k < count; ++k) {
-    const hemicube_rasterizer::shade& sh = shades[ids[k]];
+    const hemicube_rasterizer::shade& sh = shades[keys[k]];
     red[k] = sh.r;
     green[k] = sh.g;
     blue[k] = sh.b;
@@ -480,8 +480,8 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
 }
 
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
-// texels are left to the caller. Runs are found by shade key (keys[id]: the first record with
-// the same shade), so the two triangles of a quad, or all black surfaces, make one run.
+// texels are left to the caller. Runs are found by shade key (keys[id]: the draw's entry in
+// shades), so the two triangles of a quad, or all black surfaces, make one run.
 HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
                                                const hemicube_rasterizer::shade* __restrict shades,
@@ -543,7 +543,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
           }
           // More shades: texel by texel.
           alignas(32) std::uint32_t lane[8];
-          _mm256_store_si256(reinterpret_cast<__m256i*>(lane), id);
+          _mm256_store_si256(reinterpret_cast<__m256i*>(lane), key);
           copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
           continue;
         }
@@ -567,10 +567,11 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
 
 // The resolve loops, with restrict pointers so that the byte stores of the flags do not force
 // reloads (char stores may alias anything). Texels never written have depth 0 (their id is
-// stale): they are set to record 0, the sky. The radiance is planar (hemicube_buffer).
+// stale): they are set to draw 0, the sky. keys[id]: the draw's entry in shades. The radiance is
+// planar (hemicube_buffer).
 void resolve_texels(std::size_t count, float* __restrict depth, const float* __restrict lengths,
                     std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
-                    float* __restrict distance, float* __restrict red, float* __restrict green,
+                    const std::uint32_t* __restrict keys, float* __restrict distance, float* __restrict red, float* __restrict green,
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
 #if HEMILIGHT_RASTER_SSE2
@@ -595,7 +596,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
         const __m128i first = _mm_shuffle_epi32(id, 0);
         if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
           run_id = first;
-          const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm_cvtsi128_si32(id))];
+          const hemicube_rasterizer::shade& sh = shades[keys[static_cast<std::uint32_t>(_mm_cvtsi128_si32(id))]];
           run_r = _mm_set1_ps(sh.r);
           run_g = _mm_set1_ps(sh.g);
           run_b = _mm_set1_ps(sh.b);
@@ -614,6 +615,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
       }
       std::uint32_t lane[4];
       _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
+      for (std::uint32_t& k : lane) k = keys[k];
       copy_shades(lane, 4, shades, red + i, green + i, blue + i, flags + i);
     }
   }
@@ -623,7 +625,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
     distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
     ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
     depth[i] = 0.0f;                         // cleared for the next render
-    copy_shades(ids + i, 1, shades, red + i, green + i, blue + i, flags + i);
+    copy_shades(keys + ids[i], 1, shades, red + i, green + i, blue + i, flags + i);
   }
 }
 
@@ -689,6 +691,11 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
       throw_invalid_argument("hemicube_rasterizer: the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
     sky_ = options.sky;
   }
+  const glm::vec3 sky = scene_->sky_radiance();
+  shades_.reserve(2 + scene_->emissions().size());
+  shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
+  shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
+  for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -742,20 +749,17 @@ void hemicube_rasterizer::prepare(int resolution) {
   }
   depth_clear_ = false;  // drawing is about to write it
   ids_.resize(count + 8);  // stale ids are masked by depth 0 (never written)
-  // Record 0 stands for "nothing hit" (the sky): texels start there.
-  draws_.clear();
-  draws_.push_back(draw_record{});
+  // Draw 0 stands for "nothing hit" (the sky): texels start there.
+  draw_keys_.assign(1, 0u);
+  draw_triangles_.assign(1, no_triangle);
+  draws_.assign(1, draw_record{});
   draws_.front().index = no_triangle;
-  shades_.clear();
-  shades_.push_back({0.0f, 0.0f, 0.0f, texel_miss});
-  shade_keys_.assign(1, 0u);
-  std::fill(std::begin(shade_cache_), std::end(shade_cache_), 0u);
   stats_ = {};
 }
 
 std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < hemicube_texel_count(n_));
-  return draws_[ids_[texel]].index;  // the resolve set unwritten texels to record 0
+  return draw_triangles_[ids_[texel]];  // the resolve set unwritten texels to draw 0
 }
 
 unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
@@ -834,12 +838,16 @@ struct hemicube_rasterizer::face_setup {
 };
 
 #if HEMILIGHT_RASTER_AVX2
-// The position and the frame's axes, broadcast once per render for draw_leaf_avx2.
+// The position and the frame's axes, broadcast once per render for draw_leaf_avx2, and the
+// scene's per-coordinate vertex arrays.
 struct hemicube_rasterizer::simd_frame {
   __m256 p[3];              // each component of the position in all eight lanes
   __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
+  const float* coordinates[3][3];  // scene::vertex_coordinates(vertex, axis)
 
-  HEMILIGHT_TARGET_AVX2 void set(const glm::vec3& position, const frame& basis) noexcept {
+  HEMILIGHT_TARGET_AVX2 void set(const glm::vec3& position, const frame& basis, const scene& s) noexcept {
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) coordinates[i][k] = s.vertex_coordinates(i, k);
     for (int k = 0; k < 3; ++k) {
       p[k] = _mm256_set1_ps(position[k]);
       t[k] = _mm256_set1_ps(basis.t[k]);
@@ -866,13 +874,13 @@ HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
 #endif
 
 template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture) {
+void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
   if (nodes.empty()) return;
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
   simd_frame sf;
-  if (avx2_) sf.set(position, basis);
+  if (avx2_) sf.set(position, basis, *scene_);
 #endif
   // Stack entries: node index (low 27 bits are plenty: 2^31 triangles need < 2^29 nodes, so the
   // face mask travels in a second word).
@@ -899,17 +907,17 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
 #if HEMILIGHT_RASTER_AVX2
     if (avx2_) {
       for (std::uint32_t k = 0; k < node.count; k += 8)
-        draw_leaf_avx2<M>(tris.data() + node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis, texture);
+        draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
       continue;
     }
 #endif
-    for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis, texture);
+    for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
   }
 }
 
 template <hemicube_rasterizer::mode M>
 void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
-                                        const frame& basis, const radiance_texture* texture) {
+                                        const frame& basis) {
   ++stats_.triangles_tested;
   const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
                               basis.to_local(tri.v2 - position)};
@@ -934,7 +942,7 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
   for (int f = 0; f < 5; ++f)
     if (faces >> f & 1u) {
       ++stats_.face_triangles;
-      raster_face<M>(f, local, rec, draw, basis, tri, texture);
+      raster_face<M>(f, local, rec, draw, basis, tri);
     }
 }
 
@@ -946,19 +954,19 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
 // the face stage below, face by face, in leaf order within each face (the scalar path's order
 // for every texel).
 template <hemicube_rasterizer::mode M>
-HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count,
+HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::triangle* all, std::uint32_t first,
+                                                               std::uint32_t count,
                                                                unsigned face_mask, const simd_frame& sf,
-                                                               const frame& basis, const radiance_texture* texture) {
-  static_assert(sizeof(scene::triangle) == 10 * sizeof(float), "v0, v1, v2 and the index: ten 4-byte words");
+                                                               const frame& basis) {
   stats_.triangles_tested += count;
+  const scene::triangle* tris = all + first;
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), lane);
-  // Word offsets of each lane's triangle (lanes past the end repeat triangle 0).
-  const __m256i word = _mm256_mullo_epi32(_mm256_and_si256(lane, live), _mm256_set1_epi32(10));
-  const float* words = &tris->v0.x;
+  // Eight consecutive triangles from the per-coordinate arrays (lanes past `count` load the next
+  // triangles or the arrays' padding; `live` masks them out below).
   __m256 v[3][3];  // v[vertex][axis], world
   for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < 3; ++k) v[i][k] = _mm256_i32gather_ps(words, _mm256_add_epi32(word, _mm256_set1_epi32(3 * i + k)), 4);
+    for (int k = 0; k < 3; ++k) v[i][k] = _mm256_loadu_ps(sf.coordinates[i][k] + first);
   // World edges and their cross product (glm::cross's operations: x.y y.z - y.y x.z, ...).
   __m256 e1[3], e2[3];
   for (int k = 0; k < 3; ++k) {
@@ -1044,15 +1052,17 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
   }
   alignas(32) float plane_of[8];
   _mm256_store_ps(plane_of, plane);
+  // A lane's record, filled where it is needed (clipped and big lanes, textured renders): the
+  // small triangles of an untextured render need only the plane.
   draw_record rec[8];
   std::uint32_t draw[8] = {};
-  for (unsigned m = any; m; m &= m - 1) {
-    const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
+  const auto record = [&](unsigned j) -> draw_record& {
     rec[j].normal = glm::vec3(axis[0][j][3], axis[1][j][3], axis[2][j][3]);
     rec[j].v0 = glm::vec3(axis[0][j][0], axis[1][j][0], axis[2][j][0]);
     rec[j].plane = plane_of[j];
     rec[j].index = tris[j].index;
-  }
+    return rec[j];
+  };
 
   // Face by face, all lanes at once (faces cover different texels, so only the order within a
   // face matters, and within a face the lanes are drawn in leaf order, as the scalar path does).
@@ -1198,19 +1208,20 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
       const unsigned bit = 1u << j;
       const scene::triangle& tri = tris[j];
       if (clipped & bit) {
-        const glm::vec3 local[3] = {rec[j].v0, glm::vec3(axis[0][j][1], axis[1][j][1], axis[2][j][1]),
+        draw_record& r = record(j);
+        const glm::vec3 local[3] = {r.v0, glm::vec3(axis[0][j][1], axis[1][j][1], axis[2][j][1]),
                                     glm::vec3(axis[0][j][2], axis[1][j][2], axis[2][j][2])};
-        raster_face<M>(f, local, rec[j], draw[j], basis, tri, texture);
+        raster_face<M>(f, local, r, draw[j], basis, tri);
         continue;
       }
       if (big & bit) {
         face_setup fs;
         const std::int64_t bx[3] = {vx[0][j], vx[1][j], vx[2][j]}, by[3] = {vy[0][j], vy[1][j], vy[2][j]};
-        draw_fixed<M>(f, bx, by, fs, rec[j], draw[j], basis, tri, texture);
+        draw_fixed<M>(f, bx, by, fs, record(j), draw[j], basis, tri);
         continue;
       }
       if ((empty | flat) & bit) continue;
-      if (draw[j] == 0) draw[j] = commit_record(rec[j], basis, tri, texture);
+      if (draw[j] == 0) draw[j] = commit_record(plane_of[j], tri, textured_ ? &record(j) : nullptr, basis);
       small_triangle_avx2_body<M == mode::count>(&base[0][j], &sx[0][j], &sy[0][j], 8, xb[j], xe[j], yb[j], ye[j], n,
                                                  depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j]);
     }
@@ -1223,56 +1234,32 @@ HEMILIGHT_TARGET_AVX2 void hemicube_rasterizer::draw_leaf_avx2(const scene::tria
 // were a fifth of its cost.
 __attribute__((always_inline))
 #endif
-inline std::uint32_t hemicube_rasterizer::commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
-                                                        const radiance_texture* texture) {
-  const material& m = scene_->triangle_material(tri.index);
-  const bool back = rec.plane > 0.0f && !m.two_sided;
-  const auto draw = static_cast<std::uint32_t>(draws_.size());
-  // The geometry is copied and the shading written in place (and the shade field by field):
-  // building a record or a shade with narrow stores and copying it whole stalls on store
-  // forwarding, which cost more than the rest of this function.
-  draws_.push_back(rec);
-  draw_record& d = draws_.back();
-  const glm::vec3 radiance = back ? glm::vec3(0.0f) : m.emission;
-  const std::uint8_t flags = back ? texel_back_face : texel_hit_front;
-  d.flags = flags;
-  d.radiance = radiance;
-  d.textured = !back && texture && scene_->has_lightmap_uvs();
-  if (d.textured) {
-    const glm::vec3 le1 = basis.to_local(tri.v1 - tri.v0), le2 = basis.to_local(tri.v2 - tri.v0);
-    const float nn = glm::dot(rec.normal, rec.normal);
-    d.grad_b1 = glm::cross(le2, rec.normal) / nn;
-    d.grad_b2 = glm::cross(rec.normal, le1) / nn;
-  }
-  shades_.emplace_back();
-  shade& sh = shades_.back();
-  sh.r = radiance.x;
-  sh.g = radiance.y;
-  sh.b = radiance.z;
-  sh.flags = flags;
-  // Shade key: an earlier record with the same bits, if the cache remembers one.
-  const auto bits = [](float v) {
-    std::uint32_t u;
-    std::memcpy(&u, &v, sizeof u);
-    return u;
-  };
-  const std::uint32_t r = bits(radiance.x), g = bits(radiance.y), b = bits(radiance.z);
-  const std::uint32_t h = (r * 0x9e3779b1u) ^ (g * 0x85ebca77u) ^ (b * 0xc2b2ae3du) ^ flags;
-  std::uint32_t& slot = shade_cache_[(h >> 26) & 63u];
-  const shade& old = shades_[slot];  // slot 0 (the sky) never matches: it is never stored below
-  if (slot != 0 && bits(old.r) == r && bits(old.g) == g && bits(old.b) == b && old.flags == flags) {
-    shade_keys_.push_back(slot);
-  } else {
-    slot = draw;
-    shade_keys_.push_back(draw);
+// A new draw for `tri` (its plane: `plane`; `rec`: its record, needed in a textured render only).
+// The shade is the scene's emission index, or the back-face entry: no radiance is copied or
+// compared per draw.
+inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene::triangle& tri,
+                                                        const draw_record* rec, const frame& basis) {
+  const bool back = plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
+  const auto draw = static_cast<std::uint32_t>(draw_keys_.size());
+  draw_keys_.push_back(back ? 1u : 2u + scene_->emission_index(tri.index));
+  draw_triangles_.push_back(tri.index);
+  if (textured_) {
+    draws_.push_back(*rec);
+    draw_record& d = draws_.back();
+    d.textured = !back;
+    if (d.textured) {
+      const glm::vec3 le1 = basis.to_local(tri.v1 - tri.v0), le2 = basis.to_local(tri.v2 - tri.v0);
+      const float nn = glm::dot(rec->normal, rec->normal);
+      d.grad_b1 = glm::cross(le2, rec->normal) / nn;
+      d.grad_b2 = glm::cross(rec->normal, le1) / nn;
+    }
   }
   return draw;
 }
 
 template <hemicube_rasterizer::mode M>
 void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
-                                      const frame& basis, const scene::triangle& tri,
-                                      const radiance_texture* texture) {
+                                      const frame& basis, const scene::triangle& tri) {
   const int n = n_;
   const float near = near_;
 
@@ -1329,14 +1316,14 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
   // Fan of the clipped polygon.
   for (int i = 1; i + 1 < count; ++i) {
     const std::int64_t x[3] = {fx[0].x, fx[i].x, fx[i + 1].x}, y[3] = {fx[0].y, fx[i].y, fx[i + 1].y};
-    draw_fixed<M>(face, x, y, fs, rec, draw, basis, tri, texture);
+    draw_fixed<M>(face, x, y, fs, rec, draw, basis, tri);
   }
 }
 
 template <hemicube_rasterizer::mode M>
 void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
                                      face_setup& fs, draw_record& rec, std::uint32_t& draw, const frame& basis,
-                                     const scene::triangle& tri, const radiance_texture* texture) {
+                                     const scene::triangle& tri) {
   const int n = n_;
   const int rows = face == 0 ? n : n / 2;
   fixed_point p[3] = {{px[0], py[0]}, {px[1], py[1]}, {px[2], py[2]}};
@@ -1351,7 +1338,7 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
   const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
   if (x_begin > x_end || y_begin > y_end) return;
-  if (draw == 0) draw = commit_record(rec, basis, tri, texture);
+  if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
 
   fs.prepare(face, texel_step_, first_centre_, rec);
   const double z00 = fs.z00, dzdy = fs.dzdy;
@@ -1579,9 +1566,8 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   check_arguments(who, position, basis, resolution);
   if (texture) texture->validate(who);
   prepare(resolution);
-  const glm::vec3 sky = scene_->sky_radiance();
-  shades_.front() = {sky.x, sky.y, sky.z, texel_miss};
-  draw_all<mode::depth>(position, basis, texture);
+  textured_ = texture && scene_->has_lightmap_uvs();
+  draw_all<mode::depth>(position, basis);
 
   // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
   // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
@@ -1594,6 +1580,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   const float* lengths = lengths_.data();
   std::uint32_t* ids = ids_.data();
   const shade* shades = shades_.data();
+  const std::uint32_t* keys = draw_keys_.data();
   float* distance = out.distance.data();
   float* red = out.channel(0);
   float* green = out.channel(1);
@@ -1601,13 +1588,13 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   std::uint8_t* flags = out.flags.data();
 #if HEMILIGHT_RASTER_AVX2
   if (avx2_) {
-    resolve_texels_avx2(count, depth, lengths, ids, shades, shade_keys_.data(), distance, red, green, blue, flags);
+    resolve_texels_avx2(count, depth, lengths, ids, shades, keys, distance, red, green, blue, flags);
     const std::size_t done = count - count % 8, rest = count - done;
-    resolve_texels(rest, depth + done, lengths + done, ids + done, shades, distance + done, red + done,
+    resolve_texels(rest, depth + done, lengths + done, ids + done, shades, keys, distance + done, red + done,
                    green + done, blue + done, flags + done, false);
   } else
 #endif
-    resolve_texels(count, depth, lengths, ids, shades, distance, red, green, blue, flags, simd_);
+    resolve_texels(count, depth, lengths, ids, shades, keys, distance, red, green, blue, flags, simd_);
   depth_clear_ = true;  // every path of the resolve zeroed the depths it read (the padding stays 0)
   if (sky_) {
     // Misses see the environment along the texel's world direction.
@@ -1619,7 +1606,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
       blue[i] = l.z;
     }
   }
-  if (!texture || !scene_->has_lightmap_uvs()) return;
+  if (!textured_) return;
   // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
   const std::vector<std::uint32_t>& indices = scene_->indices();
@@ -1645,7 +1632,8 @@ void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame
   // Padded while drawing like the visibility buffers (the AVX2 kernel stores back past the end).
   counts.assign(hemicube_texel_count(resolution) + 8, 0u);
   counts_ = &counts;
-  draw_all<mode::count>(position, basis, nullptr);
+  textured_ = false;
+  draw_all<mode::count>(position, basis);
   counts_ = nullptr;
   counts.resize(hemicube_texel_count(resolution));
   std::fill(ids_.begin(), ids_.end(), 0u);  // seen_triangle() after this: no_triangle everywhere

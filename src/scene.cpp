@@ -1,9 +1,12 @@
 #include "hemilight/scene.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 namespace hemilight {
 
@@ -135,6 +138,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
   } else {
     s->materials_.assign(desc.triangle_count, material{});
   }
+  s->index_emissions();
 
   s->triangles_.reserve(desc.triangle_count);
   for (std::size_t i = 0; i < desc.triangle_count; ++i) {
@@ -150,8 +154,35 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
   return s;
 }
 
+void scene::index_emissions() {
+  // Keyed by the bits: -0 and +0 (both valid emissions) stay apart, so every texel gets exactly
+  // its material's value. Neighbouring triangles mostly share a material: checked first.
+  struct bits_hash {
+    std::size_t operator()(const std::array<std::uint32_t, 3>& k) const noexcept {
+      return (k[0] * 0x9e3779b1u) ^ (k[1] * 0x85ebca77u) ^ (k[2] * 0xc2b2ae3du);
+    }
+  };
+  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, bits_hash> index;
+  emissions_.clear();
+  emission_index_.resize(materials_.size());
+  std::array<std::uint32_t, 3> last{};
+  std::uint32_t last_index = 0;
+  for (std::size_t i = 0; i < materials_.size(); ++i) {
+    std::array<std::uint32_t, 3> key;
+    std::memcpy(key.data(), &materials_[i].emission, sizeof key);
+    if (i == 0 || key != last) {
+      const auto found = index.emplace(key, static_cast<std::uint32_t>(emissions_.size()));
+      if (found.second) emissions_.push_back(materials_[i].emission);
+      last = key;
+      last_index = found.first->second;
+    }
+    emission_index_[i] = last_index;
+  }
+}
+
 void scene::build_bvh() {
   nodes_.clear();
+  coordinates_.assign(9 * 8, 0.0f);  // vertex_coordinates() of an empty scene: the padding only
   if (triangles_.empty()) return;
   const std::size_t count = triangles_.size();
   std::vector<glm::vec3> centroid(count), tlo(count), thi(count);
@@ -213,6 +244,13 @@ void scene::build_bvh() {
   std::vector<triangle> sorted(count);
   for (std::size_t i = 0; i < count; ++i) sorted[i] = triangles_[order[i]];
   triangles_.swap(sorted);
+  // The same coordinates, one array each (vertex_coordinates()), zero-padded by 8.
+  const std::size_t stride = count + 8;
+  coordinates_.assign(9 * stride, 0.0f);
+  for (std::size_t i = 0; i < count; ++i) {
+    const glm::vec3* v[3] = {&triangles_[i].v0, &triangles_[i].v1, &triangles_[i].v2};
+    for (int k = 0; k < 9; ++k) coordinates_[static_cast<std::size_t>(k) * stride + i] = (*v[k / 3])[k % 3];
+  }
 }
 
 }  // namespace hemilight

@@ -6,7 +6,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <tuple>
@@ -221,5 +223,49 @@ TEST_CASE("reference scenes: rooms face inwards, boxes outwards, ground up", "[s
     box.add_box({-1, -2, -3}, {1, 2, 3}, material{}, true);
     CHECK(open_edges(box) == 0);
     for (std::size_t i = 0; i < box.triangle_count(); ++i) CHECK(glm::dot(normal_of(box, i), -centroid_of(box, i)) > 0);
+  }
+}
+
+TEST_CASE("scene: emissions() holds each distinct emission once, bit for bit, and emission_index() points to it", "[scene]") {
+  // Materials chosen here: a repeated emission, +0 and -0 (both valid, different bits), and an
+  // emission that differs from another in the last bit of one channel.
+  const float next = std::nextafter(1.0f, 2.0f);
+  const std::vector<glm::vec3> emission = {{1, 2, 3}, {0, 0, 0}, {1, 2, 3}, {-0.0f, 0, 0}, {1, 2, next}, {0, 0, 0}};
+  scene_mesh m;
+  for (std::size_t i = 0; i < emission.size(); ++i) {
+    const float x = static_cast<float>(i);
+    m.add_triangle({x, 0, 0}, {x + 1, 0, 0}, {x, 1, 0}, material{emission[i], glm::vec3(0.5f), false});
+  }
+  m.add_triangle({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, material{{7, 7, 7}, glm::vec3(0.0f), false});  // zero area: still indexed
+  const auto s = scene::create(m.desc());
+  const auto bits = [](const glm::vec3& v) {
+    std::array<std::uint32_t, 3> b;
+    std::memcpy(b.data(), &v, sizeof b);
+    return b;
+  };
+  REQUIRE(s->emissions().size() == 5);  // (1,2,3), (0,0,0), (-0,0,0), (1,2,next), (7,7,7)
+  for (std::size_t i = 0; i < s->triangle_count(); ++i) {
+    REQUIRE(s->emission_index(i) < s->emissions().size());
+    CHECK(bits(s->emissions()[s->emission_index(i)]) == bits(s->triangle_material(i).emission));
+  }
+  CHECK(s->emission_index(0) == s->emission_index(2));
+  CHECK(s->emission_index(1) == s->emission_index(5));
+  CHECK(s->emission_index(1) != s->emission_index(3));
+  CHECK(s->emission_index(0) != s->emission_index(4));
+}
+
+TEST_CASE("scene: vertex_coordinates() repeats triangles() per coordinate, padded by eight zeros", "[scene]") {
+  for (const scene_mesh& m : {heightfield(500), cornell_box(), scene_mesh{}}) {
+    const auto s = scene::create(m.desc());
+    const auto& tris = s->triangles();
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) {
+        const float* c = s->vertex_coordinates(v, a);
+        for (std::size_t t = 0; t < tris.size(); ++t) {
+          const glm::vec3& p = v == 0 ? tris[t].v0 : (v == 1 ? tris[t].v1 : tris[t].v2);
+          REQUIRE(std::memcmp(&c[t], &p[a], sizeof(float)) == 0);
+        }
+        for (std::size_t t = tris.size(); t < tris.size() + 8; ++t) CHECK(c[t] == 0.0f);
+      }
   }
 }

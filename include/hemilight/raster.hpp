@@ -143,7 +143,8 @@ struct raster_statistics {
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
-/// direction tables, plus ~100 bytes per triangle drawn; kept between renders and grown on demand.
+/// direction tables, plus 8 bytes per triangle drawn (~70 with a texture) and 16 bytes per distinct
+/// emission of the scene; kept between renders and grown on demand.
 /// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
 /// must not share a line, or the counters one writes slow down the members the other reads.
 class alignas(64) hemicube_rasterizer {
@@ -188,7 +189,8 @@ class alignas(64) hemicube_rasterizer {
   const std::shared_ptr<const scene>& scene_ptr() const noexcept { return scene_; }
 
   /// A triangle drawn in the current hemicube, in the local frame (internal, exposed for the
-  /// implementation's helpers).
+  /// implementation's helpers). The clipping and big-triangle paths use its geometry; a textured
+  /// render keeps one per draw for the UV pass.
   struct draw_record {
     glm::vec3 normal;      ///< (v1 - v0) x (v2 - v0), local frame
     float plane;           ///< normal . v0 (local; the point is the origin); < 0 for a front face
@@ -196,11 +198,10 @@ class alignas(64) hemicube_rasterizer {
     std::uint32_t index;   ///< scene triangle (scene_desc numbering)
     glm::vec3 grad_b1;     ///< barycentric b1 = grad_b1 . (q - v0)  (only with a texture)
     glm::vec3 grad_b2;     ///< barycentric b2 = grad_b2 . (q - v0)
-    glm::vec3 radiance;    ///< emission (front face), or 0 for a back face
-    std::uint8_t flags;    ///< texel_flags of the texels it wins
     bool textured;         ///< UVs + texture: radiance comes from the texture
   };
-  /// What the resolve pass copies to the texels a draw record wins (internal).
+  /// What the resolve pass copies to the texels of a draw (internal): the sky, a back face, or
+  /// the front of a triangle with one of the scene's emissions.
   struct shade {
     float r, g, b;
     std::uint32_t flags;
@@ -213,24 +214,21 @@ class alignas(64) hemicube_rasterizer {
   unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
                                             const frame& basis) const;
   template <mode M>
-  void draw_all(const glm::vec3& position, const frame& basis, const radiance_texture* texture);
+  void draw_all(const glm::vec3& position, const frame& basis);
   template <mode M>
-  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis,
-                     const radiance_texture* texture);
+  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis);
   template <mode M>
   void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
-                   const scene::triangle& tri, const radiance_texture* texture);
-  std::uint32_t commit_record(draw_record& rec, const frame& basis, const scene::triangle& tri,
-                              const radiance_texture* texture);
+                   const scene::triangle& tri);
+  std::uint32_t commit_record(float plane, const scene::triangle& tri, const draw_record* rec, const frame& basis);
   struct face_setup;  // per (triangle, face) pair: the depth plane (raster.cpp)
   template <mode M>
   void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
-                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
-                  const radiance_texture* texture);
+                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri);
   struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
   template <mode M>
-  void draw_leaf_avx2(const scene::triangle* tris, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
-                      const frame& basis, const radiance_texture* texture);
+  void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
+                      const frame& basis);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
@@ -245,12 +243,15 @@ class alignas(64) hemicube_rasterizer {
   std::vector<std::uint32_t>* counts_ = nullptr;
   std::vector<glm::vec3> directions_;  // unit texel-centre directions, local frame
   std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
-  std::vector<draw_record> draws_;     // [0] = nothing hit
-  std::vector<shade> shades_;          // radiance + flags of each draw record, compact for the resolve
-  // Per draw record, the first record drawn with the same shade (bitwise), found through a small
-  // direct-mapped cache: the AVX2 resolve finds runs of equal shades across triangle edges.
-  std::vector<std::uint32_t> shade_keys_;
-  std::uint32_t shade_cache_[64] = {};
+  // Draws: a triangle's first covered texel of a render gives it a draw number, which the texels
+  // it wins hold in ids_ (0 = nothing hit).
+  std::vector<std::uint32_t> draw_keys_;       // per draw: its entry in shades_
+  std::vector<std::uint32_t> draw_triangles_;  // per draw: the scene triangle (seen_triangle)
+  std::vector<draw_record> draws_;             // per draw, textured renders only: the UV pass's data
+  bool textured_ = false;                      // this render samples a texture (draws_ is kept)
+  // [0] the sky, [1] a back face, [2 + e] the front of a triangle with scene emission e: built
+  // once, so a draw needs no radiance of its own and equal radiances share one key.
+  std::vector<shade> shades_;
   std::vector<std::uint32_t> stack_;
   raster_statistics stats_;
 };

@@ -112,7 +112,7 @@ class scene {
   ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
   /// Zero-area triangles (repeated indices, collinear or coincident positions) are accepted and
   /// never drawn. Cost: O(T log^2 T) for T triangles (1M triangles: about a second on one core);
-  /// memory about 100 bytes per triangle.
+  /// memory about 140 bytes per triangle.
   static std::shared_ptr<const scene> create(const scene_desc& desc);
 
   std::size_t vertex_count() const noexcept { return positions_.size(); }
@@ -125,6 +125,12 @@ class scene {
   const std::vector<std::uint32_t>& indices() const noexcept { return indices_; }
   /// Material of triangle i (scene_desc numbering). Precondition: i < triangle_count().
   const material& triangle_material(std::size_t i) const noexcept { return materials_[i]; }
+  /// The distinct emissions of the scene's materials (compared bit for bit), in order of first
+  /// appearance; emission_index(i) is triangle i's entry (scene_desc numbering; precondition:
+  /// i < triangle_count()). The rasterizer labels what each texel sees with this small number
+  /// instead of comparing radiances, so its resolve finds runs of equal radiance cheaply.
+  const std::vector<glm::vec3>& emissions() const noexcept { return emissions_; }
+  std::uint32_t emission_index(std::size_t i) const noexcept { return emission_index_[i]; }
   bool has_lightmap_uvs() const noexcept { return !uvs_.empty(); }
   /// Per-vertex lightmap UVs (empty if the scene has none).
   const std::vector<glm::vec2>& lightmap_uvs() const noexcept { return uvs_; }
@@ -140,6 +146,13 @@ class scene {
   /// Drawable triangles in BVH order, and the BVH (node 0 is the root; empty if no triangle).
   const std::vector<triangle>& triangles() const noexcept { return triangles_; }
   const std::vector<bvh_node>& bvh() const noexcept { return nodes_; }
+  /// The vertex coordinates of triangles() again, one array per coordinate: vertex_coordinates(v, a)[t]
+  /// is coordinate a (0 = x, 1 = y, 2 = z) of vertex v (0, 1, 2) of triangles()[t], bit for bit.
+  /// Each array has 8 entries of padding after the last triangle, so SIMD code loads eight
+  /// consecutive triangles without gathers. Precondition: v, a in [0, 2].
+  const float* vertex_coordinates(int v, int a) const noexcept {
+    return coordinates_.data() + static_cast<std::size_t>(3 * v + a) * (triangles_.size() + 8);
+  }
 
   /// Largest number of triangles in a BVH leaf. Coarse on purpose: the rasterizer's AVX2 set-up
   /// tests eight triangles of a leaf for less than a node visit costs (docs/raster.md).
@@ -147,16 +160,20 @@ class scene {
 
  private:
   scene() = default;
+  void index_emissions();
   void build_bvh();
 
   std::vector<glm::vec3> positions_;
   std::vector<std::uint32_t> indices_;
   std::vector<material> materials_;
+  std::vector<glm::vec3> emissions_;            // distinct emissions (bitwise)
+  std::vector<std::uint32_t> emission_index_;   // per triangle: its entry in emissions_
   std::vector<glm::vec2> uvs_;
   glm::vec3 sky_{0.0f};
   glm::vec3 lo_{0.0f}, hi_{0.0f};
   float size_ = 0.0f;
   std::vector<triangle> triangles_;
+  std::vector<float> coordinates_;  // vertex_coordinates(): 9 arrays of triangles_.size() + 8
   std::vector<bvh_node> nodes_;
 };
 
