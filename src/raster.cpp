@@ -310,6 +310,14 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 }
 #endif
 
+// A texel's id -> its entry in shades: the low `bits` bits of the id when the rasterizer packs
+// the key there (hemicube_rasterizer::key_bits_), else keys[id] (keys: per draw).
+struct key_map {
+  const std::uint32_t* keys;
+  std::uint32_t bits;
+  std::uint32_t operator()(std::uint32_t id) const noexcept { return bits ? id & ((1u << bits) - 1u) : keys[id]; }
+};
+
 // The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
 // the shade (keys[k] indexes shades) copied to the radiance planes and flags.
 inline void copy_shades(const std::uint32_t* keys, std::size_t count, const hemicube_rasterizer::shade* shades,
@@ -480,18 +488,22 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
 }
 
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
-// texels are left to the caller. Runs are found by shade key (keys[id]: the draw's entry in
-// shades), so the two triangles of a quad, or all black surfaces, make one run.
+// texels are left to the caller. Runs are found by shade key (the draw's entry in shades), so the
+// two triangles of a quad, or all black surfaces, make one run. packed: the key is the id's low
+// `bits` bits (no lookup); otherwise keys[id].
+template <bool packed>
 HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
                                                const hemicube_rasterizer::shade* __restrict shades,
-                                               const std::uint32_t* __restrict keys, float* __restrict distance,
+                                               const std::uint32_t* __restrict keys, std::uint32_t bits,
+                                               float* __restrict distance,
                                                float* __restrict red, float* __restrict green,
                                                float* __restrict blue, std::uint8_t* __restrict flags) noexcept {
   const __m256 zero = _mm256_setzero_ps();
   // The current run: its shade key, and its record when all its texels so far had one record
   // (a cheap first test); -1 = none (record numbers are < 2^31).
   __m256i run_id = _mm256_set1_epi32(-1), run_key = _mm256_set1_epi32(-1);
+  const __m256i key_mask = _mm256_set1_epi32(static_cast<int>((1u << bits) - 1u));
   __m256 run_r = zero, run_g = zero, run_b = zero;
   std::uint64_t run_flags = 0;
   for (std::size_t i = 0; i + 8 <= count; i += 8) {
@@ -501,61 +513,67 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
     const __m256i id = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ids + i)),
                                         _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(ids + i), id);
-    if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) != -1) {
+    __m256i key, this_run = run_id;
+    bool same_run;
+    if (packed) {
+      key = _mm256_and_si256(id, key_mask);
+      same_run = _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1;
+    } else if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) == -1) {
+      same_run = true;
+    } else {
       // Eight texels of one record (most groups: big triangles, black walls) look up its key
       // with one load; only groups of several records gather (slow on some CPUs). Either way the
       // run remembers the record, so the next group of the same record skips the lookup.
       const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
       const bool one_record = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1;
-      const __m256i key =
-          one_record ? _mm256_set1_epi32(static_cast<int>(keys[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(id))]))
-                     : _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
-      const __m256i this_run = one_record ? id0 : _mm256_set1_epi32(-1);
-      if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1) {
-        run_id = this_run;  // same shade (maybe other records): the run goes on
-      } else {
-        const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
-        const __m256i is_first = _mm256_cmpeq_epi32(key, first);
-        if (!one_record && _mm256_movemask_epi8(is_first) != -1) {
-          run_id = run_key = _mm256_set1_epi32(-1);
-          // Two shades (a group across the boundary of two regions, the usual mixed group): the
-          // first lane's and the last lane's, blended.
-          const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
-          if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
-            const hemicube_rasterizer::shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-            const hemicube_rasterizer::shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
-            const __m256 m = _mm256_castsi256_ps(is_first);
-            _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
-            _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
-            _mm256_storeu_ps(blue + i, _mm256_blendv_ps(_mm256_set1_ps(s1.b), _mm256_set1_ps(s0.b), m));
-            // Byte k of `pick` is 0xff where lane k has the first shade: byte 0 of each lane's mask.
-            const __m256i bytes = _mm256_shuffle_epi8(
-                is_first, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1,
-                                           -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
-            const std::uint64_t pick =
-                static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_castsi256_si128(bytes))) |
-                static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_extracti128_si256(bytes, 1))))
-                    << 32;
-            const std::uint64_t f0 = (s0.flags & 0xffu) * 0x0101010101010101ull, f1 = (s1.flags & 0xffu) * 0x0101010101010101ull;
-            const std::uint64_t f = (f0 & pick) | (f1 & ~pick);
-            std::memcpy(flags + i, &f, 8);
-            continue;
-          }
-          // More shades: texel by texel.
-          alignas(32) std::uint32_t lane[8];
-          _mm256_store_si256(reinterpret_cast<__m256i*>(lane), key);
-          copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
+      key = one_record ? _mm256_set1_epi32(static_cast<int>(keys[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(id))]))
+                       : _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
+      this_run = one_record ? id0 : _mm256_set1_epi32(-1);
+      same_run = _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1;
+      run_id = this_run;  // same shade (maybe other records): the run goes on
+    }
+    if (!same_run) {
+      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
+      const __m256i is_first = _mm256_cmpeq_epi32(key, first);
+      if (_mm256_movemask_epi8(is_first) != -1) {  // (never for a group of one record)
+        run_id = run_key = _mm256_set1_epi32(-1);
+        // Two shades (a group across the boundary of two regions, the usual mixed group): the
+        // first lane's and the last lane's, blended.
+        const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
+        if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
+          const hemicube_rasterizer::shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+          const hemicube_rasterizer::shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
+          const __m256 m = _mm256_castsi256_ps(is_first);
+          _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
+          _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
+          _mm256_storeu_ps(blue + i, _mm256_blendv_ps(_mm256_set1_ps(s1.b), _mm256_set1_ps(s0.b), m));
+          // Byte k of `pick` is 0xff where lane k has the first shade: byte 0 of each lane's mask.
+          const __m256i bytes = _mm256_shuffle_epi8(
+              is_first, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1,
+                                         -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
+          const std::uint64_t pick =
+              static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_castsi256_si128(bytes))) |
+              static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_extracti128_si256(bytes, 1))))
+                  << 32;
+          const std::uint64_t f0 = (s0.flags & 0xffu) * 0x0101010101010101ull, f1 = (s1.flags & 0xffu) * 0x0101010101010101ull;
+          const std::uint64_t f = (f0 & pick) | (f1 & ~pick);
+          std::memcpy(flags + i, &f, 8);
           continue;
         }
-        // A new run of shade key `first`.
-        run_key = first;
-        run_id = this_run;
-        const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-        run_r = _mm256_set1_ps(sh.r);
-        run_g = _mm256_set1_ps(sh.g);
-        run_b = _mm256_set1_ps(sh.b);
-        run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
+        // More shades: texel by texel.
+        alignas(32) std::uint32_t lane[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(lane), key);
+        copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
+        continue;
       }
+      // A new run of shade key `first`.
+      run_key = first;
+      run_id = this_run;
+      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+      run_r = _mm256_set1_ps(sh.r);
+      run_g = _mm256_set1_ps(sh.g);
+      run_b = _mm256_set1_ps(sh.b);
+      run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
     }
     _mm256_storeu_ps(red + i, run_r);
     _mm256_storeu_ps(green + i, run_g);
@@ -571,7 +589,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
 // planar (hemicube_buffer).
 void resolve_texels(std::size_t count, float* __restrict depth, const float* __restrict lengths,
                     std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
-                    const std::uint32_t* __restrict keys, float* __restrict distance, float* __restrict red, float* __restrict green,
+                    key_map key_of, float* __restrict distance, float* __restrict red, float* __restrict green,
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
 #if HEMILIGHT_RASTER_SSE2
@@ -596,7 +614,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
         const __m128i first = _mm_shuffle_epi32(id, 0);
         if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
           run_id = first;
-          const hemicube_rasterizer::shade& sh = shades[keys[static_cast<std::uint32_t>(_mm_cvtsi128_si32(id))]];
+          const hemicube_rasterizer::shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
           run_r = _mm_set1_ps(sh.r);
           run_g = _mm_set1_ps(sh.g);
           run_b = _mm_set1_ps(sh.b);
@@ -615,7 +633,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
       }
       std::uint32_t lane[4];
       _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
-      for (std::uint32_t& k : lane) k = keys[k];
+      for (std::uint32_t& k : lane) k = key_of(k);
       copy_shades(lane, 4, shades, red + i, green + i, blue + i, flags + i);
     }
   }
@@ -625,7 +643,8 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
     distance[i] = lengths[i] / depth[i];  // +inf for 1/w = 0
     ids[i] = depth[i] > 0.0f ? ids[i] : 0u;  // ids of texels never written are stale
     depth[i] = 0.0f;                         // cleared for the next render
-    copy_shades(keys + ids[i], 1, shades, red + i, green + i, blue + i, flags + i);
+    const std::uint32_t key = key_of(ids[i]);
+    copy_shades(&key, 1, shades, red + i, green + i, blue + i, flags + i);
   }
 }
 
@@ -696,6 +715,14 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
   for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
+  // Texel ids are draw << key_bits_ | key when both fit in 31 bits (draws: at most one per
+  // drawable triangle, plus draw 0); the resolve then reads the key from the id instead of
+  // looking it up per draw (a gather per group of eight texels). Ids stay below 2^31: the
+  // resolve's "no run" marker is all ones.
+  std::uint32_t bits = 1;
+  while ((std::size_t(1) << bits) < shades_.size()) ++bits;
+  const std::size_t draws = scene_->drawable_triangle_count() + 1;
+  key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -759,7 +786,7 @@ void hemicube_rasterizer::prepare(int resolution) {
 
 std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < hemicube_texel_count(n_));
-  return draw_triangles_[ids_[texel]];  // the resolve set unwritten texels to draw 0
+  return draw_triangles_[ids_[texel] >> key_bits_];  // the resolve set unwritten texels to draw 0
 }
 
 unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
@@ -1241,7 +1268,8 @@ inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene
                                                         const draw_record* rec, const frame& basis) {
   const bool back = plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
   const auto draw = static_cast<std::uint32_t>(draw_keys_.size());
-  draw_keys_.push_back(back ? 1u : 2u + scene_->emission_index(tri.index));
+  const std::uint32_t key = back ? 1u : 2u + scene_->emission_index(tri.index);
+  draw_keys_.push_back(key);
   draw_triangles_.push_back(tri.index);
   if (textured_) {
     draws_.push_back(*rec);
@@ -1254,7 +1282,7 @@ inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene
       d.grad_b2 = glm::cross(rec->normal, le1) / nn;
     }
   }
-  return draw;
+  return key_bits_ ? draw << key_bits_ | key : draw;
 }
 
 template <hemicube_rasterizer::mode M>
@@ -1588,13 +1616,16 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   std::uint8_t* flags = out.flags.data();
 #if HEMILIGHT_RASTER_AVX2
   if (avx2_) {
-    resolve_texels_avx2(count, depth, lengths, ids, shades, keys, distance, red, green, blue, flags);
+    if (key_bits_)
+      resolve_texels_avx2<true>(count, depth, lengths, ids, shades, keys, key_bits_, distance, red, green, blue, flags);
+    else
+      resolve_texels_avx2<false>(count, depth, lengths, ids, shades, keys, 0, distance, red, green, blue, flags);
     const std::size_t done = count - count % 8, rest = count - done;
-    resolve_texels(rest, depth + done, lengths + done, ids + done, shades, keys, distance + done, red + done,
-                   green + done, blue + done, flags + done, false);
+    resolve_texels(rest, depth + done, lengths + done, ids + done, shades, {keys, key_bits_}, distance + done,
+                   red + done, green + done, blue + done, flags + done, false);
   } else
 #endif
-    resolve_texels(count, depth, lengths, ids, shades, keys, distance, red, green, blue, flags, simd_);
+    resolve_texels(count, depth, lengths, ids, shades, {keys, key_bits_}, distance, red, green, blue, flags, simd_);
   depth_clear_ = true;  // every path of the resolve zeroed the depths it read (the padding stays 0)
   if (sky_) {
     // Misses see the environment along the texel's world direction.
@@ -1611,7 +1642,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
   const std::vector<std::uint32_t>& indices = scene_->indices();
   for (std::size_t i = 0; i < count; ++i) {
-    const draw_record& rec = draws_[ids[i]];
+    const draw_record& rec = draws_[ids[i] >> key_bits_];
     if (!rec.textured) continue;
     const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
     const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);

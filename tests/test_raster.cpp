@@ -462,6 +462,57 @@ TEST_CASE("raster: two-sided triangles look the same from both sides", "[raster]
   CHECK(buf.distance[centre] == Approx(std::sqrt(1.0 + 2 * (0.125 * 0.125))).epsilon(1e-6));
 }
 
+TEST_CASE("raster: every texel gets the emission of the triangle it sees, with few or many distinct emissions", "[raster]") {
+  // Texels carry a shade key: packed into the texel's id when the scene has few distinct
+  // emissions, looked up per draw when keys and draws do not fit 31 bits together. 49,928
+  // triangles with distinct emissions need 16 key bits and over 2^15 draws: the lookup. 5 distinct
+  // emissions: packed. Reference: the material of seen_triangle(), on every path.
+  scene_mesh base = heightfield(50000);
+  REQUIRE(base.triangle_count() > 46341);  // (T + 2) * (T + 1) > 2^31 when every emission differs
+  for (const int kinds : {5, 0}) {
+    scene_mesh m = base;
+    for (std::size_t i = 0; i < m.materials.size(); ++i) {
+      const auto k = static_cast<float>(kinds ? i % static_cast<std::size_t>(kinds) : i);
+      m.materials[i] = material{glm::vec3(k + 1.0f, 0.5f * k, 0.25f), glm::vec3(0.5f), i % 3 == 0};
+    }
+    m.sky_radiance = glm::vec3(0.125f, 0.25f, 0.5f);
+    const auto s = scene::create(m.desc());
+    CHECK(s->emissions().size() == (kinds ? 5u : m.triangle_count()));
+    raster_options scalar, sse2;
+    scalar.simd = false;
+    sse2.avx2 = false;
+    hemicube_rasterizer paths[] = {hemicube_rasterizer(s), hemicube_rasterizer(s, sse2), hemicube_rasterizer(s, scalar)};
+    const glm::vec3 centre = 0.5f * (s->bounds_lo() + s->bounds_hi());
+    const float height = 0.2f * s->size();
+    for (const float side : {1.0f, -1.0f}) {  // above the surface (fronts), below it (backs)
+      const glm::vec3 p = centre + glm::vec3(0.0f, side * height, 0.0f);
+      const frame f = make_frame(glm::normalize(glm::vec3(0.3f, -side, 0.2f)));
+      for (hemicube_rasterizer& r : paths) {
+        hemicube_buffer buf;
+        r.render(p, f, 64, buf);
+        std::size_t front = 0, back = 0, wrong = 0;
+        for (std::size_t i = 0; i < buf.texel_count(); ++i) {
+          const glm::vec3 l = buf.radiance_at(i);
+          const std::uint32_t t = r.seen_triangle(i);
+          if (buf.flags[i] == texel_miss) {
+            wrong += t != hemicube_rasterizer::no_triangle || l != m.sky_radiance;
+          } else if (buf.flags[i] == texel_hit_front) {
+            ++front;
+            wrong += t >= m.triangle_count() || std::memcmp(&l, &m.materials[t].emission, sizeof l) != 0;
+          } else {
+            ++back;
+            wrong += buf.flags[i] != texel_back_face || t >= m.triangle_count() || m.materials[t].two_sided ||
+                     l != glm::vec3(0.0f);
+          }
+        }
+        CHECK(wrong == 0);
+        CHECK(front > 1000);            // the surface fills much of the view from either side:
+        if (side < 0) CHECK(back > 1000);  // two-sided fronts, one-sided backs
+      }
+    }
+  }
+}
+
 TEST_CASE("raster: degenerate triangles are accepted and never drawn", "[raster]") {
   scene_mesh m;
   const material lit{glm::vec3(1.0f), glm::vec3(0.5f), false};

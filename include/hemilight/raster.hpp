@@ -239,7 +239,7 @@ class alignas(64) hemicube_rasterizer {
   int n_ = 0;
   double texel_step_ = 0.0, first_centre_ = 0.0;  // 2 / N and 1 / N - 1 (face units)
   std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
-  std::vector<std::uint32_t> ids_;     // draw record of the nearest fragment per texel (0 = none)
+  std::vector<std::uint32_t> ids_;     // draw of the nearest fragment per texel (0 = none; see key_bits_)
   std::vector<std::uint32_t>* counts_ = nullptr;
   std::vector<glm::vec3> directions_;  // unit texel-centre directions, local frame
   std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
@@ -252,6 +252,9 @@ class alignas(64) hemicube_rasterizer {
   // [0] the sky, [1] a back face, [2 + e] the front of a triangle with scene emission e: built
   // once, so a draw needs no radiance of its own and equal radiances share one key.
   std::vector<shade> shades_;
+  // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
+  // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
+  std::uint32_t key_bits_ = 0;
   std::vector<std::uint32_t> stack_;
   raster_statistics stats_;
 };
