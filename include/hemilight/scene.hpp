@@ -155,7 +155,8 @@ class scene {
   }
 
   /// Largest number of triangles in a BVH leaf. Coarse on purpose: the rasterizer's AVX2 set-up
-  /// tests eight triangles of a leaf for less than a node visit costs (docs/raster.md).
+  /// tests eight triangles of a leaf for less than a node visit costs (docs/raster.md). The BVH
+  /// splits at multiples of it, so all leaves but one per subtree split are full.
   static constexpr std::uint32_t max_leaf_triangles = 32;
 
  private:
