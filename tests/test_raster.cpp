@@ -688,19 +688,20 @@ TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round
   CHECK_THROWS_AS(write_hemicube_exr(prefix, bad), error);
 }
 
-TEST_CASE("raster: the SIMD paths (AVX2 where the CPU has it, SSE2) give bit-identical buffers to the scalar reference", "[raster]") {
+TEST_CASE("raster: the SIMD paths (AVX-512 and AVX2 where the CPU has them, SSE2) give bit-identical buffers to the scalar reference", "[raster]") {
   std::mt19937 rng(23);
   const scene_mesh scenes[] = {cornell_box(), hexagon_room(2), sky_and_occluders(), heightfield(3000),
                                fan_box(rng, {-1, -1, -1}, {1, 1, 1})};
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
   for (const scene_mesh& m : scenes) {
     const auto s = scene::create(m.desc());
-    raster_options scalar, sse2;
+    raster_options scalar, sse2, avx2;
     scalar.simd = false;
-    sse2.avx2 = false;  // the SSE2 kernels even on an AVX2 machine
-    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar);
-    hemicube_buffer a, b, c;
-    std::vector<std::uint32_t> ca, cb, cc;
+    sse2.avx2 = false;     // the SSE2 kernels even on an AVX2 machine
+    avx2.avx512 = false;   // the AVX2 build of the set-up even on an AVX-512 machine
+    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
+    hemicube_buffer a, b, c, e;
+    std::vector<std::uint32_t> ca, cb, cc, ce;
     for (int k = 0; k < 7; ++k) {
       const glm::vec3 p = 0.5f * (s->bounds_lo() + s->bounds_hi()) + glm::vec3(u(rng), u(rng), u(rng)) * 0.2f * s->size();
       const frame f = random_frame(rng);
@@ -710,6 +711,7 @@ TEST_CASE("raster: the SIMD paths (AVX2 where the CPU has it, SSE2) give bit-ide
       best.render(p, f, n, a);
       sse2_only.render(p, f, n, b);
       reference.render(p, f, n, c);
+      avx2_only.render(p, f, n, e);
       // Bitwise: compare the bytes (so NaN or -0 differences would show).
       CHECK(std::memcmp(a.distance.data(), c.distance.data(), a.distance.size() * sizeof(float)) == 0);
       CHECK(std::memcmp(a.radiance.data(), c.radiance.data(), a.radiance.size() * sizeof(float)) == 0);
@@ -717,6 +719,9 @@ TEST_CASE("raster: the SIMD paths (AVX2 where the CPU has it, SSE2) give bit-ide
       CHECK(std::memcmp(b.distance.data(), c.distance.data(), b.distance.size() * sizeof(float)) == 0);
       CHECK(std::memcmp(b.radiance.data(), c.radiance.data(), b.radiance.size() * sizeof(float)) == 0);
       CHECK(b.flags == c.flags);
+      CHECK(std::memcmp(e.distance.data(), c.distance.data(), e.distance.size() * sizeof(float)) == 0);
+      CHECK(std::memcmp(e.radiance.data(), c.radiance.data(), e.radiance.size() * sizeof(float)) == 0);
+      CHECK(e.flags == c.flags);
       std::size_t same_triangle = 0;
       for (std::size_t i = 0; i < a.texel_count(); ++i)
         same_triangle += best.seen_triangle(i) == reference.seen_triangle(i) ? 1u : 0u;
@@ -732,8 +737,10 @@ TEST_CASE("raster: the SIMD paths (AVX2 where the CPU has it, SSE2) give bit-ide
       best.render_coverage(p, f, n, ca);
       sse2_only.render_coverage(p, f, n, cb);
       reference.render_coverage(p, f, n, cc);
+      avx2_only.render_coverage(p, f, n, ce);
       CHECK(ca == cc);
       CHECK(cb == cc);
+      CHECK(ce == cc);
     }
   }
 }
@@ -793,25 +800,30 @@ TEST_CASE("raster: edges through texel centres (exact ties) give the same covera
           m.add_quad(b, a, d, c, grey);
       }
     const auto s = scene::create(m.desc());
-    raster_options scalar, sse2;
+    raster_options scalar, sse2, avx2;
     scalar.simd = false;
     sse2.avx2 = false;
-    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar);
+    avx2.avx512 = false;
+    hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
     const frame f{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    std::vector<std::uint32_t> ca, cb, cc;
+    std::vector<std::uint32_t> ca, cb, cc, ce;
     best.render_coverage({0, 0, 0}, f, n, ca);
     sse2_only.render_coverage({0, 0, 0}, f, n, cb);
     reference.render_coverage({0, 0, 0}, f, n, cc);
+    avx2_only.render_coverage({0, 0, 0}, f, n, ce);
     INFO("cell " << cell);
     CHECK(ca == cc);
     CHECK(cb == cc);
+    CHECK(ce == cc);
     std::size_t once = 0;
     for (std::size_t i = 0; i < static_cast<std::size_t>(n) * n; ++i) once += cc[i] == 1 ? 1u : 0u;  // top face first
     CHECK(once == static_cast<std::size_t>(n) * n);
-    hemicube_buffer a, c;
+    hemicube_buffer a, c, e;
     best.render({0, 0, 0}, f, n, a);
     reference.render({0, 0, 0}, f, n, c);
+    avx2_only.render({0, 0, 0}, f, n, e);
     CHECK(std::memcmp(a.distance.data(), c.distance.data(), a.distance.size() * sizeof(float)) == 0);
+    CHECK(std::memcmp(e.distance.data(), c.distance.data(), e.distance.size() * sizeof(float)) == 0);
     std::size_t same_triangle = 0;
     for (std::size_t i = 0; i < a.texel_count(); ++i) same_triangle += best.seen_triangle(i) == reference.seen_triangle(i);
     CHECK(same_triangle == a.texel_count());

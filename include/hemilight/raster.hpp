@@ -61,6 +61,8 @@
 //     the coverage mask going straight into the depth test; longer spans are depth-tested eight
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
 //     a per-render shade key, so the two triangles of a quad make one run) as broadcast stores.
+//     Where the CPU has AVX-512 (F, VL, BW, DQ) the set-up runs as an AVX-512 build of the same
+//     code (32 registers; raster_options::avx512).
 //   - SSE2 (every x86-64): the same for triangles up to 32 texels across, four texels at a time.
 // raster_options::simd = false selects the scalar reference path; raster_options::avx2 = false
 // keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
@@ -117,6 +119,10 @@ struct raster_options {
   /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked at
   /// run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine. Bit-identical.
   bool avx2 = true;
+  /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
+  /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
+  /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build. Bit-identical.
+  bool avx512 = true;
   /// Optional environment sky: texels that hit nothing get sky->sample(world direction of the
   /// texel centre) (seamless bilinear, top level; cubemap.hpp) instead of the scene's constant
   /// sky radiance. The cube map's directions are the scene's world axes (OpenGL face table).
@@ -229,11 +235,15 @@ class alignas(64) hemicube_rasterizer {
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis);
+  template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
+  void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
+                        const simd_frame& sf, const frame& basis);
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
   bool simd_ = true;
   bool avx2_ = false;  // simd_ and the CPU has AVX2
+  bool avx512_ = false;  // avx2_, the option, and the CPU has AVX-512 F, VL, BW and DQ
   bool depth_clear_ = false;  // depth_ is all zero (the last render's resolve cleared it)
   std::shared_ptr<const cubemap> sky_;
   int n_ = 0;
