@@ -171,8 +171,8 @@ class alignas(64) hemicube_rasterizer {
   /// orthonormal and right-handed to within 1e-3 (each length within 1e-3 of 1, pairwise dots
   /// below 1e-3, (t x b) . n > 0); N odd or outside [2, 4096]; an invalid texture.
   /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
-  /// Cornell box at N = 64: about 30 us on one core of a 2020s server (AVX2); a closed room of
-  /// 1,000 small triangles, all in view: about 200 us (the cost is per triangle).
+  /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
+  /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle).
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
