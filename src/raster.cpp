@@ -983,14 +983,18 @@ void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned fac
 #if HEMILIGHT_RASTER_AVX2
 #define HEMILIGHT_LEAF_NAME draw_leaf_avx2
 #define HEMILIGHT_LEAF_TARGET HEMILIGHT_TARGET_AVX2
+#define HEMILIGHT_LEAF_WIDE 0
 #include "raster_leaf.inl"
 #undef HEMILIGHT_LEAF_NAME
 #undef HEMILIGHT_LEAF_TARGET
+#undef HEMILIGHT_LEAF_WIDE
 #define HEMILIGHT_LEAF_NAME draw_leaf_avx512
 #define HEMILIGHT_LEAF_TARGET HEMILIGHT_TARGET_AVX512
+#define HEMILIGHT_LEAF_WIDE 1
 #include "raster_leaf.inl"
 #undef HEMILIGHT_LEAF_NAME
 #undef HEMILIGHT_LEAF_TARGET
+#undef HEMILIGHT_LEAF_WIDE
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)

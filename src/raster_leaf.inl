@@ -126,8 +126,16 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
   const int n = n_;
   const __m256 sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
   const __m256 near8 = _mm256_set1_ps(near_), band = _mm256_set1_ps(guard_band);
+#if HEMILIGHT_LEAF_WIDE
+  // The zero-masked conversions (all lanes kept) are the plain ones; GCC 12 warns about the
+  // plain ones' undefined pass-through operand (-Wmaybe-uninitialized, a known false positive).
+  const __mmask8 all8 = 0xff;
+  const __m512d one8 = _mm512_set1_pd(1.0), half8 = _mm512_set1_pd(0.5), minus_half8 = _mm512_set1_pd(-0.5);
+  const __m512d dscale8 = _mm512_set1_pd(0.5 * n * static_cast<double>(sub_one)), zero8 = _mm512_setzero_pd();
+#else
   const __m256d one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5), minus_half = _mm256_set1_pd(-0.5);
   const __m256d dscale = _mm256_set1_pd(0.5 * n * static_cast<double>(sub_one)), zero_d = _mm256_setzero_pd();
+#endif
   const __m256i zero_i = _mm256_setzero_si256(), ones_i = _mm256_set1_epi32(-1);
   for (int f = 0; f < 5; ++f) {
     const unsigned todo = in_face[f];
@@ -159,8 +167,19 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
     // raster_face's projection and snapping in double, four lanes per register: iw = 1 / w,
     // round((u iw + 1) scale), round((v iw + v_offset) scale), halves away from zero. Clipped
     // lanes compute garbage here (w may be <= 0) and are not used.
-    const __m256d v_offset = _mm256_set1_pd(f == 0 ? 1.0 : 0.0);
     __m256i X[3], Y[3];
+#if HEMILIGHT_LEAF_WIDE
+    // The AVX-512 build: the same double operations on all eight lanes in one register.
+    const __m512d v_offset = _mm512_set1_pd(f == 0 ? 1.0 : 0.0);
+    for (int i = 0; i < 3; ++i) {
+      const __m512d iw = _mm512_div_pd(one8, _mm512_maskz_cvtps_pd(all8, w[i]));
+      const __m512d xs = _mm512_mul_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(all8, u[i]), iw), one8), dscale8);
+      const __m512d ys = _mm512_mul_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(all8, vv[i]), iw), v_offset), dscale8);
+      X[i] = _mm512_maskz_cvttpd_epi32(all8, _mm512_add_pd(xs, _mm512_mask_blend_pd(_mm512_cmp_pd_mask(xs, zero8, _CMP_GE_OQ), minus_half8, half8)));
+      Y[i] = _mm512_maskz_cvttpd_epi32(all8, _mm512_add_pd(ys, _mm512_mask_blend_pd(_mm512_cmp_pd_mask(ys, zero8, _CMP_GE_OQ), minus_half8, half8)));
+    }
+#else
+    const __m256d v_offset = _mm256_set1_pd(f == 0 ? 1.0 : 0.0);
     for (int i = 0; i < 3; ++i) {
       __m128i xs_half[2], ys_half[2];
       for (int h = 0; h < 2; ++h) {
@@ -176,6 +195,7 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
       X[i] = _mm256_set_m128i(xs_half[1], xs_half[0]);
       Y[i] = _mm256_set_m128i(ys_half[1], ys_half[0]);
     }
+#endif
     const __m256i min_x = _mm256_min_epi32(_mm256_min_epi32(X[0], X[1]), X[2]);
     const __m256i max_x = _mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]);
     const __m256i min_y = _mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]);
@@ -227,8 +247,19 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
       _mm256_store_si256(reinterpret_cast<__m256i*>(sy[k]), _mm256_slli_epi32(ddx, sub_bits));
     }
     // face_setup::prepare's depth plane, four lanes of double at a time.
-    alignas(32) double z00[8], dzdy[8];
+    alignas(64) double z00[8], dzdy[8];
     alignas(32) float dzdx[8];
+#if HEMILIGHT_LEAF_WIDE
+    {
+      const __m512d step = _mm512_set1_pd(texel_step_), u0 = _mm512_set1_pd(first_centre_);
+      const __m512d v0 = f == 0 ? u0 : _mm512_set1_pd(0.5 * texel_step_);
+      const __m512d inv_k = _mm512_div_pd(one8, _mm512_maskz_cvtps_pd(all8, plane));
+      const __m512d nud = _mm512_maskz_cvtps_pd(all8, u[3]), nvd = _mm512_maskz_cvtps_pd(all8, vv[3]), nwd = _mm512_maskz_cvtps_pd(all8, w[3]);
+      _mm256_store_ps(dzdx, _mm512_maskz_cvtpd_ps(all8, _mm512_mul_pd(_mm512_mul_pd(nud, step), inv_k)));
+      _mm512_store_pd(dzdy, _mm512_mul_pd(_mm512_mul_pd(nvd, step), inv_k));
+      _mm512_store_pd(z00, _mm512_mul_pd(_mm512_add_pd(_mm512_add_pd(nwd, _mm512_mul_pd(nud, u0)), _mm512_mul_pd(nvd, v0)), inv_k));
+    }
+#else
     {
       const __m256d step = _mm256_set1_pd(texel_step_), u0 = _mm256_set1_pd(first_centre_);
       const __m256d v0 = f == 0 ? u0 : _mm256_set1_pd(0.5 * texel_step_);
@@ -245,6 +276,7 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
                         _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(nwd, _mm256_mul_pd(nud, u0)), _mm256_mul_pd(nvd, v0)), inv_k));
       }
     }
+#endif
     alignas(32) std::int32_t xb[8], xe[8], yb[8], ye[8], vx[3][8], vy[3][8];
     _mm256_store_si256(reinterpret_cast<__m256i*>(xb), x_begin);
     _mm256_store_si256(reinterpret_cast<__m256i*>(xe), x_end);
