@@ -8,11 +8,15 @@
 // Multi-threaded runs hand batches of hemicubes (256 for the small scenes, 64 for 10k triangles,
 // 16 above) to hemilight::parallel_for (one rasterizer per worker) and are timed in real time. The 1M-triangle scene uses 3 repetitions (a full run with
 // the default 5 takes several minutes), whatever --benchmark_repetitions says.
+// Counter `steal`: the fraction of all CPU time that the hypervisor gave to other guests during
+// the run (/proc/stat; -1 where unknown). Two-thread rows with steal over a few percent measure
+// the host more than the library (docs/raster.md).
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
 #include "hemilight/reference_scenes.hpp"
 
 #include "bench_points.hpp"
+#include "host_steal.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -66,12 +70,14 @@ void render_one_thread(benchmark::State& state, std::size_t scene_index, int n) 
   hemicube_rasterizer r(b.built);
   hemicube_buffer buf;
   std::size_t k = 0;
+  const bench::cpu_ticks before = bench::read_cpu_ticks();
   for (auto _ : state) {
     r.render(b.points[k], b.frames[k], n, buf);
     benchmark::DoNotOptimize(buf.radiance.data());
     k = (k + 1) % b.points.size();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+  state.counters["steal"] = bench::steal_fraction(before, bench::read_cpu_ticks());
 }
 
 void render_all_threads(benchmark::State& state, std::size_t scene_index, int n) {
@@ -82,6 +88,7 @@ void render_all_threads(benchmark::State& state, std::size_t scene_index, int n)
   // Batches long enough to amortise the thread starts of parallel_for (~20 us per worker).
   const std::size_t batch = b.built->drawable_triangle_count() < 5000 ? 256 : (b.built->drawable_triangle_count() < 50000 ? 64 : 16);
   std::size_t offset = 0;
+  const bench::cpu_ticks before = bench::read_cpu_ticks();
   for (auto _ : state) {
     parallel_for(batch, 0, 1, [&](int worker, std::size_t begin, std::size_t end) {
       const auto w = static_cast<std::size_t>(worker);
@@ -93,6 +100,7 @@ void render_all_threads(benchmark::State& state, std::size_t scene_index, int n)
     offset = (offset + batch) % b.points.size();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(batch));
+  state.counters["steal"] = bench::steal_fraction(before, bench::read_cpu_ticks());
 }
 
 }  // namespace
