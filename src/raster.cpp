@@ -234,9 +234,13 @@ inline void walk_rows_of(int nl, int nr, const edge_walk* left, const edge_walk*
 // Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
 constexpr std::int64_t simd_extent = 32 * sub_one;
 // The same for the AVX2 kernel, which also takes the big triangles of small hemicubes: with both
-// extents <= 64 texels (2^14 in fixed point), every edge value it forms, up to 8 texels past the
-// box, is below 2^14 * 2^14 + 2^14 * (2^14 + 2^11) + 1 < 2^29.2: exact in 32-bit lanes.
-constexpr std::int64_t avx2_extent = 64 * sub_one;
+// extents <= E = 120 texels (30,720 in fixed point), every edge value it forms (texel centres in
+// the triangle's box, or up to 8 texels past it in x), dx (Py - Ay) - dy (Px - Ax) + bias, is at
+// most E^2 + E (E + 2^11) + 1 = 1,950,351,361 < 2^31 - 1: exact in 32-bit lanes, and so are the
+// two products and the signed area of the set-up. (64 texels until session 8: three in five of
+// the room's triangles over 64 texels across are under 120, and the box scan of their part on the
+// face is cheaper than the exact span walk.)
+constexpr std::int64_t avx2_extent = 120 * sub_one;
 
 // See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
 // E = ex x + ey y + e0; covered iff all three are >= 0.
