@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace hemilight {
 
@@ -42,6 +43,36 @@ void add_open_prism(scene_mesh& m, const glm::vec2* footprint, int count, float 
 void add_open_box(scene_mesh& m, float x0, float z0, float x1, float z1, float height, const material& mat) {
   const glm::vec2 fp[4] = {{x0, z0}, {x1, z0}, {x1, z1}, {x0, z1}};
   add_open_prism(m, fp, 4, height, mat);
+}
+
+// A closed prism between heights y0 and y1 over the regular polygon of `sides` corners of
+// circumradius r around (cx, cz), the first corner at angle `phase`: sides face outwards, the
+// top faces up, the bottom down.
+void add_closed_prism(scene_mesh& m, float cx, float cz, float r, int sides, float phase, float y0, float y1,
+                      const material& mat) {
+  const double pi = 3.14159265358979323846;
+  std::vector<glm::vec2> fp(static_cast<std::size_t>(sides));
+  for (int i = 0; i < sides; ++i) {
+    const double t = phase + 2.0 * pi * i / sides;
+    fp[static_cast<std::size_t>(i)] = {cx + static_cast<float>(r * std::cos(t)), cz + static_cast<float>(r * std::sin(t))};
+  }
+  for (int i = 0; i < sides; ++i) {
+    const glm::vec2 p = fp[static_cast<std::size_t>(i)], q = fp[static_cast<std::size_t>((i + 1) % sides)];
+    const glm::vec2 out = 0.5f * (p + q) - glm::vec2(cx, cz);
+    add_facing(m, {p.x, y0, p.y}, {q.x, y0, q.y}, {q.x, y1, q.y}, {p.x, y1, p.y}, {out.x, 0, out.y}, mat);
+  }
+  for (int level = 0; level < 2; ++level) {
+    const float y = level ? y1 : y0;
+    for (int i = 1; i + 1 < sides; ++i) {
+      const glm::vec3 a(fp[0].x, y, fp[0].y), b(fp[static_cast<std::size_t>(i)].x, y, fp[static_cast<std::size_t>(i)].y),
+          c(fp[static_cast<std::size_t>(i + 1)].x, y, fp[static_cast<std::size_t>(i + 1)].y);
+      const bool up = glm::cross(b - a, c - a).y >= 0.0f;
+      if (up == (level == 1))
+        m.add_triangle(a, b, c, mat);
+      else
+        m.add_triangle(a, c, b, mat);
+    }
+  }
 }
 
 // A small deterministic generator (splitmix64): the same scene on every platform.
@@ -185,6 +216,50 @@ scene_mesh many_boxes(std::size_t box_count) {
     const float x0 = -half + cell * ci + (cell - wx) * rng.next(), z0 = -half + cell * cj + (cell - wz) * rng.next();
     add_open_box(m, x0, z0, x0 + wx, z0 + wz, hy, white());
   }
+  m.sky_radiance = glm::vec3(1.0f);
+  return m;
+}
+
+scene_mesh open_pavilion() {
+  scene_mesh m;
+  const material stone = white(0.6f), wood = white(0.7f);
+  const float octagon = 3.14159265f / 8.0f;  // corners at 22.5 + 45 k degrees: faces along the axes
+  m.add_box({-7.0f, -0.3f, -5.0f}, {7.0f, 0.02f, 5.0f}, stone);  // step
+  m.add_box({-6.0f, 0.0f, -4.0f}, {6.0f, 0.3f, 4.0f}, stone);    // floor slab, 2 cm into the step
+  m.add_box({-6.5f, 3.8f, -4.5f}, {6.5f, 4.2f, 4.5f}, wood);     // roof slab
+  for (float x : {-4.5f, -1.5f, 1.5f, 4.5f})
+    for (float z : {-2.8f, 2.8f}) {
+      add_closed_prism(m, x, z, 0.35f, 8, octagon, 0.28f, 0.5f, stone);  // plinth, 2 cm into the floor
+      add_closed_prism(m, x, z, 0.12f, 8, octagon, 0.45f, 3.65f, wood);  // pillar, 5 cm into plinth and capital
+      add_closed_prism(m, x, z, 0.25f, 8, octagon, 3.6f, 3.82f, wood);   // capital, 2 cm into the roof
+    }
+  m.sky_radiance = glm::vec3(1.0f);
+  return m;
+}
+
+scene_mesh open_street() {
+  scene_mesh m;
+  add_facing(m, {-20, 0, -8}, {20, 0, -8}, {20, 0, 8}, {-20, 0, 8}, {0, 1, 0}, white(0.5f));
+  splitmix rng{2024};
+  // Buildings: each side of the street (|z| >= 4) from x = -19 onwards, some flush with the
+  // previous one (touching), some with a gap.
+  for (int side = 0; side < 2; ++side) {
+    float x = -19.0f;
+    while (x < 17.0f) {
+      const float w = std::min(3.0f + 4.0f * rng.next(), 19.0f - x), d = 4.0f + 5.0f * rng.next();
+      const float h = 3.0f + 9.0f * rng.next(), albedo = 0.55f + 0.25f * rng.next();
+      const float z0 = side ? 4.0f : -4.0f - d, z1 = side ? 4.0f + d : -4.0f;
+      m.add_box({x, -0.01f, std::max(z0, -7.9f)}, {x + w, h, std::min(z1, 7.9f)}, white(albedo));
+      x += w + (rng.next() < 0.5f ? 0.0f : 0.5f + 1.5f * rng.next());
+    }
+  }
+  // Lamp posts on bases along both kerbs (z = +-3.4).
+  for (int i = 0; i < 8; ++i)
+    for (float z : {-3.4f, 3.4f}) {
+      const float x = -17.5f + 5.0f * static_cast<float>(i);
+      m.add_box({x - 0.2f, -0.01f, z - 0.2f}, {x + 0.2f, 0.15f, z + 0.2f}, white(0.6f));
+      m.add_box({x - 0.06f, 0.13f, z - 0.06f}, {x + 0.06f, 3.5f, z + 0.06f}, white(0.7f));
+    }
   m.sky_radiance = glm::vec3(1.0f);
   return m;
 }

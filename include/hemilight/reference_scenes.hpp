@@ -49,4 +49,24 @@ scene_mesh heightfield(std::size_t triangle_count);
 /// Throws error(invalid_argument) for a count over 2^24.
 scene_mesh many_boxes(std::size_t box_count);
 
+/// Open pavilion (the traits of a low-poly game asset under an open sky): a floor slab 12 x 8 x
+/// 0.3 m (y = 0 .. 0.3) set 2 cm into a wider step slab (14 x 10 m, y = -0.3 .. 0.02), a roof slab
+/// 13 x 9 x 0.4 m (y = 3.8 .. 4.2), and eight thin pillars (octagonal prisms, circumradius 0.12 m)
+/// at x = -4.5, -1.5, 1.5, 4.5 and z = -2.8, 2.8, each standing on an octagonal plinth (0.35 m,
+/// y = 0.28 .. 0.5, 2 cm into the floor) and topped by an octagonal capital (0.25 m, y = 3.6 ..
+/// 3.82, 2 cm into the roof); pillars reach 5 cm into plinth and capital. Every part is a closed
+/// solid (caps included), so where parts meet, surface points lie inside geometry (the floor under
+/// a plinth, the plinth top under its pillar, the roof above a capital), as in real assets. Slabs
+/// are boxes of 12 large triangles; 708 triangles in all. Albedo 0.7 (floor and step 0.6), nothing
+/// emits, sky (1, 1, 1) on all sides (also below the step).
+scene_mesh open_pavilion();
+
+/// Open street: a 40 x 16 m ground (two triangles, albedo 0.5) at y = 0 under the sky (1, 1, 1),
+/// two rows of closed buildings (boxes of pseudo-random size, 3 to 7 m wide, 4 to 9 m deep, 3 to 12 m
+/// tall, albedo 0.55 to 0.8) set 1 cm into the ground along both sides of an 8 m street, some of
+/// them touching, and sixteen thin closed lamp posts (0.12 x 0.12 x 3.5 m, each on a 0.4 x 0.4 x
+/// 0.15 m base) along both kerbs. Every part is a closed box, so ground texels under buildings,
+/// bases and posts are inside geometry. Deterministic; 2 + 12 x (buildings + 32) triangles.
+scene_mesh open_street();
+
 }  // namespace hemilight
