@@ -383,6 +383,8 @@ struct coverage_detail {
   float max_weight = 0.0f;       // largest weight of a covering record
   std::uint32_t last = 0;        // index of the last covering record (the only one when records == 1)
   float last_prediction = 0.0f;  // its luminance prediction at the point
+  float max_backface = 0.0f;     // largest backface_fraction of a covering record
+  std::size_t visited = 0;       // records whose box the query visited (covering or not)
 };
 
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
@@ -401,7 +403,9 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   const int order = prediction_order(o);
+  std::size_t visited = 0;
   bvh.query(x, [&](std::uint32_t i) {
+    ++visited;
     const cache_record& r = records[i];
     const float w = record_weight(r, x, n, o);
     if (w <= 0.0f || record_is_behind(r, x, n)) return;
@@ -423,6 +427,7 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
       detail->last = i;
       detail->max_weight = std::max(detail->max_weight, w);
       detail->last_prediction = l;
+      detail->max_backface = std::max(detail->max_backface, r.backface_fraction);
       detail->first_order = std::max(detail->first_order, std::fabs(l - li) / std::max({li, detail->floor, 1e-30f}));
     }
     at_record = at_record || r.position == x;
@@ -435,6 +440,7 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
       for (glm::vec3& c : cone_sum.coefficients) c /= wsum;
     *cone = cone_sum;
   }
+  if (detail) detail->visited = visited;
   if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
   if (own) *own = at_record;
   return wsum;
@@ -721,382 +727,559 @@ std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_recor
   return sum;
 }
 
-cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
-                              const irradiance_sampler& sampler, const cache_options& options_in) {
-  validate(positions, normals, count, options_in);
-  if (!sampler) throw_invalid_argument("cache_irradiance: sampler is empty");
-  const auto start = std::chrono::steady_clock::now();
-  cache_options o = options_in;
-  const int threads = resolve_thread_count(o.thread_count);
-  const float a = o.error_threshold;
+namespace {
 
-  // Automatic radii from the points' extent and spacing.
-  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-  for (std::size_t i = 0; i < count; ++i) {
-    lo = glm::min(lo, positions[i]);
-    hi = glm::max(hi, positions[i]);
+// One run of cache_irradiance (cache.hpp), as a chain of named stages over shared state:
+//   derive_radii -> [ coverage_pass -> pick_seeds -> render_seeds -> append_records
+//                     -> limit_radii -> mark_dirty ]* -> fit_hessians -> interpolate_all
+//                     -> fill_invalid
+// Per point the state is: covered (a record's weight passes 1/a and the opinions agree), own
+// invalid sample (inside geometry: its own hemicube saw back faces), presumed inside (within the
+// exclusion ball of an invalid sample on the same side of the same surface), contested (presumed
+// inside, but a valid record covers it too: the point may be on either side of a contact, so it
+// gets its own hemicube). A point is open (a seed candidate) when it is none of covered, own
+// invalid or presumed-but-uncontested.
+class placement {
+ public:
+  placement(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const irradiance_sampler& sampler,
+            const cache_options& options)
+      : p_(positions), n_(normals), count_(count), sampler_(sampler), o_(options) {}
+
+  cache_result run() {
+    const auto start = std::chrono::steady_clock::now();
+    threads_ = resolve_thread_count(o_.thread_count);
+    derive_radii();
+    set_up();
+    for (;;) {
+      cache_round_stats round;
+      round.spacing = spacing_;
+      timed(round.coverage_seconds, [&] { coverage_pass(round); });
+      const std::size_t open = count_open();
+      round.open_points = open;
+      report(1.0f - float(open) / float(count_));
+      if (open == 0) {
+        stats_.round_details.push_back(round);
+        break;
+      }
+      std::vector<std::size_t> seeds;
+      timed(round.seed_seconds, [&] { seeds = pick_seeds(); });
+      std::vector<cache_sample> samples;
+      timed(round.render_seconds, [&] { samples = render_seeds(seeds, open); });
+      round.seeds = seeds.size();
+      timed(round.update_seconds, [&] {
+        const std::size_t first_new = append_records(seeds, samples, round);
+        const bool limited = limit_radii(first_new);
+        mark_dirty(first_new);
+        // Only radii changed since limit_radii built the tree (if it did): refit its boxes.
+        if (limited)
+          bvh_.refit(records_, o_);
+        else
+          bvh_.build(records_, o_, threads_);
+      });
+      stats_.round_details.push_back(round);
+      ++stats_.rounds;
+      if (spacing_ > finest_)
+        spacing_ = std::max(finest_, 0.5f * spacing_);
+      else if (seeds.empty())
+        break;  // defensive: nothing could be placed
+    }
+    if (o_.second_order && o_.use_gradients) fit_hessians(records_, o_, threads_);
+    cache_result result;
+    const auto t_final = std::chrono::steady_clock::now();
+    interpolate_all(result);
+    if (o_.fill_invalid) fill_invalid(result);
+    else stats_.invalid_points = count_invalid(result);
+    stats_.interpolation_seconds = seconds_since(t_final);
+    for (const cache_round_stats& r : stats_.round_details) stats_.render_seconds += r.render_seconds;
+    stats_.records = records_.size();
+    stats_.min_radius = o_.min_radius;
+    stats_.max_radius = o_.max_radius;
+    stats_.seconds = seconds_since(start);
+    stats_.placement_seconds = std::max(0.0, stats_.seconds - stats_.render_seconds - stats_.interpolation_seconds);
+    report(1.0f);
+    result.records = std::move(records_);
+    result.stats = stats_;
+    return result;
   }
-  const float diagonal = glm::length(hi - lo);
-  if (o.min_radius == 0.0f) {
-    const float spacing = median_spacing(positions, count, diagonal);
-    o.min_radius = spacing > 0.0f ? spacing / a : std::max(diagonal, 1e-3f) * 1e-3f;
+
+ private:
+  static double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   }
-  if (o.max_radius == 0.0f) o.max_radius = 0.2f * diagonal;
-  o.max_radius = std::max(o.max_radius, o.min_radius);
+  template <class F>
+  static void timed(double& seconds, F&& f) {
+    const auto t = std::chrono::steady_clock::now();
+    f();
+    seconds += seconds_since(t);
+  }
 
   // Coverage can drop between rounds (radii shrink), so the reported fraction is the running
   // maximum: progress never goes backwards.
-  float reported = 0.0f;
-  auto report = [&](float fraction) {
-    reported = std::max(reported, fraction);
-    if (o.progress && !o.progress(reported)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
-  };
+  void report(float fraction) {
+    reported_ = std::max(reported_, fraction);
+    if (o_.progress && !o_.progress(reported_)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
+  }
 
-  std::vector<cache_record> records;
-  record_bvh bvh;
-  bvh.build(records, o);
-  // Per point: 0 = open, 1 = inside geometry (an invalid sample there or near one).
-  std::vector<std::uint8_t> inside(count, 0);
-  std::vector<std::uint8_t> covered(count, 0);
-  // Coverage is re-checked only where it can have changed: open points, points in the coverage
-  // sphere of a record added or shrunk in the last round (dirty), and points whose check leaned
-  // on floor_e (fragile), which moves as records are added. Every other point is covered by the
-  // same records with the same radii as when it was checked, so its answer stands.
-  std::vector<std::uint8_t> dirty(count, 0), fragile(count, 0);
-  point_grid grid_of_points;
-  grid_of_points.build(positions, count);
-  std::vector<float> old_radius;
-  std::vector<std::uint64_t> order_key(count);
-  for (std::size_t i = 0; i < count; ++i) order_key[i] = mix(i);
-  std::vector<std::size_t> order(count);
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return order_key[x] < order_key[y]; });
-
-  cache_stats stats;
-  float spacing = a * o.max_radius;
-  const float finest = a * o.min_radius;
-  // Invalid samples: position and exclusion radius (0.9 x their min distance).
-  std::vector<std::pair<glm::vec3, float>> invalid_balls;
-  // Per point: the index of the record placed there, or -1 (for nearby_opinion).
-  std::vector<std::int32_t> record_at_point(count, -1);
-  const float nearby_reach = o.nearby_opinion * finest;
-
-  // The coverage tests weigh records with Ward's own weight under ward_continuous too, so that
-  // both place the same records (only the final interpolation differs; cache.hpp).
-  cache_options coverage_options = o;
-  if (coverage_options.weight == cache_weight::ward_continuous) coverage_options.weight = cache_weight::ward;
-  coverage_options.progress = nullptr;
-  coverage_options.second_order = false;  // the Hessians are fitted after placement
-  for (;;) {
-    // 1. Coverage of every open point (parallel, read-only on the records). A point is covered
-    // when a record's weight passes the threshold and, with refine_disagreement, the covering
-    // records agree on it: their predictions span at most a x max(E, floor) (luminance).
-    float floor_e = 0.0f;
-    if (!records.empty()) {
-      double mean = 0.0;
-      for (const cache_record& r : records) mean += luminance(r.irradiance);
-      floor_e = 0.05f * float(mean / double(records.size()));
+  // Automatic radii from the points' extent and spacing (cache_options::min_radius, max_radius).
+  void derive_radii() {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::size_t i = 0; i < count_; ++i) {
+      lo = glm::min(lo, p_[i]);
+      hi = glm::max(hi, p_[i]);
     }
-    parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
+    diagonal_ = glm::length(hi - lo);
+    const float a = o_.error_threshold;
+    if (o_.min_radius == 0.0f) {
+      const float spacing = median_spacing(p_, count_, diagonal_);
+      o_.min_radius = spacing > 0.0f ? spacing / a : std::max(diagonal_, 1e-3f) * 1e-3f;
+    }
+    if (o_.max_radius == 0.0f) o_.max_radius = 0.2f * diagonal_;
+    o_.max_radius = std::max(o_.max_radius, o_.min_radius);
+    spacing_ = a * o_.max_radius;
+    finest_ = a * o_.min_radius;
+    nearby_reach_ = o_.nearby_opinion * finest_;
+    contact_backface_ = 0.1f * o_.invalid_backface_fraction;
+  }
+
+  void set_up() {
+    bvh_.build(records_, o_);
+    for (auto* v : {&covered_, &dirty_, &fragile_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
+    record_at_point_.assign(count_, -1);
+    grid_of_points_.build(p_, count_);
+    std::vector<std::uint64_t> key(count_);
+    for (std::size_t i = 0; i < count_; ++i) key[i] = mix(i);
+    order_.resize(count_);
+    std::iota(order_.begin(), order_.end(), std::size_t(0));
+    std::sort(order_.begin(), order_.end(), [&](std::size_t x, std::size_t y) { return key[x] < key[y]; });
+    // The coverage tests weigh records with Ward's own weight under ward_continuous too, so that
+    // both place the same records (only the final interpolation differs; cache.hpp).
+    coverage_options_ = o_;
+    if (coverage_options_.weight == cache_weight::ward_continuous) coverage_options_.weight = cache_weight::ward;
+    coverage_options_.progress = nullptr;
+    coverage_options_.second_order = false;  // the Hessians are fitted after placement
+  }
+
+  bool inside(std::size_t i) const { return own_invalid_[i] || (presumed_[i] && !contested_[i]); }
+  bool open(std::size_t i) const { return !covered_[i] && !inside(i); }
+  std::size_t count_open() const {
+    std::size_t open_points = 0;
+    for (std::size_t i = 0; i < count_; ++i) open_points += open(i) ? 1u : 0u;
+    return open_points;
+  }
+
+  // 1. Coverage of every point whose answer can have changed (parallel, read-only on the
+  // records): open points, points in the reach of a record added or shrunk in the last round
+  // (dirty), and points whose answer leaned on floor_e (fragile), which moves as records are
+  // added. Every other point is covered by the same records with the same radii as when it was
+  // checked, so its answer stands.
+  void coverage_pass(cache_round_stats& round) {
+    float floor_e = 0.0f;
+    if (!records_.empty()) {
+      double mean = 0.0;
+      for (const cache_record& r : records_) mean += luminance(r.irradiance);
+      floor_e = 0.05f * float(mean / double(records_.size()));
+    }
+    struct tally {
+      std::size_t checked = 0, visited = 0, max_visited = 0;
+      std::array<std::size_t, cache_stats::histogram_buckets> histogram{};
+    };
+    std::vector<tally> tallies(static_cast<std::size_t>(threads_));
+    parallel_for(count_, threads_, 4096, [&](int worker, std::size_t b, std::size_t e) {
+      tally& t = tallies[std::size_t(worker)];
       for (std::size_t i = b; i < e; ++i) {
-        if (inside[i] || (covered[i] && !dirty[i] && !fragile[i])) continue;
-        glm::vec3 value;
-        float spread = 0.0f;
-        bool own = false;
-        coverage_detail detail;
-        detail.floor = floor_e;
-        const bool second_opinion = o.second_opinion > 0.0f;
-        const bool nearby_opinion = o.nearby_opinion > 0.0f;
-        const bool sole_reach = o.sole_record_reach < 1.0f;
-        const float w = interpolate(records, bvh, positions[i], normals[i], coverage_options, value, &spread, &own,
-                                    nullptr, nullptr, second_opinion || nearby_opinion || sole_reach ? &detail : nullptr);
-        bool ok = w > 0.0f;
-        bool leans_on_floor = false;
-        if (ok && o.refine_disagreement && !own) {
-          ok = spread <= a * std::max(luminance(value), floor_e);
-          leans_on_floor = ok && spread > a * luminance(value);
-        }
-        // Second opinion: a point that only one record covers is not covered while that record's
-        // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record
-        // can disagree with an extrapolation that may be wrong (an edge between two rows of
-        // points, a second derivative the gradient does not see).
-        if (ok && second_opinion && !own && detail.records == 1) {
-          ok = detail.first_order <= o.second_opinion * a;
-          leans_on_floor = leans_on_floor || (ok && floor_e > 0.0f);  // the floor moves: re-check
-        }
-        // Sole record reach: a point that one record covers must lie inside sole_record_reach of
-        // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
-        if (ok && sole_reach && !own && detail.records == 1 && coverage_options.weight == cache_weight::ward)
-          ok = detail.max_weight >= 1.0f / (o.sole_record_reach * a);
-        // Nearby opinion: records near a point that one record covers, which do not cover it
-        // themselves, must predict the same there within a (a hard shadow edge between two rows
-        // of points is invisible to the covering record's gradient, not to a record beyond it).
-        if (ok && nearby_opinion && !own && detail.records == 1) {
-          const glm::vec3 x = positions[i], nx = normals[i];
-          const float la = std::max(detail.last_prediction, 0.0f);
-          const float tolerance = a * std::max(la, floor_e);
-          grid_of_points.for_each_in_sphere(x, nearby_reach, [&](std::uint32_t j) {
-            const std::int32_t k = record_at_point[j];
-            if (!ok || k < 0 || std::uint32_t(k) == detail.last) return;
-            const cache_record& rb = records[std::size_t(k)];
-            if (glm::dot(rb.normal, nx) <= 0.9f || record_is_behind(rb, x, nx)) return;
-            const float lb = luminance(glm::max(extrapolate(rb, x, nx, o.use_gradients ? 1 : 0), glm::vec3(0.0f)));
-            if (std::fabs(lb - la) > tolerance) ok = false;
-          });
-          // Records added near the point later can change the answer (and the floor moves): re-check.
-          leans_on_floor = true;
-        }
-        covered[i] = ok ? 1 : 0;
-        fragile[i] = leans_on_floor ? 1 : 0;
+        if (own_invalid_[i] || (presumed_[i] && !contested_[i] && !dirty_[i]) ||
+            (covered_[i] && !dirty_[i] && !fragile_[i]))
+          continue;
+        std::size_t visited = 0;
+        check_point(i, floor_e, visited);
+        ++t.checked;
+        t.visited += visited;
+        t.max_visited = std::max(t.max_visited, visited);
+        ++t.histogram[cache_stats::histogram_bucket(visited)];
       }
     });
-    std::fill(dirty.begin(), dirty.end(), std::uint8_t(0));
-    std::size_t open = 0;
-    for (std::size_t i = 0; i < count; ++i) open += (!covered[i] && !inside[i]) ? 1u : 0u;
-    report(1.0f - float(open) / float(count));
-    if (open == 0) break;
-
-    // 2. Seeds: open points in the fixed order, at least `spacing` from this round's other seeds
-    // of a similar normal (a hash grid with cells of `spacing`).
-    std::vector<std::size_t> seeds;
-    const float cell = std::max(spacing, 1e-30f);
-    std::unordered_multimap<std::uint64_t, std::size_t> grid;
-    auto key = [&](const glm::ivec3& q) {
-      return (std::uint64_t(std::uint32_t(q.x)) * 73856093u) ^ (std::uint64_t(std::uint32_t(q.y)) * 19349663u) ^
-             (std::uint64_t(std::uint32_t(q.z)) * 83492791u);
-    };
-    for (std::size_t i : order) {
-      if (covered[i] || inside[i]) continue;
-      bool blocked = false;
-      if (spacing > finest) {  // at the finest spacing every open point is a seed
-        const glm::ivec3 q = glm::ivec3(glm::floor(positions[i] / cell));
-        for (int dz = -1; dz <= 1 && !blocked; ++dz)
-          for (int dy = -1; dy <= 1 && !blocked; ++dy)
-            for (int dx = -1; dx <= 1 && !blocked; ++dx) {
-              auto range = grid.equal_range(key(q + glm::ivec3(dx, dy, dz)));
-              for (auto it = range.first; it != range.second && !blocked; ++it) {
-                const std::size_t j = it->second;
-                blocked = glm::length(positions[j] - positions[i]) < spacing && glm::dot(normals[j], normals[i]) > 0.9f;
-              }
-            }
-        if (!blocked) grid.emplace(key(q), i);
-      }
-      if (!blocked) seeds.push_back(i);
+    for (const tally& t : tallies) {
+      round.points_checked += t.checked;
+      round.records_visited += t.visited;
+      round.max_records_visited = std::max(round.max_records_visited, t.max_visited);
+      for (std::size_t k = 0; k < t.histogram.size(); ++k) stats_.records_visited_histogram[k] += t.histogram[k];
     }
+    std::fill(dirty_.begin(), dirty_.end(), std::uint8_t(0));
+  }
 
-    // 3. Render the seeds in parallel; results land in per-seed slots (deterministic).
+  // The coverage test of one point (coverage_pass); `visited` counts the records the query saw.
+  void check_point(std::size_t i, float floor_e, std::size_t& visited) {
+    const float a = o_.error_threshold;
+    glm::vec3 value;
+    float spread = 0.0f;
+    bool own = false;
+    coverage_detail detail;
+    detail.floor = floor_e;
+    const bool second_opinion = o_.second_opinion > 0.0f;
+    const bool nearby_opinion = o_.nearby_opinion > 0.0f;
+    const bool sole_reach = o_.sole_record_reach < 1.0f;
+    const float w = interpolate(records_, bvh_, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
+    visited = detail.visited;
+    bool ok = w > 0.0f;
+    // Presumed inside: a valid record that covers the point contests the presumption (the point
+    // may lie across a contact from the invalid sample); from then on it needs its own hemicube.
+    if (presumed_[i] && !contested_[i]) {
+      if (!ok) {
+        covered_[i] = 0;
+        fragile_[i] = 0;
+        return;
+      }
+      contested_[i] = 1;
+    }
+    if (contested_[i]) ok = ok && own;
+    // A covering record that saw back faces stands at a contact or an intersection: its
+    // neighbours get their own hemicubes rather than its extrapolation.
+    if (ok && !own && detail.max_backface > contact_backface_) ok = false;
+    bool leans_on_floor = false;
+    if (ok && o_.refine_disagreement && !own) {
+      ok = spread <= a * std::max(luminance(value), floor_e);
+      leans_on_floor = ok && spread > a * luminance(value);
+    }
+    // Second opinion: a point that only one record covers is not covered while that record's
+    // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
+    // disagree with an extrapolation that may be wrong (an edge between two rows of points, a
+    // second derivative the gradient does not see).
+    if (ok && second_opinion && !own && detail.records == 1) {
+      ok = detail.first_order <= o_.second_opinion * a;
+      leans_on_floor = leans_on_floor || (ok && floor_e > 0.0f);  // the floor moves: re-check
+    }
+    // Sole record reach: a point that one record covers must lie inside sole_record_reach of
+    // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
+    if (ok && sole_reach && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
+      ok = detail.max_weight >= 1.0f / (o_.sole_record_reach * a);
+    // Nearby opinion: records near a point that one record covers, which do not cover it
+    // themselves, must predict the same there within a (a hard shadow edge between two rows of
+    // points is invisible to the covering record's gradient, not to a record beyond it).
+    if (ok && nearby_opinion && !own && detail.records == 1) {
+      ok = nearby_records_agree(i, detail, floor_e);
+      // Records added near the point later can change the answer (and the floor moves): re-check.
+      leans_on_floor = true;
+    }
+    covered_[i] = ok ? 1 : 0;
+    fragile_[i] = leans_on_floor ? 1 : 0;
+  }
+
+  bool nearby_records_agree(std::size_t i, const coverage_detail& detail, float floor_e) const {
+    const glm::vec3 x = p_[i], nx = n_[i];
+    const float la = std::max(detail.last_prediction, 0.0f);
+    const float tolerance = o_.error_threshold * std::max(la, floor_e);
+    bool ok = true;
+    grid_of_points_.for_each_in_sphere(x, nearby_reach_, [&](std::uint32_t j) {
+      const std::int32_t k = record_at_point_[j];
+      if (!ok || k < 0 || std::uint32_t(k) == detail.last) return;
+      const cache_record& rb = records_[std::size_t(k)];
+      if (glm::dot(rb.normal, nx) <= 0.9f || record_is_behind(rb, x, nx)) return;
+      const float lb = luminance(glm::max(extrapolate(rb, x, nx, o_.use_gradients ? 1 : 0), glm::vec3(0.0f)));
+      if (std::fabs(lb - la) > tolerance) ok = false;
+    });
+    return ok;
+  }
+
+  // 2. Seeds: open points in the fixed order, at least `spacing` from this round's earlier seeds
+  // of a similar normal (each seed blocks the points around it); at the finest spacing every
+  // open point is a seed.
+  std::vector<std::size_t> pick_seeds() {
+    std::vector<std::size_t> seeds;
+    const bool finest = !(spacing_ > finest_);
+    if (!finest) blocked_.assign(count_, 0);
+    for (std::size_t i : order_) {
+      if (!open(i) || (!finest && blocked_[i])) continue;
+      seeds.push_back(i);
+      if (finest) continue;
+      // Every point this seed blocks for the rest of the round.
+      const glm::vec3 c = p_[i], nc = n_[i];
+      grid_of_points_.for_each_in_sphere(c, spacing_, [&](std::uint32_t j) {
+        if (glm::length(p_[j] - c) < spacing_ && glm::dot(n_[j], nc) > 0.9f) blocked_[j] = 1;
+      });
+    }
+    return seeds;
+  }
+
+  // 3. The seeds' hemicubes in parallel; results land in per-seed slots (deterministic).
+  std::vector<cache_sample> render_seeds(const std::vector<std::size_t>& seeds, std::size_t open_points) {
     std::vector<cache_sample> samples(seeds.size());
     std::atomic<bool> cancel{false};
     std::atomic<std::size_t> done{0};
-    const float covered_fraction = 1.0f - float(open) / float(count);
-    parallel_for(seeds.size(), threads, 1, [&](int worker, std::size_t b, std::size_t e) {
+    const float covered_fraction = 1.0f - float(open_points) / float(count_);
+    parallel_for(seeds.size(), threads_, 1, [&](int worker, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e && !cancel; ++k) {
-        samples[k] = sampler(worker, positions[seeds[k]], normals[seeds[k]]);
+        samples[k] = sampler_(worker, p_[seeds[k]], n_[seeds[k]]);
         const std::size_t finished = ++done;
         // Worker 0 is the calling thread: the only one that calls progress.
-        if (worker == 0 && o.progress) {
-          reported = std::max(reported, covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f);
-          if (!o.progress(reported)) cancel = true;
+        if (worker == 0 && o_.progress) {
+          reported_ = std::max(reported_, covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f);
+          if (!o_.progress(reported_)) cancel = true;
         }
       }
     });
     if (cancel) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
-    stats.hemicubes += seeds.size();
+    stats_.hemicubes += seeds.size();
+    return samples;
+  }
 
-    // 4. New records in seed order, with their radius limits.
-    const std::size_t first_new = records.size();
-    old_radius.resize(first_new);
-    for (std::size_t j = 0; j < first_new; ++j) old_radius[j] = records[j].radius;
+  // 4. New records in seed order with their own radius limits (split sphere, gradient limit,
+  // clamp to [min_radius, max_radius]); invalid samples mark their point and, within their
+  // exclusion ball, the points on the same side of the same surface (presume_inside). Returns
+  // the index of the first new record.
+  std::size_t append_records(const std::vector<std::size_t>& seeds, const std::vector<cache_sample>& samples,
+                             cache_round_stats& round) {
+    const std::size_t first_new = records_.size();
+    old_radius_.resize(first_new);
+    for (std::size_t j = 0; j < first_new; ++j) old_radius_[j] = records_[j].radius;
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
       const cache_sample& s = samples[k];
-      if (s.backface_fraction > o.invalid_backface_fraction) {
-        ++stats.invalid_samples;
-        inside[i] = 1;
-        // Nothing lies nearer than min_distance in the visible half-space: points within most
-        // of that distance are inside the same closed region.
-        const float ball = std::isfinite(s.min_distance) ? 0.9f * s.min_distance : 0.0f;
-        invalid_balls.emplace_back(positions[i], ball);
+      if (s.backface_fraction > o_.invalid_backface_fraction) {
+        ++stats_.invalid_samples;
+        ++round.invalid_samples;
+        own_invalid_[i] = 1;
+        presume_inside(i, s.min_distance);
         continue;
       }
-      cache_record r;
-      r.position = positions[i];
-      r.normal = normals[i];
-      r.irradiance = s.irradiance;
-      r.rotation_gradient = s.rotation_gradient;
-      r.translation_gradient = s.translation_gradient;
-      r.harmonic_distance = s.harmonic_mean_distance;
-      if (o.directional) {
-        r.sh_l1 = s.sh_l1;
-        r.cone = s.cone;
-      }
-      float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o.max_radius;
-      if (o.gradient_radius_limit) {
-        const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
-                                     0.0722f * s.translation_gradient[2]);
-        const float e = luminance(s.irradiance);
-        if (gt > 0.0f && e > 0.0f) radius = std::min(radius, e / gt);
-      }
-      r.radius = std::clamp(radius, o.min_radius, o.max_radius);
-      records.push_back(r);
-      record_at_point[i] = static_cast<std::int32_t>(records.size() - 1);
+      records_.push_back(make_record(i, s));
+      record_at_point_[i] = static_cast<std::int32_t>(records_.size() - 1);
     }
-    // Points within an invalid sample's exclusion ball are inside geometry too.
-    if (!invalid_balls.empty()) {
-      parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          if (inside[i]) continue;
-          for (const auto& ball : invalid_balls)
-            if (glm::length(positions[i] - ball.first) < ball.second) {
-              inside[i] = 1;
-              break;
-            }
-        }
-      });
-      invalid_balls.clear();  // applied; later rounds only add new ones
-    }
-
-    // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
-    // over pairs (new record, any record) within reach (deterministic).
-    const bool built = records.size() > first_new && (o.neighbour_clamp || o.shrink_disagreeing);
-    if (built) {
-      bvh.build(records, o, threads);
-      // Candidates of each new record: records whose coverage box holds x_i (the tree is not
-      // rebuilt during the sequential pass below, so these are gathered first, in parallel).
-      std::vector<std::vector<std::uint32_t>> candidates(records.size() - first_new);
-      parallel_for(candidates.size(), threads, 64, [&](int, std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          std::vector<std::uint32_t>& near = candidates[k];
-          bvh.query(records[first_new + k].position, [&](std::uint32_t j) { near.push_back(j); });
-          std::sort(near.begin(), near.end());
-        }
-      });
-      for (std::size_t i = first_new; i < records.size(); ++i) {
-        for (std::uint32_t j : candidates[i - first_new]) {
-          if (std::size_t(j) == i) continue;
-          cache_record& ri = records[i];
-          cache_record& rj = records[j];
-          const float d = glm::length(ri.position - rj.position);
-          if (o.neighbour_clamp) {
-            ri.radius = std::max(o.min_radius, std::min(ri.radius, rj.radius + d));
-            rj.radius = std::max(o.min_radius, std::min(rj.radius, ri.radius + d));
-          }
-          if (o.shrink_disagreeing && glm::dot(ri.normal, rj.normal) > 0.9f && d > 0.0f) {
-            // Each record's first-order prediction of the other's irradiance (luminance).
-            const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
-            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
-            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
-            const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
-            if (err > a) {
-              // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
-              const float r_gap = std::max(o.min_radius, 0.4f * d / a);
-              ri.radius = std::min(ri.radius, r_gap);
-              rj.radius = std::min(rj.radius, r_gap);
-            }
-          }
-        }
-      }
-    }
-    // Points whose coverage this round's records can have changed (a shrunk record's old
-    // sphere holds its new one).
-    for (std::size_t j = 0; j < records.size(); ++j) {
-      const bool added = j >= first_new;
-      if (!added && records[j].radius == old_radius[j]) continue;
-      const float r = coverage_radius(records[j], o);
-      const float reach = added ? r : std::max(r, a * old_radius[j]);
-      // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
-      grid_of_points.for_each_in_sphere(records[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
-    }
-    // Only radii changed since the build above (if there was one): refit its boxes.
-    if (built) bvh.refit(records, o);
-    else bvh.build(records, o, threads);
-    ++stats.rounds;
-    if (spacing > finest) spacing = std::max(finest, 0.5f * spacing);
-    else if (seeds.empty()) break;  // defensive: nothing could be placed
+    round.records_added = records_.size() - first_new;
+    return first_new;
   }
 
-  if (o.second_order && o.use_gradients) fit_hessians(records, o, threads);
-
-  // Final interpolation (parallel); points inside geometry or left uncovered are filled from the
-  // nearest valid records (weights without the threshold: 1 / (d / R + sqrt(1 - n.n_i))).
-  cache_result result;
-  result.irradiance.assign(count, glm::vec3(0.0f));
-  result.valid.assign(count, 0);
-  if (o.directional) {
-    result.sh_l1.assign(count, std::array<glm::vec3, 4>{});
-    result.cone.assign(count, hl2_cone{});
-  }
-  parallel_for(count, threads, 4096, [&](int, std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      glm::vec3 v;
-      std::array<glm::vec3, 4> sh{};
-      hl2_cone cone;
-      if (!inside[i] && interpolate(records, bvh, positions[i], normals[i], o, v, nullptr, nullptr, o.directional ? &sh : nullptr,
-                                    o.directional ? &cone : nullptr) > 0.0f) {
-        result.irradiance[i] = v;
-        result.valid[i] = 1;
-        if (o.directional) {
-          result.sh_l1[i] = sh;
-          result.cone[i] = cone;
-        }
-      }
+  cache_record make_record(std::size_t i, const cache_sample& s) const {
+    cache_record r;
+    r.position = p_[i];
+    r.normal = n_[i];
+    r.irradiance = s.irradiance;
+    r.rotation_gradient = s.rotation_gradient;
+    r.translation_gradient = s.translation_gradient;
+    r.harmonic_distance = s.harmonic_mean_distance;
+    r.backface_fraction = s.backface_fraction;
+    if (o_.directional) {
+      r.sh_l1 = s.sh_l1;
+      r.cone = s.cone;
     }
-  });
-  std::vector<std::size_t> fill;
-  for (std::size_t i = 0; i < count; ++i)
-    if (!result.valid[i]) fill.push_back(i);
-  stats.invalid_points = fill.size();
-  if (!records.empty() && !fill.empty()) {
-    parallel_for(fill.size(), threads, 256, [&](int, std::size_t b, std::size_t e) {
+    float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o_.max_radius;
+    if (o_.gradient_radius_limit) {
+      const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
+                                   0.0722f * s.translation_gradient[2]);
+      const float e = luminance(s.irradiance);
+      if (gt > 0.0f && e > 0.0f) radius = std::min(radius, e / gt);
+    }
+    r.radius = std::clamp(radius, o_.min_radius, o_.max_radius);
+    return r;
+  }
+
+  // An invalid sample at point i saw nothing nearer than min_distance in its visible half-space:
+  // points within 0.9 of that distance, on the visible side of its tangent plane (not below it by
+  // more than 1% of the ball) and with a similar normal (n . n_i > 0.9), lie in the same closed
+  // region, so they are presumed inside without a hemicube of their own. Points on other surfaces
+  // (a wall meeting the floor, a slab's underside inside another slab) are never presumed: the
+  // ball says nothing behind the sample. A valid record covering a presumed point contests it
+  // (check_point).
+  void presume_inside(std::size_t i, float min_distance) {
+    if (!std::isfinite(min_distance) || !(min_distance > 0.0f)) return;
+    const float ball = 0.9f * min_distance;
+    const glm::vec3 c = p_[i], nc = n_[i];
+    grid_of_points_.for_each_in_sphere(c, ball, [&](std::uint32_t j) {
+      if (presumed_[j] || glm::dot(n_[j], nc) <= 0.9f || glm::dot(p_[j] - c, nc) < -0.01f * ball) return;
+      presumed_[j] = 1;
+      dirty_[j] = 1;
+    });
+  }
+
+  // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
+  // over pairs (new record, any record) within reach (deterministic). Returns whether it built
+  // the record tree (then only radii changed since, and a refit suffices).
+  bool limit_radii(std::size_t first_new) {
+    if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return false;
+    const float a = o_.error_threshold;
+    bvh_.build(records_, o_, threads_);
+    // Candidates of each new record: records whose coverage box holds x_i (the tree is not
+    // rebuilt during the sequential pass below, so these are gathered first, in parallel).
+    std::vector<std::vector<std::uint32_t>> candidates(records_.size() - first_new);
+    parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
-        const std::size_t i = fill[k];
-        // The 8 records of largest relaxed weight (brute force: only filled points pay this).
-        std::array<std::pair<float, std::uint32_t>, 8> best;
-        best.fill({0.0f, 0u});
-        for (std::size_t j = 0; j < records.size(); ++j) {
-          const cache_record& r = records[j];
-          const float denom = glm::length(positions[i] - r.position) / r.radius +
-                              std::sqrt(std::max(0.0f, 1.0f - glm::dot(normals[i], r.normal)));
-          const float w = 1.0f / std::max(denom, 1e-12f);
-          if (w > best.back().first) {
-            best.back() = {w, static_cast<std::uint32_t>(j)};
-            std::sort(best.begin(), best.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+        std::vector<std::uint32_t>& near = candidates[k];
+        bvh_.query(records_[first_new + k].position, [&](std::uint32_t j) { near.push_back(j); });
+        std::sort(near.begin(), near.end());
+      }
+    });
+    for (std::size_t i = first_new; i < records_.size(); ++i) {
+      for (std::uint32_t j : candidates[i - first_new]) {
+        if (std::size_t(j) == i) continue;
+        cache_record& ri = records_[i];
+        cache_record& rj = records_[j];
+        const float d = glm::length(ri.position - rj.position);
+        if (o_.neighbour_clamp) {
+          ri.radius = std::max(o_.min_radius, std::min(ri.radius, rj.radius + d));
+          rj.radius = std::max(o_.min_radius, std::min(rj.radius, ri.radius + d));
+        }
+        if (o_.shrink_disagreeing && glm::dot(ri.normal, rj.normal) > 0.9f && d > 0.0f) {
+          // Each record's first-order prediction of the other's irradiance (luminance).
+          const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
+          const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
+          const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
+          const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
+          if (err > a) {
+            // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
+            const float r_gap = std::max(o_.min_radius, 0.4f * d / a);
+            ri.radius = std::min(ri.radius, r_gap);
+            rj.radius = std::min(rj.radius, r_gap);
           }
         }
-        glm::vec3 sum(0.0f);
+      }
+    }
+    return true;
+  }
+
+  // 6. Points whose coverage this round's records can have changed (a shrunk record's old
+  // sphere holds its new one) are re-checked in the next coverage pass.
+  void mark_dirty(std::size_t first_new) {
+    const float a = o_.error_threshold;
+    for (std::size_t j = 0; j < records_.size(); ++j) {
+      const bool added = j >= first_new;
+      if (!added && records_[j].radius == old_radius_[j]) continue;
+      const float r = coverage_radius(records_[j], o_);
+      const float reach = added ? r : std::max(r, a * old_radius_[j]);
+      // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
+      grid_of_points_.for_each_in_sphere(records_[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty_[i] = 1; });
+    }
+  }
+
+  // 7. Final interpolation (parallel) of every point that is not inside geometry.
+  void interpolate_all(cache_result& result) const {
+    result.irradiance.assign(count_, glm::vec3(0.0f));
+    result.valid.assign(count_, 0);
+    if (o_.directional) {
+      result.sh_l1.assign(count_, std::array<glm::vec3, 4>{});
+      result.cone.assign(count_, hl2_cone{});
+    }
+    parallel_for(count_, threads_, 4096, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
-        cone.reference = make_frame(normals[i]).t;
-        float wsum = 0.0f;
-        for (const auto& bw : best)
-          if (bw.first > 0.0f) {
-            const cache_record& rec = records[bw.second];
-            sum += bw.first * rec.irradiance;
-            if (o.directional) {
-              for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
-              const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
-              for (std::size_t c = 0; c < std::size_t(hl2_cone_terms); ++c) cone.coefficients[c] += bw.first * rc.coefficients[c];
-            }
-            wsum += bw.first;
+        if (!inside(i) && interpolate(records_, bvh_, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
+                                      o_.directional ? &cone : nullptr) > 0.0f) {
+          result.irradiance[i] = v;
+          result.valid[i] = 1;
+          if (o_.directional) {
+            result.sh_l1[i] = sh;
+            result.cone[i] = cone;
           }
-        result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
-        if (o.directional && wsum > 0.0f) {
-          for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
-          for (glm::vec3& c : cone.coefficients) c /= wsum;
-          result.cone[i] = cone;
         }
       }
     });
   }
-  stats.records = records.size();
-  stats.min_radius = o.min_radius;
-  stats.max_radius = o.max_radius;
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  report(1.0f);
-  result.records = std::move(records);
-  result.stats = stats;
-  return result;
+
+  // 8. Points inside geometry (or, defensively, left uncovered) get the relaxed-weight average
+  // (1 / (d / R + sqrt(1 - n.n_i)), no threshold) of the 8 best records on the same side of
+  // their surface (n . n_i > 0.5, not behind), searched in spheres that double from 4 x the finest
+  // seed spacing; from the third doubling on, of any records in the sphere.
+  std::size_t count_invalid(const cache_result& result) const {
+    std::size_t invalid = 0;
+    for (std::uint8_t v : result.valid) invalid += v ? 0u : 1u;
+    return invalid;
+  }
+
+  void fill_invalid(cache_result& result) {
+    std::vector<std::size_t> fill;
+    for (std::size_t i = 0; i < count_; ++i)
+      if (!result.valid[i]) fill.push_back(i);
+    stats_.invalid_points = fill.size();
+    if (records_.empty() || fill.empty()) return;
+    std::vector<glm::vec3> where(records_.size());
+    for (std::size_t j = 0; j < records_.size(); ++j) where[j] = records_[j].position;
+    point_grid grid;
+    grid.build(where.data(), where.size());
+    parallel_for(fill.size(), threads_, 256, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) fill_point(fill[k], grid, result);
+    });
+  }
+
+  void fill_point(std::size_t i, const point_grid& grid, cache_result& result) const {
+    std::array<std::pair<float, std::uint32_t>, 8> best;
+    best.fill({0.0f, 0u});
+    const auto consider = [&](std::uint32_t j, bool same_side) {
+      const cache_record& r = records_[j];
+      if (same_side && (glm::dot(n_[i], r.normal) <= 0.5f || record_is_behind(r, p_[i], n_[i]))) return;
+      const float denom = glm::length(p_[i] - r.position) / r.radius + std::sqrt(std::max(0.0f, 1.0f - glm::dot(n_[i], r.normal)));
+      const float w = 1.0f / std::max(denom, 1e-12f);
+      if (w > best.back().first || (w == best.back().first && j < best.back().second && w > 0.0f)) {
+        best.back() = {w, j};
+        // Weight, then index: a fixed order whatever order the grid visits records in.
+        std::sort(best.begin(), best.end(), [](const auto& x, const auto& y) {
+          return x.first > y.first || (x.first == y.first && x.second < y.second);
+        });
+      }
+    };
+    // Doubling spheres: records on the point's side first; from 4 x the first radius on, any
+    // record in the sphere (a point deep inside a solid may have no record on its side nearby).
+    const float first = 4.0f * std::max(finest_, 1e-30f);
+    for (float radius = first; best.front().first == 0.0f; radius *= 2.0f) {
+      grid.for_each_in_sphere(p_[i], radius, [&](std::uint32_t j) { consider(j, true); });
+      if (best.front().first == 0.0f && radius >= 4.0f * first)
+        grid.for_each_in_sphere(p_[i], radius, [&](std::uint32_t j) { consider(j, false); });
+      if (radius > 2.0f * diagonal_ + o_.max_radius) break;
+    }
+    if (best.front().first == 0.0f)  // defensive: the spheres above end beyond every record
+      for (std::uint32_t j = 0; j < records_.size(); ++j) consider(j, false);
+    glm::vec3 sum(0.0f);
+    std::array<glm::vec3, 4> sh{};
+    hl2_cone cone;
+    cone.reference = make_frame(n_[i]).t;
+    float wsum = 0.0f;
+    for (const auto& bw : best)
+      if (bw.first > 0.0f) {
+        const cache_record& rec = records_[bw.second];
+        sum += bw.first * rec.irradiance;
+        if (o_.directional) {
+          for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
+          const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
+          for (std::size_t c = 0; c < std::size_t(hl2_cone_terms); ++c) cone.coefficients[c] += bw.first * rc.coefficients[c];
+        }
+        wsum += bw.first;
+      }
+    result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+    if (o_.directional && wsum > 0.0f) {
+      for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
+      for (glm::vec3& c : cone.coefficients) c /= wsum;
+      result.cone[i] = cone;
+    }
+  }
+
+  const glm::vec3* p_;
+  const glm::vec3* n_;
+  std::size_t count_;
+  const irradiance_sampler& sampler_;
+  cache_options o_;
+  cache_options coverage_options_;
+  int threads_ = 1;
+  float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
+  float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (check_point)
+  std::vector<cache_record> records_;
+  record_bvh bvh_;
+  point_grid grid_of_points_;
+  std::vector<std::uint8_t> covered_, dirty_, fragile_, own_invalid_, presumed_, contested_;
+  std::vector<std::uint8_t> blocked_;  // pick_seeds: within spacing of an earlier seed of the round
+  std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
+  std::vector<std::size_t> order_;             // the fixed pseudo-random order of the points
+  std::vector<float> old_radius_;
+  cache_stats stats_;
+};
+
+}  // namespace
+
+cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
+                              const irradiance_sampler& sampler, const cache_options& options) {
+  validate(positions, normals, count, options);
+  if (!sampler) throw_invalid_argument("cache_irradiance: sampler is empty");
+  return placement(positions, normals, count, sampler, options).run();
 }
+
 
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
   if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");

@@ -88,6 +88,11 @@ struct cache_record {
   std::array<glm::vec3, 3> translation_gradient{};
   float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
   float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
+  /// The sample's irradiance_sample::backface_fraction (at most invalid_backface_fraction, or it
+  /// would not be a record). Points covered by a record with a nonzero value (other than the
+  /// record's own point) get their own hemicube: such a record stands at a contact or where
+  /// surfaces intersect.
+  float backface_fraction = 0.0f;
   /// L1 spherical harmonics of the incoming radiance, world space, the sample's
   /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
   /// channel c: sh_l1[k][c]). Zero unless cache_options::directional.
@@ -179,6 +184,11 @@ struct cache_options {
   /// forms per covering record and point.
   bool second_order = true;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
+  /// Give the points that are not interpolated (inside geometry: cache_result::valid = 0) the
+  /// relaxed-weight average of the nearest records on their side of the surface. Off: they are
+  /// left at 0, for callers that fill them in their own terms (the baker dilates valid texels of
+  /// the same chart into them).
+  bool fill_invalid = true;
   /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
   /// sh_l1; the sampler must compute it: make_hemicube_sampler with sh_l1 or
   /// integrate.directional) and its HL2 cone (cache_sample::cone, hemicube_sampler_options::hl2_cone;
@@ -195,15 +205,48 @@ struct cache_options {
   std::function<bool(float fraction)> progress;
 };
 
+/// What one placement round of cache_irradiance did (cache_stats::round_details).
+struct cache_round_stats {
+  float spacing = 0.0f;                  ///< the round's seed spacing (scene units)
+  std::size_t points_checked = 0;        ///< points whose coverage the round's coverage pass tested
+  std::size_t records_visited = 0;       ///< records the tested points' queries visited, summed
+  std::size_t max_records_visited = 0;   ///< the most records one query visited
+  std::size_t open_points = 0;           ///< points left open after the coverage pass
+  std::size_t seeds = 0;                 ///< hemicubes rendered in the round
+  std::size_t records_added = 0;         ///< of them valid (records)
+  std::size_t invalid_samples = 0;       ///< of them inside geometry
+  double coverage_seconds = 0.0, seed_seconds = 0.0, render_seconds = 0.0, update_seconds = 0.0;  ///< wall time per stage
+};
+
 /// Statistics of one cache run.
 struct cache_stats {
   std::size_t hemicubes = 0;        ///< hemicubes rendered (records + invalid samples)
   std::size_t records = 0;          ///< records kept
-  std::size_t invalid_samples = 0;  ///< samples rejected for seeing back faces
-  std::size_t invalid_points = 0;   ///< points filled from records around them
-  std::size_t rounds = 0;           ///< placement rounds
+  std::size_t invalid_samples = 0;  ///< samples rejected for seeing back faces (their own point is inside geometry)
+  /// Points not interpolated (cache_result::valid = 0): invalid samples' own points and points
+  /// presumed inside geometry near them (cache.hpp, top), filled from records on their side.
+  std::size_t invalid_points = 0;
+  std::size_t rounds = 0;           ///< placement rounds that rendered hemicubes
   double seconds = 0.0;             ///< wall time
+  /// Wall time of rendering and integrating hemicubes (render), of the final interpolation and
+  /// fill (interpolation), and of everything else (placement: coverage passes, seed picking,
+  /// record updates, automatic radii, second-order fits): the three add up to `seconds`.
+  double placement_seconds = 0.0, render_seconds = 0.0, interpolation_seconds = 0.0;
   float min_radius = 0.0f, max_radius = 0.0f;  ///< the radii used (after automatic defaults)
+  std::vector<cache_round_stats> round_details;  ///< per round, including the last (coverage only)
+  /// Records visited per coverage query, over all rounds: bucket 0 counts queries that visited
+  /// none, bucket k >= 1 those that visited [2^(k-1), 2^k) records, the last bucket everything above.
+  static constexpr std::size_t histogram_buckets = 16;
+  std::array<std::size_t, histogram_buckets> records_visited_histogram{};
+  /// The bucket of a visit count v (see records_visited_histogram).
+  static constexpr std::size_t histogram_bucket(std::size_t v) noexcept {
+    std::size_t k = 0;
+    while (v > 0 && k + 1 < histogram_buckets) {
+      v >>= 1;
+      ++k;
+    }
+    return k;
+  }
 };
 
 /// Renders and integrates one hemicube at (position, unit normal). `worker` is in
