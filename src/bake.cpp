@@ -377,37 +377,270 @@ std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings) {
                            std::to_string(texels));
   if (rings < -1) throw_invalid_argument("dilate: rings " + std::to_string(rings) + " must be >= -1");
   const int w = img.width, h = img.height, ch = img.channels;
-  std::size_t total = 0;
-  std::vector<std::size_t> fresh;
-  for (int ring = 0; rings < 0 || ring < rings; ++ring) {
-    fresh.clear();
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t k = std::size_t(y) * std::size_t(w) + std::size_t(x);
-        if (filled[k]) continue;
-        float acc[4] = {0, 0, 0, 0};
-        int n = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx, ny = y + dy;
-            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-            if (!filled[std::size_t(ny) * std::size_t(w) + std::size_t(nx)]) continue;
-            const float* p = img.at(nx, ny);
-            for (int c = 0; c < ch; ++c) acc[c] += p[c];
-            ++n;
-          }
-        if (n == 0) continue;
-        float* p = img.at(x, y);
-        for (int c = 0; c < ch; ++c) p[c] = acc[c] / float(n);
-        fresh.push_back(k);
+  const auto neighbours = [&](std::size_t k, auto&& f) {
+    const int x = int(k % std::size_t(w)), y = int(k / std::size_t(w));
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = x + dx, ny = y + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+        f(std::size_t(ny) * std::size_t(w) + std::size_t(nx), nx, ny);
       }
-    if (fresh.empty()) break;
+  };
+  // Candidates of a ring: empty texels next to a texel filled before it (the first ring: next to
+  // any filled texel; later rings: next to the previous ring's texels). Kept sorted, so each
+  // ring's writes are in texel order (they do not depend on it: a ring reads only older texels).
+  std::vector<std::size_t> candidates, fresh;
+  std::vector<std::uint8_t> queued(texels, 0);
+  for (std::size_t k = 0; k < texels; ++k)
+    if (!filled[k]) {
+      bool next_to_filled = false;
+      neighbours(k, [&](std::size_t q, int, int) { next_to_filled = next_to_filled || filled[q]; });
+      if (next_to_filled) {
+        candidates.push_back(k);
+        queued[k] = 1;
+      }
+    }
+  std::size_t total = 0;
+  for (int ring = 0; (rings < 0 || ring < rings) && !candidates.empty(); ++ring) {
+    fresh.clear();
+    for (std::size_t k : candidates) {
+      float acc[4] = {0, 0, 0, 0};
+      int n = 0;
+      neighbours(k, [&](std::size_t q, int nx, int ny) {
+        if (!filled[q]) return;
+        const float* p = img.at(nx, ny);
+        for (int c = 0; c < ch; ++c) acc[c] += p[c];
+        ++n;
+      });
+      if (n == 0) continue;
+      float* p = img.pixels.data() + k * std::size_t(ch);
+      for (int c = 0; c < ch; ++c) p[c] = acc[c] / float(n);
+      fresh.push_back(k);
+    }
     // Marked after the ring: a ring reads only texels filled before it (order independent).
     for (std::size_t k : fresh) filled[k] = 1;
     total += fresh.size();
+    candidates.clear();
+    for (std::size_t k : fresh)
+      neighbours(k, [&](std::size_t q, int, int) {
+        if (!filled[q] && !queued[q]) {
+          queued[q] = 1;
+          candidates.push_back(q);
+        }
+      });
+    std::sort(candidates.begin(), candidates.end());
   }
   return total;
 }
+
+namespace {
+
+// The per-sample state of a bake (bake_lightmap's stages below), for sampled texels only.
+struct sample_points {
+  std::vector<std::size_t> texel_of;     // texel index of each sample
+  std::vector<glm::vec3> positions, normals;
+};
+
+// L1 SH per sample, coefficient-major (sh[k][i]).
+using sh_planes = std::array<std::vector<glm::vec3>, 4>;
+
+// What one pass gives per sample.
+struct pass_values {
+  std::vector<glm::vec3> e;
+  sh_planes sh;                 // with directional outputs in this pass
+  std::vector<hl2_cone> cone;   // with output_hl2 in this pass (reference make_frame(normal).t)
+  std::vector<std::uint8_t> invalid;  // 1: the sample is inside geometry (filled, not computed)
+};
+
+// Step 2 of bake.hpp: the sampled texels, offset along their normals.
+sample_points place_samples(const lightmap_samples& s, const scene& sc, const bake_options& o, bake_result& r) {
+  const std::size_t texels = s.coverage.size();
+  const float min_offset = 2.0f * default_near_distance(sc);
+  sample_points out;
+  r.coverage = s.coverage;
+  r.sampled.assign(texels, 0);
+  for (std::size_t k = 0; k < texels; ++k) {
+    if (s.coverage[k] > 0.0f) ++r.stats.covered_texels;
+    if (s.sample_triangle[k] == lightmap_samples::no_triangle || !(s.coverage[k] >= o.min_coverage) || !(s.coverage[k] > 0.0f))
+      continue;
+    r.sampled[k] = 1;
+    out.texel_of.push_back(k);
+    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[k]);
+    out.positions.push_back(s.position[k] + offset * s.normal[k]);
+    out.normals.push_back(s.normal[k]);
+  }
+  r.stats.sampled_texels = out.texel_of.size();
+  if (out.texel_of.empty())
+    throw_invalid_argument("bake_lightmap: no texel is covered by a triangle (coverage >= min_coverage): nothing to bake");
+  return out;
+}
+
+// Step 4's radiance texture for pass k > 1: emission + albedo E_{k-1} / pi of each texel's owner,
+// dilated (at least 2 rings) so that hemicubes looking at chart borders do not see black.
+image pass_radiance_texture(const lightmap_samples& s, const scene& sc, const sample_points& pts,
+                            const std::vector<glm::vec3>& e, const bake_options& o) {
+  image texture = image::make(o.width, o.height, 3);
+  std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
+  for (std::size_t i = 0; i < pts.texel_of.size(); ++i) {
+    const std::size_t k = pts.texel_of[i];
+    const material& m = sc.triangle_material(s.owner[k]);
+    const glm::vec3 l = m.emission + m.albedo * e[i] / pi_f;
+    std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
+    filled[k] = 1;
+  }
+  dilate(texture, filled, o.dilation < 0 ? -1 : std::max(o.dilation, 2));
+  return texture;
+}
+
+// One pass through the cache (bake_options::use_cache).
+pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, cache_options co, bool directional,
+                        const std::function<bool(float)>& progress, bake_stats& stats) {
+  const std::size_t count = pts.texel_of.size();
+  co.directional = directional;
+  co.fill_invalid = false;  // fill_invalid_samples dilates valid texels into them instead
+  if (progress) co.progress = progress;
+  cache_result cr = cache_irradiance(pts.positions.data(), pts.normals.data(), count, sampler, co);
+  pass_values v;
+  v.e = std::move(cr.irradiance);
+  v.invalid.resize(count);
+  for (std::size_t i = 0; i < count; ++i) v.invalid[i] = cr.valid[i] ? 0 : 1;
+  if (directional) {
+    for (auto& plane : v.sh) plane.resize(count);
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = cr.sh_l1[i][c];
+    v.cone = std::move(cr.cone);
+  }
+  stats.hemicubes += cr.stats.hemicubes;
+  stats.records += cr.stats.records;
+  stats.passes.push_back(cr.stats);
+  return v;
+}
+
+// One pass with a hemicube at every sample (use_cache = false: the reference), in blocks so that
+// progress and cancellation stay live.
+pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& sampler, const bake_options& o,
+                           bool directional, const std::function<bool(float)>& progress, bake_stats& stats) {
+  const auto tp = std::chrono::steady_clock::now();
+  const std::size_t count = pts.texel_of.size();
+  pass_values v;
+  v.e.resize(count);
+  v.invalid.assign(count, 0);
+  if (directional) {
+    for (auto& plane : v.sh) plane.assign(count, glm::vec3(0.0f));
+    v.cone.assign(count, hl2_cone{});
+  }
+  const std::size_t block = 2048;
+  for (std::size_t b = 0; b < count; b += block) {
+    if (progress && !progress(float(b) / float(count)))
+      throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+    const std::size_t end = std::min(count, b + block);
+    parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
+      for (std::size_t i = b + lo; i < b + hi; ++i) {
+        const cache_sample smp = sampler(worker, pts.positions[i], pts.normals[i]);
+        v.e[i] = smp.irradiance;
+        v.invalid[i] = smp.backface_fraction > o.cache.invalid_backface_fraction ? 1 : 0;
+        if (directional) {
+          for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = smp.sh_l1[c];
+          v.cone[i] = rotate_hl2_cone(smp.cone, pts.normals[i], make_frame(pts.normals[i]).t);
+        }
+      }
+    });
+  }
+  std::size_t invalid = 0;
+  for (std::uint8_t f : v.invalid) invalid += f;
+  cache_stats cs;
+  cs.hemicubes = count;
+  cs.records = count;
+  cs.invalid_samples = invalid;
+  cs.invalid_points = invalid;
+  cs.seconds = seconds_since(tp);
+  stats.hemicubes += count;
+  stats.records += count;
+  stats.passes.push_back(cs);
+  return v;
+}
+
+// Samples inside geometry get the values of the valid texels around them in the lightmap (texel
+// dilation until every such texel is reached): the same chart, so the same side of the same
+// surface, never a record across a wall. Used by both modes.
+void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_options& o) {
+  const std::size_t count = pts.texel_of.size();
+  std::size_t invalid = 0;
+  for (std::uint8_t f : v.invalid) invalid += f;
+  if (invalid == 0) return;
+  std::vector<std::uint8_t> filled(std::size_t(o.width) * std::size_t(o.height), 0);
+  for (std::size_t i = 0; i < count; ++i)
+    if (!v.invalid[i]) filled[pts.texel_of[i]] = 1;
+  const auto fill = [&](std::vector<glm::vec3>& values) {
+    image tmp = image::make(o.width, o.height, 3);
+    for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * pts.texel_of[i], &values[i], sizeof(glm::vec3));
+    std::vector<std::uint8_t> f = filled;
+    dilate(tmp, f, -1);
+    for (std::size_t i = 0; i < count; ++i)
+      if (v.invalid[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts.texel_of[i], sizeof(glm::vec3));
+  };
+  fill(v.e);
+  for (auto& plane : v.sh)
+    if (!plane.empty()) fill(plane);
+  if (!v.cone.empty()) {
+    // Cone coefficients term by term (neighbours on a chart share the normal and so the
+    // reference tangent).
+    std::vector<glm::vec3> plane(count);
+    for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) {
+      for (std::size_t i = 0; i < count; ++i) plane[i] = v.cone[i].coefficients[t];
+      fill(plane);
+      for (std::size_t i = 0; i < count; ++i) v.cone[i].coefficients[t] = plane[i];
+    }
+  }
+}
+
+// Step 5 and 6: the lightmap images from the last pass (less the first with indirect_only),
+// dilated around every chart.
+void write_outputs(const lightmap_samples& s, const sample_points& pts, const pass_values& last, const pass_values* first,
+                   const std::vector<std::uint8_t>& valid, const bake_options& o, bake_result& r) {
+  const std::size_t texels = std::size_t(o.width) * std::size_t(o.height);
+  const std::size_t count = pts.texel_of.size();
+  r.irradiance = image::make(o.width, o.height, 3);
+  r.valid.assign(texels, 0);
+  std::vector<std::uint8_t> filled(texels, 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t k = pts.texel_of[i];
+    glm::vec3 v = last.e[i];
+    if (first) v = glm::max(v - first->e[i], glm::vec3(0.0f));
+    std::memcpy(r.irradiance.pixels.data() + 3 * k, &v, sizeof v);
+    filled[k] = 1;
+    r.valid[k] = valid[i];
+    if (!valid[i]) ++r.stats.invalid_texels;
+  }
+  // Per-sample values written into images, each dilated from the same mask as the irradiance.
+  const auto to_image = [&](const auto& value_of) {
+    image img = image::make(o.width, o.height, 3);
+    for (std::size_t i = 0; i < count; ++i) {
+      const glm::vec3 v = value_of(i);
+      std::memcpy(img.pixels.data() + 3 * pts.texel_of[i], &v, sizeof v);
+    }
+    std::vector<std::uint8_t> f = filled;
+    dilate(img, f, o.dilation);
+    return img;
+  };
+  if (o.output_sh_l1)
+    for (std::size_t j = 0; j < 4; ++j)
+      r.sh_l1[j] = to_image([&](std::size_t i) { return first ? last.sh[j][i] - first->sh[j][i] : last.sh[j][i]; });
+  if (o.output_hl2) {
+    std::vector<std::array<glm::vec3, 3>> h(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t k = pts.texel_of[i];
+      hl2_cone c = last.cone[i];
+      if (first)
+        for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= first->cone[i].coefficients[t];
+      h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
+    }
+    for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = to_image([&](std::size_t i) { return h[i][j]; });
+  }
+  r.stats.dilated_texels = dilate(r.irradiance, filled, o.dilation);
+}
+
+}  // namespace
 
 bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -427,43 +660,18 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   const lightmap_samples s = compute_lightmap_samples(input, o.width, o.height);
   r.stats.coverage_seconds = seconds_since(t0);
   r.stats.overlapping_texels = s.overlapping_texels;
-  const std::size_t texels = r.stats.texels;
-
-  // Sampled texels, offset along their normals (bake.hpp, step 2).
-  const float min_offset = 2.0f * default_near_distance(*sc);
-  std::vector<std::size_t> texel_of;
-  std::vector<glm::vec3> positions, normals;
-  r.coverage = s.coverage;
-  r.sampled.assign(texels, 0);
-  for (std::size_t k = 0; k < texels; ++k) {
-    if (s.coverage[k] > 0.0f) ++r.stats.covered_texels;
-    if (s.sample_triangle[k] == lightmap_samples::no_triangle || !(s.coverage[k] >= o.min_coverage) || !(s.coverage[k] > 0.0f))
-      continue;
-    r.sampled[k] = 1;
-    texel_of.push_back(k);
-    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[k]);
-    positions.push_back(s.position[k] + offset * s.normal[k]);
-    normals.push_back(s.normal[k]);
-  }
-  const std::size_t count = texel_of.size();
-  r.stats.sampled_texels = count;
-  if (count == 0)
-    throw_invalid_argument("bake_lightmap: no texel is covered by a triangle (coverage >= min_coverage): nothing to bake");
+  const sample_points pts = place_samples(s, *sc, o, r);
+  const std::size_t count = pts.texel_of.size();
 
   const int workers = resolve_thread_count(o.thread_count);
   const bool directional = o.output_sh_l1 || o.output_hl2;
   cache_options co = o.cache;
   co.thread_count = o.thread_count;
-  std::vector<glm::vec3> e(count), e_first;
-  // L1 SH per sample, coefficient-major (sh[k][i]); only with directional outputs.
-  using sh_planes = std::array<std::vector<glm::vec3>, 4>;
-  sh_planes sh, sh_first;
-  // HL2 cones per sample, reference make_frame(normal).t (as cache_result::cone); only with output_hl2.
-  std::vector<hl2_cone> cone, cone_first;
+  co.progress = nullptr;
   std::vector<std::uint8_t> valid(count, 1);
+  pass_values current, first;
   image texture;
   radiance_texture texture_view;
-  const int tex_rings = o.dilation < 0 ? -1 : std::max(o.dilation, 2);
 
   // The cache's fraction can step back between rounds; the bake reports the running maximum.
   float reported = 0.0f;
@@ -483,169 +691,27 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     so.raster.sky = o.environment;
     so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
     so.hl2_cone = pass_directional && o.output_hl2;
-    co.directional = pass_directional;
     if (pass > 0) {
-      // Radiance texture of this pass: emission + albedo E_{k-1} / pi of each texel's owner.
-      texture = image::make(o.width, o.height, 3);
-      std::vector<std::uint8_t> filled(texels, 0);
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t k = texel_of[i];
-        const material& m = sc->triangle_material(s.owner[k]);
-        const glm::vec3 l = m.emission + m.albedo * e[i] / pi_f;
-        float* p = texture.pixels.data() + 3 * k;
-        p[0] = l.x;
-        p[1] = l.y;
-        p[2] = l.z;
-        filled[k] = 1;
-      }
-      dilate(texture, filled, tex_rings);
+      texture = pass_radiance_texture(s, *sc, pts, current.e, o);
       texture_view = radiance_texture(texture);
       so.texture = &texture_view;
     }
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
-    if (pass_directional) {
-      for (auto& plane : sh) plane.assign(count, glm::vec3(0.0f));
-      cone.assign(count, hl2_cone{});
-    }
-    if (o.use_cache) {
-      if (o.progress) co.progress = [&](float f) { return report(base + span * f); };
-      cache_result cr = cache_irradiance(positions.data(), normals.data(), count, sampler, co);
-      for (std::size_t i = 0; i < count; ++i) {
-        e[i] = cr.irradiance[i];
-        valid[i] = std::uint8_t(valid[i] & cr.valid[i]);
-        if (pass_directional) {
-          for (std::size_t c = 0; c < 4; ++c) sh[c][i] = cr.sh_l1[i][c];
-          cone[i] = cr.cone[i];
-        }
-      }
-      r.stats.hemicubes += cr.stats.hemicubes;
-      r.stats.records += cr.stats.records;
-      r.stats.passes.push_back(cr.stats);
-    } else {
-      // Reference mode: a hemicube at every sample, in blocks so progress and cancel stay live.
-      const auto tp = std::chrono::steady_clock::now();
-      std::vector<float> backface(count, 0.0f);
-      const std::size_t block = 2048;
-      for (std::size_t b = 0; b < count; b += block) {
-        if (o.progress && !report(base + span * float(b) / float(count)))
-          throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
-        const std::size_t end = std::min(count, b + block);
-        parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
-          for (std::size_t i = b + lo; i < b + hi; ++i) {
-            const cache_sample smp = sampler(worker, positions[i], normals[i]);
-            e[i] = smp.irradiance;
-            backface[i] = smp.backface_fraction;
-            if (pass_directional) {
-              for (std::size_t c = 0; c < 4; ++c) sh[c][i] = smp.sh_l1[c];
-              cone[i] = rotate_hl2_cone(smp.cone, normals[i], make_frame(normals[i]).t);
-            }
-          }
-        });
-      }
-      // Invalid samples (inside geometry) are filled from valid texel neighbours by dilation.
-      std::vector<std::uint8_t> filled(texels, 0);
-      std::size_t invalid = 0;
-      for (std::size_t i = 0; i < count; ++i) {
-        if (backface[i] > co.invalid_backface_fraction) {
-          valid[i] = 0;
-          ++invalid;
-        } else {
-          filled[texel_of[i]] = 1;
-        }
-      }
-      if (invalid > 0) {
-        const auto fill = [&](std::vector<glm::vec3>& values) {
-          image tmp = image::make(o.width, o.height, 3);
-          for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * texel_of[i], &values[i], sizeof(glm::vec3));
-          std::vector<std::uint8_t> f = filled;
-          dilate(tmp, f, -1);
-          for (std::size_t i = 0; i < count; ++i)
-            if (backface[i] > co.invalid_backface_fraction) std::memcpy(&values[i], tmp.pixels.data() + 3 * texel_of[i], sizeof(glm::vec3));
-        };
-        fill(e);
-        if (pass_directional) {
-          for (auto& plane : sh) fill(plane);
-          // Cone coefficients term by term (neighbours on a chart share the normal and so the
-          // reference tangent).
-          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) {
-            std::vector<glm::vec3> plane(count);
-            for (std::size_t i = 0; i < count; ++i) plane[i] = cone[i].coefficients[t];
-            fill(plane);
-            for (std::size_t i = 0; i < count; ++i) cone[i].coefficients[t] = plane[i];
-          }
-        }
-      }
-      cache_stats cs;
-      cs.hemicubes = count;
-      cs.records = count;
-      cs.invalid_samples = invalid;
-      cs.invalid_points = invalid;
-      cs.seconds = seconds_since(tp);
-      r.stats.hemicubes += count;
-      r.stats.records += count;
-      r.stats.passes.push_back(cs);
-    }
-    if (pass == 0 && o.indirect_only) {
-      e_first = e;
-      if (pass_directional) {
-        sh_first = sh;
-        cone_first = cone;
-      }
-    }
+    std::function<bool(float)> pass_progress;
+    if (o.progress) pass_progress = [&](float f) { return report(base + span * f); };
+    current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, r.stats)
+                          : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, r.stats);
+    fill_invalid_samples(pts, current, o);
+    for (std::size_t i = 0; i < count; ++i) valid[i] = std::uint8_t(valid[i] & (current.invalid[i] ? 0 : 1));
+    if (pass == 0 && o.indirect_only) first = current;
   }
   if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
-
-  r.irradiance = image::make(o.width, o.height, 3);
-  r.valid.assign(texels, 0);
-  std::vector<std::uint8_t> filled(texels, 0);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t k = texel_of[i];
-    glm::vec3 v = e[i];
-    if (o.indirect_only) v = glm::max(v - e_first[i], glm::vec3(0.0f));
-    float* p = r.irradiance.pixels.data() + 3 * k;
-    p[0] = v.x;
-    p[1] = v.y;
-    p[2] = v.z;
-    filled[k] = 1;
-    r.valid[k] = valid[i];
-    if (!valid[i]) ++r.stats.invalid_texels;
-  }
-  if (directional) {
-    // Per-sample values written into images, each dilated from the same mask as the irradiance.
-    const auto to_image = [&](const auto& value_of) {
-      image img = image::make(o.width, o.height, 3);
-      for (std::size_t i = 0; i < count; ++i) {
-        const glm::vec3 v = value_of(i);
-        std::memcpy(img.pixels.data() + 3 * texel_of[i], &v, sizeof v);
-      }
-      std::vector<std::uint8_t> f = filled;
-      dilate(img, f, o.dilation);
-      return img;
-    };
-    const auto coefficients = [&](std::size_t i) {
-      std::array<glm::vec3, 4> c;
-      for (std::size_t j = 0; j < 4; ++j) c[j] = o.indirect_only ? sh[j][i] - sh_first[j][i] : sh[j][i];
-      return c;
-    };
-    if (o.output_sh_l1)
-      for (std::size_t j = 0; j < 4; ++j) r.sh_l1[j] = to_image([&](std::size_t i) { return coefficients(i)[j]; });
-    if (o.output_hl2) {
-      std::vector<std::array<glm::vec3, 3>> h(count);
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t k = texel_of[i];
-        hl2_cone c = cone[i];
-        if (o.indirect_only)
-          for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= cone_first[i].coefficients[t];
-        h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
-      }
-      for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = to_image([&](std::size_t i) { return h[i][j]; });
-    }
-  }
-  r.stats.dilated_texels = dilate(r.irradiance, filled, o.dilation);
+  write_outputs(s, pts, current, o.indirect_only ? &first : nullptr, valid, o, r);
   r.stats.seconds = seconds_since(t0);
   return r;
 }
+
 
 image bake_mask_image(const bake_result& result) {
   const image& e = result.irradiance;
