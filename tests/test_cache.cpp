@@ -849,3 +849,67 @@ TEST_CASE("cache: nearby opinion - a hard edge between two columns of points", "
   }
   CHECK(wrong_off > 0);  // measured: 1 wrong point at a = 0.25 and 1 at a = 0.3 (a lit record covers it alone)
 }
+
+TEST_CASE("cache: statistics add up - rounds, seeds, checked points and the records-visited histogram", "[cache]") {
+  const lit_floor f;
+  const cache_result r = f.run(cache_options{});
+  const cache_stats& s = r.stats;
+  // One entry per round that rendered, plus the last coverage pass that found nothing open.
+  REQUIRE(s.round_details.size() == s.rounds + 1);
+  CHECK(s.round_details.back().open_points == 0);
+  CHECK(s.round_details.back().seeds == 0);
+  std::size_t seeds = 0, added = 0, invalid = 0, checked = 0, histogram = 0;
+  for (const cache_round_stats& d : s.round_details) {
+    seeds += d.seeds;
+    added += d.records_added;
+    invalid += d.invalid_samples;
+    checked += d.points_checked;
+    CHECK(d.seeds == d.records_added + d.invalid_samples);
+    CHECK(d.records_visited <= d.points_checked * d.max_records_visited);
+  }
+  for (std::size_t h : s.records_visited_histogram) histogram += h;
+  CHECK(seeds == s.hemicubes);
+  CHECK(added == s.records);
+  CHECK(invalid == s.invalid_samples);
+  CHECK(histogram == checked);                       // one histogram entry per coverage query
+  CHECK(s.round_details.front().points_checked == f.p.size());  // the first pass checks every point
+  CHECK(s.records_visited_histogram[0] >= f.p.size());          // ... against no record
+  // The three times add up to the wall time (placement is defined as the rest).
+  CHECK(s.placement_seconds + s.render_seconds + s.interpolation_seconds == Approx(s.seconds).epsilon(1e-6));
+  // The histogram's buckets: 0, then [2^(k-1), 2^k).
+  CHECK(cache_stats::histogram_bucket(0) == 0);
+  CHECK(cache_stats::histogram_bucket(1) == 1);
+  CHECK(cache_stats::histogram_bucket(3) == 2);
+  CHECK(cache_stats::histogram_bucket(4) == 3);
+  CHECK(cache_stats::histogram_bucket(std::size_t(1) << 40) == cache_stats::histogram_buckets - 1);
+}
+
+TEST_CASE("cache: fill_invalid = false leaves points inside geometry at 0 and everything else unchanged", "[cache]") {
+  // The floor of the lit room with a closed box standing on it (as the test above).
+  closed_form_scene s = lit_room();
+  const glm::dvec3 lo(0.2, 0.2, -0.01), hi(0.6, 0.6, 0.5);
+  auto q = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) { add_quad(s.tris, a, b, c, d, glm::vec3(0.5f)); };
+  q({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
+  q({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
+  q({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});
+  q({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});
+  q({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});
+  std::vector<glm::vec3> p, n;
+  floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.1f, p, n);
+  const irradiance_sampler sampler = raycast_sampler(s, 16);
+  cache_options o;
+  const cache_result filled = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
+  o.fill_invalid = false;
+  const cache_result bare = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
+  REQUIRE(bare.stats.invalid_points > 0);
+  CHECK(bare.stats.invalid_points == filled.stats.invalid_points);
+  CHECK(bare.valid == filled.valid);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (bare.valid[i])
+      CHECK(bare.irradiance[i] == filled.irradiance[i]);
+    else {
+      CHECK(bare.irradiance[i] == glm::vec3(0.0f));
+      CHECK(filled.irradiance[i].x > 0.0f);
+    }
+  }
+}

@@ -178,6 +178,33 @@ TEST_CASE("reference scenes: sizes and triangle counts as documented", "[scene]"
   CHECK(c->bounds_hi().z == Approx(0.5592f));
   // Deterministic: two builds are identical.
   CHECK(many_boxes(30).positions == many_boxes(30).positions);
+  CHECK(open_pavilion().triangle_count() == 708);
+  const scene_mesh street = open_street();
+  CHECK((street.triangle_count() - 2) % 12 == 0);
+  CHECK(street.triangle_count() > 2 + 12 * 32);  // some buildings besides the 32 post boxes
+  CHECK(street.positions == open_street().positions);
+}
+
+TEST_CASE("reference scenes: the open pavilion and street are closed solids that meet (every part closed, facing out)", "[scene]") {
+  // Every part is a closed solid with outward faces: no open edge (the street's ground quad,
+  // its two triangles, adds its four border edges), and each triangle faces away from its
+  // part's inside (a point just behind it is inside some part; one just in front is not
+  // necessarily outside, where parts meet).
+  CHECK(open_edges(open_pavilion()) == 0);
+  CHECK(open_edges(open_street()) == 4);
+  // Outward faces: the signed volume (divergence theorem) is the sum of the parts' volumes,
+  // positive: slabs 14 x 10 x 0.32 + 12 x 8 x 0.3 + 13 x 9 x 0.4 m, and 8 x three regular
+  // octagonal prisms (area 2 sqrt2 r^2) of r = 0.35, 0.12, 0.25 m and heights 0.22, 3.2, 0.22 m.
+  const scene_mesh m = open_pavilion();
+  double volume = 0.0;
+  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+    const glm::dvec3 a(m.positions[m.indices[3 * i]]), b(m.positions[m.indices[3 * i + 1]]), c(m.positions[m.indices[3 * i + 2]]);
+    volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+  }
+  const double octagon = 2.0 * std::sqrt(2.0);
+  const double expected = 14.0 * 10.0 * 0.32 + 12.0 * 8.0 * 0.3 + 13.0 * 9.0 * 0.4 +
+                          8.0 * octagon * (0.35 * 0.35 * 0.22 + 0.12 * 0.12 * 3.2 + 0.25 * 0.25 * 0.22);
+  CHECK(volume == Approx(expected).epsilon(1e-5));
 }
 
 TEST_CASE("reference scenes: rooms face inwards, boxes outwards, ground up", "[scene]") {
