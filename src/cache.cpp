@@ -39,7 +39,7 @@ float coverage_radius(const cache_record& r, const cache_options& o) { return o.
 // The weight the coverage tests use: Ward's w where it passes 1/a (for both Ward weightings, so
 // ward_continuous places the same records as ward), the Tabellion-Lamorlette w where positive;
 // else 0. record_weight (the interpolation's weight) is this, less 1/a for ward_continuous.
-float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+inline float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
   const float d = glm::length(x - r.position);
   const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
   if (o.weight != cache_weight::tabellion_lamorlette) {
@@ -50,6 +50,16 @@ float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3
   const float k = 1.0f / (2.0f * o.error_threshold);
   const float w = 1.0f - k * std::max(d / (0.5f * r.radius), ndot / 0.12326f);
   return w > 0.0f ? w : 0.0f;
+}
+
+// record_weight and record_is_behind (cache.hpp), inline for the placement's hot loops.
+inline float weight_of(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+  const float w = coverage_weight(r, x, n, o);
+  // w > 1/a here, so w - 1/a > 0 (IEEE subtraction of two different floats is never 0).
+  return o.weight == cache_weight::ward_continuous && w > 0.0f ? w - 1.0f / o.error_threshold : w;
+}
+inline bool is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) {
+  return 0.5f * glm::dot(x - r.position, r.normal + n) < -behind_epsilon;
 }
 
 // A record's prediction at (x, n): order 0 = E_i, 1 = with the gradient terms, 2 = also with the
@@ -407,8 +417,8 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   bvh.query(x, [&](std::uint32_t i) {
     ++visited;
     const cache_record& r = records[i];
-    const float w = record_weight(r, x, n, o);
-    if (w <= 0.0f || record_is_behind(r, x, n)) return;
+    const float w = weight_of(r, x, n, o);
+    if (w <= 0.0f || is_behind(r, x, n)) return;
     const glm::vec3 e = extrapolate(r, x, n, order, o.error_threshold);
     sum += w * e;
     wsum += w;
@@ -672,14 +682,10 @@ std::array<glm::vec3, 3> hl2_from_cone(const hl2_cone& c, const frame& f) noexce
 }
 
 float record_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
-  const float w = coverage_weight(r, x, n, o);
-  // w > 1/a here, so w - 1/a > 0 (IEEE subtraction of two different floats is never 0).
-  return o.weight == cache_weight::ward_continuous && w > 0.0f ? w - 1.0f / o.error_threshold : w;
+  return weight_of(r, x, n, o);
 }
 
-bool record_is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) {
-  return 0.5f * glm::dot(x - r.position, r.normal + n) < -behind_epsilon;
-}
+bool record_is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) { return is_behind(r, x, n); }
 
 glm::vec3 interpolate_records(const std::vector<cache_record>& records, const glm::vec3& x, const glm::vec3& n,
                               const cache_options& o, float* weight_sum) {
@@ -843,7 +849,7 @@ class placement {
 
   void set_up() {
     bvh_.build(records_, o_);
-    for (auto* v : {&covered_, &dirty_, &fragile_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
+    for (auto* v : {&covered_, &dirty_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
     record_at_point_.assign(count_, -1);
     grid_of_points_.build(p_, count_);
     std::vector<std::uint64_t> key(count_);
@@ -868,16 +874,18 @@ class placement {
   }
 
   // 1. Coverage of every point whose answer can have changed (parallel, read-only on the
-  // records): open points, points in the reach of a record added or shrunk in the last round
-  // (dirty), and points whose answer leaned on floor_e (fragile), which moves as records are
-  // added. Every other point is covered by the same records with the same radii as when it was
-  // checked, so its answer stands.
+  // records): open points and dirty points (in the reach of a record added or shrunk in the last
+  // round, within nearby_opinion's reach of a new record, or newly presumed inside). Every other
+  // point is covered by the same records with the same radii as when it was checked, and its
+  // opinions come from the same records, so its answer stands. The dark floor of the tests
+  // (floor_e_: 5% of the mean irradiance of the first round's records, a uniform sample of the
+  // points) is fixed once set, so no answer depends on records far away.
   void coverage_pass(cache_round_stats& round) {
-    float floor_e = 0.0f;
-    if (!records_.empty()) {
+    if (!floor_set_ && !records_.empty()) {
       double mean = 0.0;
       for (const cache_record& r : records_) mean += luminance(r.irradiance);
-      floor_e = 0.05f * float(mean / double(records_.size()));
+      floor_e_ = 0.05f * float(mean / double(records_.size()));
+      floor_set_ = true;
     }
     struct tally {
       std::size_t checked = 0, visited = 0, max_visited = 0;
@@ -887,11 +895,9 @@ class placement {
     parallel_for(count_, threads_, 4096, [&](int worker, std::size_t b, std::size_t e) {
       tally& t = tallies[std::size_t(worker)];
       for (std::size_t i = b; i < e; ++i) {
-        if (own_invalid_[i] || (presumed_[i] && !contested_[i] && !dirty_[i]) ||
-            (covered_[i] && !dirty_[i] && !fragile_[i]))
-          continue;
+        if (own_invalid_[i] || (!dirty_[i] && (covered_[i] || (presumed_[i] && !contested_[i])))) continue;
         std::size_t visited = 0;
-        check_point(i, floor_e, visited);
+        check_point(i, visited);
         ++t.checked;
         t.visited += visited;
         t.max_visited = std::max(t.max_visited, visited);
@@ -908,16 +914,13 @@ class placement {
   }
 
   // The coverage test of one point (coverage_pass); `visited` counts the records the query saw.
-  void check_point(std::size_t i, float floor_e, std::size_t& visited) {
+  void check_point(std::size_t i, std::size_t& visited) {
     const float a = o_.error_threshold;
     glm::vec3 value;
     float spread = 0.0f;
     bool own = false;
     coverage_detail detail;
-    detail.floor = floor_e;
-    const bool second_opinion = o_.second_opinion > 0.0f;
-    const bool nearby_opinion = o_.nearby_opinion > 0.0f;
-    const bool sole_reach = o_.sole_record_reach < 1.0f;
+    detail.floor = floor_e_;
     const float w = interpolate(records_, bvh_, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
@@ -926,7 +929,6 @@ class placement {
     if (presumed_[i] && !contested_[i]) {
       if (!ok) {
         covered_[i] = 0;
-        fragile_[i] = 0;
         return;
       }
       contested_[i] = 1;
@@ -935,39 +937,27 @@ class placement {
     // A covering record that saw back faces stands at a contact or an intersection: its
     // neighbours get their own hemicubes rather than its extrapolation.
     if (ok && !own && detail.max_backface > contact_backface_) ok = false;
-    bool leans_on_floor = false;
-    if (ok && o_.refine_disagreement && !own) {
-      ok = spread <= a * std::max(luminance(value), floor_e);
-      leans_on_floor = ok && spread > a * luminance(value);
-    }
+    if (ok && o_.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e_);
     // Second opinion: a point that only one record covers is not covered while that record's
     // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
     // disagree with an extrapolation that may be wrong (an edge between two rows of points, a
     // second derivative the gradient does not see).
-    if (ok && second_opinion && !own && detail.records == 1) {
-      ok = detail.first_order <= o_.second_opinion * a;
-      leans_on_floor = leans_on_floor || (ok && floor_e > 0.0f);  // the floor moves: re-check
-    }
+    if (ok && o_.second_opinion > 0.0f && !own && detail.records == 1) ok = detail.first_order <= o_.second_opinion * a;
     // Sole record reach: a point that one record covers must lie inside sole_record_reach of
     // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
-    if (ok && sole_reach && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
+    if (ok && o_.sole_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
       ok = detail.max_weight >= 1.0f / (o_.sole_record_reach * a);
     // Nearby opinion: records near a point that one record covers, which do not cover it
     // themselves, must predict the same there within a (a hard shadow edge between two rows of
     // points is invisible to the covering record's gradient, not to a record beyond it).
-    if (ok && nearby_opinion && !own && detail.records == 1) {
-      ok = nearby_records_agree(i, detail, floor_e);
-      // Records added near the point later can change the answer (and the floor moves): re-check.
-      leans_on_floor = true;
-    }
+    if (ok && o_.nearby_opinion > 0.0f && !own && detail.records == 1) ok = nearby_records_agree(i, detail);
     covered_[i] = ok ? 1 : 0;
-    fragile_[i] = leans_on_floor ? 1 : 0;
   }
 
-  bool nearby_records_agree(std::size_t i, const coverage_detail& detail, float floor_e) const {
+  bool nearby_records_agree(std::size_t i, const coverage_detail& detail) const {
     const glm::vec3 x = p_[i], nx = n_[i];
     const float la = std::max(detail.last_prediction, 0.0f);
-    const float tolerance = o_.error_threshold * std::max(la, floor_e);
+    const float tolerance = o_.error_threshold * std::max(la, floor_e_);
     bool ok = true;
     grid_of_points_.for_each_in_sphere(x, nearby_reach_, [&](std::uint32_t j) {
       const std::int32_t k = record_at_point_[j];
@@ -1146,6 +1136,9 @@ class placement {
       const float reach = added ? r : std::max(r, a * old_radius_[j]);
       // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
       grid_of_points_.for_each_in_sphere(records_[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty_[i] = 1; });
+      // nearby_opinion consults the records placed within nearby_reach of a point.
+      if (added && o_.nearby_opinion > 0.0f)
+        grid_of_points_.for_each_in_sphere(records_[j].position, nearby_reach_ * 1.0001f, [&](std::uint32_t i) { dirty_[i] = 1; });
     }
   }
 
@@ -1259,11 +1252,13 @@ class placement {
   cache_options coverage_options_;
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
-  float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (check_point)
+  float contact_backface_ = 0.0f;
+  float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
+  bool floor_set_ = false;  // records seeing more back faces than this stand at a contact (check_point)
   std::vector<cache_record> records_;
   record_bvh bvh_;
   point_grid grid_of_points_;
-  std::vector<std::uint8_t> covered_, dirty_, fragile_, own_invalid_, presumed_, contested_;
+  std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
   std::vector<std::uint8_t> blocked_;  // pick_seeds: within spacing of an earlier seed of the round
   std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
   std::vector<std::size_t> order_;             // the fixed pseudo-random order of the points
