@@ -2,6 +2,8 @@
 # Regenerates the benchmark CSVs and charts under docs/bench/ (one command for all of them):
 #   bash benchmarks/run.sh            every benchmark and sweep
 #   bash benchmarks/run.sh NAME...    only these (e.g. geometry raster)
+#   bash benchmarks/run.sh bake_scaling       bake time and peak memory against triangles, lightmap size
+#                                     and threads (benchmarks/sweep_bake_scaling.cpp; long, not run by default)
 #   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 #   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
@@ -24,6 +26,7 @@ if [ ${#names[@]} -eq 0 ]; then
   for f in "$build"/benchmarks/bench_* "$build"/benchmarks/sweep_*; do
     [ -x "$f" ] || continue
     n=$(basename "$f"); n=${n#bench_}; n=${n#sweep_}
+    [ "$n" = bake_scaling ] && continue  # long (a 1M-triangle bake, 4096^2 lightmaps): only when named
     [[ " ${names[*]-} " == *" $n "* ]] || names+=("$n")
   done
 fi

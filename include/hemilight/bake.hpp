@@ -23,8 +23,10 @@
 //      leaves its own surface by a fraction of a texel, and always by more than the near plane.
 //   3. Irradiance. cache_irradiance() with make_hemicube_sampler() (cache.hpp), each hemicube
 //      rolled about its normal by an angle hashed from the sample position (deterministic per
-//      texel): hemicube aliasing shows as fine noise, not bands. Samples inside geometry (seeing
-//      back faces) are filled by the cache from valid neighbours in object space.
+//      texel): hemicube aliasing shows as fine noise, not bands. Samples inside geometry (their own
+//      hemicube sees back faces, or the cache presumes them inside from an invalid sample on the
+//      same side of the same surface: cache.hpp) are filled by dilating the valid texels around
+//      them in the lightmap (the same chart: never light from across a wall), in both modes.
 //   4. Bounces. Pass 1 sees emission and sky. Pass k > 1 renders with a radiance texture (same
 //      size as the lightmap) holding, per texel, emission + albedo E_{k-1} / pi of the texel's
 //      owner, dilated like the lightmap. The result of pass `bounces` is the lightmap; with
@@ -92,7 +94,8 @@ struct bake_options {
   /// ignored: the fields below are used instead.
   cache_options cache;
   /// false: a hemicube at every sampled texel (no interpolation); the reference the cache's
-  /// error is measured against.
+  /// error is measured against. (cache.fill_invalid is ignored: the baker fills invalid texels
+  /// by dilation.)
   bool use_cache = true;
   int thread_count = 0;  ///< 0 = all cores
   /// Output the L1 SH lightmaps (bake_result::sh_l1): world-space coefficients of the incoming

@@ -29,9 +29,12 @@
 // (second_opinion) a point covered by one record only is not extrapolated far from it, nor
 // (sole_record_reach) from the rim of its reach, and (nearby_opinion) records near such a point
 // that do not cover it agree with that record there. Samples that see more than
-// invalid_backface_fraction back faces (the point is inside geometry) never become records;
-// their points, and points within 0.9 x the invalid sample's min distance, are filled at the end
-// from the nearest valid records.
+// invalid_backface_fraction back faces (the point is inside geometry) never become records; the
+// points within 0.9 x such a sample's min distance on the visible side of its tangent plane and
+// with a similar normal are presumed inside too, unless a valid record covers them (then they get
+// their own hemicube, as do points covered by a record that saw back faces: a contact). Points
+// inside are filled at the end from records on their side of the surface (fill_invalid).
+// docs/cache.md, "Points inside geometry, and contacts".
 #pragma once
 
 #include "hemilight/integrate.hpp"
