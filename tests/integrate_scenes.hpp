@@ -78,7 +78,7 @@ inline closed_form_scene occluded_emitter() {
 
 /// A point on the ground 0.3 from a tall black wall, under a uniform sky of radiance 1:
 /// E = pi - (projected solid angle of the wall rectangle). The wall is seen edge-on at its
-/// foot, the hard case for wall-based gradients (REFERENCES.md).
+/// foot, the hard case for wall-based gradients (docs/integration.md).
 inline closed_form_scene beside_wall_under_sky() {
   closed_form_scene s;
   s.name = "beside a tall wall under a sky";

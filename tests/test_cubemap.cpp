@@ -289,7 +289,7 @@ TEST_CASE("fixup lookup: for warp it is exact at face centre and edges, and a fr
     }
     CHECK(at_centre < 1e-9);
     CHECK(at_edge < 1e-9);
-    // REFERENCES.md: up to about 0.19 texel in between; measured 0.18-0.19 for these sizes.
+    // Up to about 0.19 texel in between (docs/cubemap.md); measured 0.18-0.19 for these sizes.
     CHECK(worst > 0.15);
     CHECK(worst < 0.2);
   }

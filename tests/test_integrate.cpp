@@ -204,7 +204,7 @@ TEST_CASE("integrate: translation gradients against central differences of the c
   // reference ray caster, so only the integrator is measured. Measured relative errors at
   // N = 256 are in docs/integration.md (benchmarks/sweep_integrate); tolerances sit about 3x
   // above them: great_arc 1% (unoccluded), 3% (occluder edge), 15% (a wall seen edge-on: its
-  // depth is sampled half a texel from the silhouette, the slow case of REFERENCES.md), 3% (lit
+  // depth is sampled half a texel from the silhouette, the slow case of docs/integration.md), 3% (lit
   // room). The occlusion-aware estimators must beat the simple one near occluders.
   struct expect { closed_form_scene scene; double great_arc_tolerance; };
   for (const expect& e : {expect{unoccluded_emitter(), 0.01}, expect{occluded_emitter(), 0.03},

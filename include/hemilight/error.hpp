@@ -1,6 +1,6 @@
 // hemilight/error.hpp — status codes, the exception the C++ API throws, and the version.
 //
-// Error policy (DESIGN.md): math kernels take validated data and assert their preconditions;
+// Error policy: math kernels take validated data and assert their preconditions;
 // functions that build objects from user data (scenes, cube maps, options, files) validate and
 // throw hemilight::error with a status code and a message that names the bad argument. The C ABI
 // catches every exception and turns it into a hemilight_status plus hemilight_last_error().

@@ -1,7 +1,7 @@
 // hemilight/geometry.hpp — hemicube layout and exact texel weights, OpenGL cube-map faces,
 // orthonormal frames.
 //
-// Everything else in hemilight stands on these conventions (see DESIGN.md):
+// Everything else in hemilight stands on these conventions (docs/conventions.md):
 //
 // Hemicube of resolution N (even, 2..4096) in its local frame, normal = +z:
 //

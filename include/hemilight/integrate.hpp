@@ -23,7 +23,7 @@
 //                a translation u moves it at the rate (u.m)/r_min, so its coefficient is
 //                m_t * (integral of cos(theta) along the arc) / r_min.
 // All three weight a wall (or texel) by the cosine where the radiance changes, not by the texels'
-// own cosines (REFERENCES.md: the latter biases the gradient wherever lit surfaces are near).
+// own cosines (the latter biases the gradient wherever lit surfaces are near: docs/integration.md).
 //
 // Robustness: misses (distance +inf) contribute to E but a wall uses the finite side's distance
 // (a wall between two misses contributes nothing). A wall's distance is clamped from below by

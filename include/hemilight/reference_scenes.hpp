@@ -1,4 +1,4 @@
-// hemilight/reference_scenes.hpp — the reference scenes of the project (REFERENCES.md), by name.
+// hemilight/reference_scenes.hpp — the reference scenes of the project, by name.
 //
 // Every builder returns a scene_mesh (scene.hpp): pass mesh.desc() to scene::create(). They are
 // deterministic (no global state, fixed pseudo-random sequences), in metres, with +y up, and
