@@ -87,6 +87,16 @@ def empty(ax, title):
     ax.text(0.5, 0.5, "no rows in the CSV", transform=ax.transAxes, ha="center")
 
 
+def finish_loglog(ax, mem_ax, handles, note, xlabel, title):
+    """Log-log axes for both the time and the memory axis, labels, then finish()."""
+    for a in (ax, mem_ax):
+        a.set_xscale("log")
+        a.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_title(title)
+    finish(ax, mem_ax, handles, note)
+
+
 def triangles_panel(ax, rows):
     """Time and peak memory against the triangle count (log-log), references O(T) and O(log T)."""
     title = "(a) against triangles"
@@ -113,12 +123,7 @@ def triangles_panel(ax, rows):
             f"hemicubes {int(min(hc))}-{int(max(hc))} (slope {fmt_slope(loglog_slope(t, hc))})\n"
             f"µs/hc = thread-µs per hemicube, slope per step: {step_slopes(t, [us_per_hemicube(r) for r in rows])}"
             + (f"\nmarginal peak memory {per_t:.0f} B/triangle (last two points)" if per_t is not None else ""))
-    for a in (ax, mem_ax):
-        a.set_xscale("log")
-        a.set_yscale("log")
-    ax.set_xlabel(f"triangles (heightfield, {size}² lightmap, {threads} threads)")
-    ax.set_title(title)
-    finish(ax, mem_ax, h, note)
+    finish_loglog(ax, mem_ax, h, note, f"triangles (heightfield, {size}² lightmap, {threads} threads)", title)
 
 
 def texels_panel(ax, rows):
@@ -147,12 +152,7 @@ def texels_panel(ax, rows):
             f"hemicubes: slope {fmt_slope(loglog_slope(n, hc))} "
             f"({100 * hc[0] / n[0]:.1f}% -> {100 * hc[-1] / n[-1]:.1f}% of texels)"
             + (f"\nmarginal peak memory {per_texel:.0f} B/texel (last two points)" if per_texel is not None else ""))
-    for a in (ax, mem_ax):
-        a.set_xscale("log")
-        a.set_yscale("log")
-    ax.set_xlabel(f"lightmap texels = sampled texels ({tri} triangles, {threads} threads)")
-    ax.set_title(title)
-    finish(ax, mem_ax, h, note)
+    finish_loglog(ax, mem_ax, h, note, f"lightmap texels = sampled texels ({tri} triangles, {threads} threads)", title)
 
 
 def threads_panel(ax, rows):
