@@ -793,8 +793,8 @@ class placement {
     cache_result result;
     const auto t_final = std::chrono::steady_clock::now();
     interpolate_all(result);
+    stats_.invalid_points = count_invalid(result);
     if (o_.fill_invalid) fill_invalid(result);
-    else stats_.invalid_points = count_invalid(result);
     stats_.interpolation_seconds = seconds_since(t_final);
     for (const cache_round_stats& r : stats_.round_details) stats_.render_seconds += r.render_seconds;
     stats_.records = records_.size();
@@ -1178,12 +1178,11 @@ class placement {
     return invalid;
   }
 
-  void fill_invalid(cache_result& result) {
+  void fill_invalid(cache_result& result) const {
+    if (records_.empty() || stats_.invalid_points == 0) return;
     std::vector<std::size_t> fill;
     for (std::size_t i = 0; i < count_; ++i)
       if (!result.valid[i]) fill.push_back(i);
-    stats_.invalid_points = fill.size();
-    if (records_.empty() || fill.empty()) return;
     std::vector<glm::vec3> where(records_.size());
     for (std::size_t j = 0; j < records_.size(); ++j) where[j] = records_[j].position;
     point_grid grid;
