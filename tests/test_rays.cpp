@@ -1,0 +1,222 @@
+// Tests of rays.hpp against the independent double-precision ray caster of
+// tests/raycast_reference.hpp (brute force over all triangles, Moeller-Trumbore), and against
+// rays whose answers are known by construction (shared edges, t_max, both faces).
+#include "hemilight/rays.hpp"
+#include "hemilight/reference_scenes.hpp"
+
+#include "raycast_reference.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace hemilight;
+using namespace hemilight::test;
+
+namespace {
+
+constexpr float inf = std::numeric_limits<float>::infinity();
+
+std::vector<ref_triangle> reference_triangles(const scene_mesh& m) {
+  std::vector<ref_triangle> out;
+  for (std::size_t i = 0; i < m.triangle_count(); ++i)
+    out.push_back({glm::dvec3(m.positions[m.indices[3 * i]]), glm::dvec3(m.positions[m.indices[3 * i + 1]]),
+                   glm::dvec3(m.positions[m.indices[3 * i + 2]]), glm::vec3(0.0f), true});
+  return out;
+}
+
+// Whether the ray o + t d (0 < t < t_max) passes within `eps` (barycentric) of an edge of some
+// triangle it crosses, or crosses a triangle within eps (relative) of t_max: the rays on which a
+// float caster may legitimately answer differently from the double reference.
+bool near_an_edge(const std::vector<ref_triangle>& tris, const glm::dvec3& o, const glm::dvec3& d, double t_max,
+                  double eps) {
+  for (const ref_triangle& t : tris) {
+    const glm::dvec3 e1 = t.b - t.a, e2 = t.c - t.a, p = glm::cross(d, e2);
+    const double det = glm::dot(e1, p);
+    if (std::fabs(det) < 1e-300) continue;
+    const glm::dvec3 s = o - t.a, q = glm::cross(s, e1);
+    const double u = glm::dot(s, p) / det, v = glm::dot(d, q) / det, dist = glm::dot(e2, q) / det;
+    if (dist < -eps * (1.0 + t_max) || (std::isfinite(t_max) && dist > t_max * (1.0 + eps))) continue;
+    const double w = 1.0 - u - v;
+    const bool inside = u >= -eps && v >= -eps && w >= -eps;
+    const bool near_edge = std::fabs(u) < eps || std::fabs(v) < eps || std::fabs(w) < eps;
+    const bool near_ends = std::fabs(dist) < eps * (1.0 + t_max) ||
+                           (std::isfinite(t_max) && std::fabs(dist - t_max) < eps * t_max);
+    if (inside && (near_edge || near_ends)) return true;
+  }
+  return false;
+}
+
+struct named_mesh {
+  const char* name;
+  scene_mesh mesh;
+};
+
+}  // namespace
+
+TEST_CASE("rays: random rays on reference scenes agree with the reference caster", "[rays]") {
+  for (const named_mesh& nm : {named_mesh{"cornell_box", cornell_box()}, named_mesh{"hexagon_room_3", hexagon_room(3)},
+                               named_mesh{"open_pavilion", open_pavilion()},
+                               named_mesh{"sky_and_occluders", sky_and_occluders()}}) {
+    INFO("scene " << nm.name);
+    const auto s = scene::create(nm.mesh.desc());
+    const std::vector<ref_triangle> tris = reference_triangles(nm.mesh);
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    const glm::vec3 lo = s->bounds_lo(), hi = s->bounds_hi();
+    int rays = 0, near_edge = 0;
+    for (int k = 0; k < 1500; ++k) {
+      // Origins over the scene's box grown by 10%, directions uniform, t_max from 0.05 to 1.0 of
+      // the scene size, or +inf (every fourth ray).
+      const glm::vec3 o = lo + (hi - lo) * glm::vec3(u01(rng), u01(rng), u01(rng)) * 1.2f - 0.1f * (hi - lo);
+      glm::vec3 d(gauss(rng), gauss(rng), gauss(rng));
+      if (glm::length(d) < 1e-3f) continue;
+      d = glm::normalize(d) * (0.5f + 2.0f * u01(rng));  // not unit: t is in units of |d|
+      const float t_max = k % 4 == 0 ? inf : s->size() * (0.05f + 0.95f * u01(rng)) / glm::length(d);
+      ++rays;
+      int ref_hit;
+      bool back;
+      const double t_ref = cast(tris, glm::dvec3(o), glm::dvec3(d), ref_hit, back);
+      const bool ref_any = ref_hit >= 0 && t_ref < double(t_max);
+      ray_hit h;
+      const bool any = occluded(*s, o, d, t_max);
+      const bool found = intersect(*s, o, d, t_max, h);
+      // Disagreements are allowed only within 1e-5 (barycentric, or relative in t) of an edge
+      // or of the segment's ends: float rounding of the vertices' shear is ~1e-7 relative, so
+      // 1e-5 leaves two orders of margin, and the scenes' edges are exact in float.
+      if (any != ref_any || found != ref_any ||
+          (found && ref_any && (std::fabs(double(h.distance) - t_ref) > 1e-5 * (t_ref + double(s->size())) ||
+                                (h.triangle != std::uint32_t(ref_hit) &&
+                                 std::fabs(double(h.distance) - t_ref) > 1e-5 * (t_ref + double(s->size())))))) {
+        const bool allowed = near_an_edge(tris, glm::dvec3(o), glm::dvec3(d), double(t_max), 1e-5);
+        INFO("ray " << k << ": any " << any << " found " << found << " reference " << ref_any << " t " << h.distance
+                    << " t_ref " << t_ref);
+        CHECK(allowed);
+        ++near_edge;
+      } else if (found) {
+        // The same triangle, or one at the same distance (touching parts, shared edges).
+        CHECK(std::fabs(double(h.distance) - t_ref) <= 1e-5 * (t_ref + double(s->size())));
+      }
+    }
+    INFO(near_edge << " of " << rays << " rays near an edge disagree");
+    CHECK(near_edge <= rays / 100);
+  }
+}
+
+TEST_CASE("rays: a ray through a shared edge or vertex of a closed grid is always caught (watertight)", "[rays]") {
+  // A skewed 16 x 16 grid of quads (512 triangles sharing edges and vertices, add_grid) in the
+  // tilted plane z = 0.1 x + 0.2 y + 0.05 (planar, so every ray towards a point of it crosses it
+  // there: on a bent grid a grazing ray may touch a ridge without crossing). Rays aim at points on
+  // the interior edges (the segment's own float points, so exactly on or within an ulp of the
+  // edge) and at the interior vertices, from origins on both sides and at grazing angles. A ray
+  // through the grid's interior must hit some triangle: none may slip through.
+  const auto on_plane = [](float x, float y) { return glm::vec3(x, y, 0.1f * x + 0.2f * y + 0.05f); };
+  scene_mesh m;
+  m.add_grid(on_plane(-1.0f, -0.9f), on_plane(1.1f, -1.0f), on_plane(0.9f, 1.2f), on_plane(-1.05f, 1.0f), 16, 16,
+             material{});
+  const auto s = scene::create(m.desc());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  int misses = 0, rays = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const glm::vec3 a = m.positions[m.indices[3 * t + std::size_t(e)]];
+      const glm::vec3 b = m.positions[m.indices[3 * t + std::size_t((e + 1) % 3)]];
+      for (int k = 0; k < 4; ++k) {
+        const float f = k == 0 ? 0.0f : u01(rng);  // k = 0: the vertex itself
+        const glm::vec3 target = a + f * (b - a);
+        if (std::fabs(target.x) > 0.85f || std::fabs(target.y) > 0.85f) continue;  // interior only
+        const float side = (k % 2) ? 1.0f : -1.0f;
+        // grazing (k = 3: about 3 degrees from the plane) to steep
+        const glm::vec3 normal = glm::normalize(glm::vec3(-0.1f, -0.2f, 1.0f));
+        glm::vec3 along(u01(rng) - 0.5f, u01(rng) - 0.5f, 0.0f);
+        along = glm::normalize(along - glm::dot(along, normal) * normal);
+        const glm::vec3 dir_in = along + normal * (k == 3 ? 0.05f : 0.3f + u01(rng));
+        const glm::vec3 o = target + side * glm::normalize(dir_in) * (0.5f + 3.0f * u01(rng));
+        ++rays;
+        if (!occluded(*s, o, target - o, 2.0f)) ++misses;
+        ray_hit h;
+        if (!intersect(*s, o, target - o, 2.0f, h)) ++misses;
+      }
+    }
+  INFO(misses << " of " << rays << " rays through shared edges and vertices missed");
+  CHECK(rays > 4000);
+  CHECK(misses == 0);
+}
+
+TEST_CASE("rays: t_max is respected (exclusive) and t is in units of |direction|", "[rays]") {
+  scene_mesh m;
+  m.add_quad({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, material{});  // z = 1, facing +z
+  const auto s = scene::create(m.desc());
+  const glm::vec3 o(0.1f, 0.2f, 0.0f);
+  CHECK(occluded(*s, o, {0, 0, 1}, 1.0001f));
+  CHECK_FALSE(occluded(*s, o, {0, 0, 1}, 0.9999f));
+  CHECK_FALSE(occluded(*s, o, {0, 0, 1}, 1.0f));  // t = 1 exactly is not below t_max = 1
+  CHECK(occluded(*s, o, {0, 0, 1}, inf));
+  CHECK_FALSE(occluded(*s, o, {0, 0, -1}, inf));  // pointing away
+  ray_hit h;
+  REQUIRE(intersect(*s, o, {0, 0, 2}, inf, h));
+  CHECK(h.distance == Approx(0.5).epsilon(1e-6));  // float rounding of the shear: ~1e-7
+  CHECK_FALSE(intersect(*s, o, {0, 0, 2}, 0.5f, h));
+  // Degenerate queries answer "no hit".
+  CHECK_FALSE(occluded(*s, o, {0, 0, 0}, inf));
+  CHECK_FALSE(occluded(*s, o, {0, 0, 1}, 0.0f));
+  CHECK_FALSE(occluded(*s, o, {0, 0, 1}, std::numeric_limits<float>::quiet_NaN()));
+  CHECK_FALSE(occluded(*s, o, {0, inf, 1}, 10.0f));
+  // An origin exactly on the triangle: t = 0 is not a hit.
+  CHECK_FALSE(occluded(*s, {0.1f, 0.2f, 1.0f}, {0, 0, 1}, inf));
+  const auto empty = scene::create(scene_mesh{}.desc());
+  CHECK_FALSE(occluded(*empty, o, {0, 0, 1}, inf));
+  CHECK_FALSE(intersect(*empty, o, {0, 0, 1}, inf, h));
+}
+
+TEST_CASE("rays: both faces are hit; the closest of several is reported", "[rays]") {
+  scene_mesh m;
+  m.add_quad({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, material{});  // triangles 0, 1: z = 1, front +z
+  m.add_quad({-1, -1, 3}, {-1, 1, 3}, {1, 1, 3}, {1, -1, 3}, material{});  // triangles 2, 3: z = 3, front -z
+  const auto s = scene::create(m.desc());
+  ray_hit h;
+  REQUIRE(intersect(*s, {0.3f, -0.2f, 0.0f}, {0, 0, 1}, inf, h));  // from below: the back of z = 1
+  CHECK(h.distance == Approx(1.0).epsilon(1e-6));
+  CHECK(h.triangle < 2);
+  CHECK_FALSE(h.front_face);
+  REQUIRE(intersect(*s, {0.3f, -0.2f, 2.0f}, {0, 0, 1}, inf, h));  // the front of z = 3
+  CHECK(h.distance == Approx(1.0).epsilon(1e-6));
+  CHECK(h.triangle >= 2);
+  CHECK(h.front_face);
+  REQUIRE(intersect(*s, {0.3f, -0.2f, 2.0f}, {0, 0, -1}, inf, h));  // the front of z = 1
+  CHECK(h.triangle < 2);
+  CHECK(h.front_face);
+  REQUIRE(intersect(*s, {0.3f, -0.2f, 5.0f}, {0, 0, -1}, inf, h));  // the back of z = 3, nearer than z = 1
+  CHECK(h.distance == Approx(2.0).epsilon(1e-6));
+  CHECK(h.triangle >= 2);
+  CHECK_FALSE(h.front_face);
+  CHECK(occluded(*s, {0.3f, -0.2f, 0.0f}, {0, 0, 1}, inf));
+  CHECK(occluded(*s, {0.3f, -0.2f, 5.0f}, {0, 0, -1}, inf));
+}
+
+TEST_CASE("rays: the AVX2 and SSE2 builds give the same answers bit for bit", "[rays]") {
+  const scene_mesh m = hexagon_room(3);
+  const auto s = scene::create(m.desc());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-4.5f, 4.5f);
+  ray_options sse2;
+  sse2.avx2 = false;
+  for (int k = 0; k < 2000; ++k) {
+    const glm::vec3 o(u(rng), u(rng) * 0.4f + 1.5f, u(rng)), d(u(rng), u(rng), u(rng));
+    const float t_max = k % 2 ? inf : 0.5f;
+    CHECK(occluded(*s, o, d, t_max) == occluded(*s, o, d, t_max, sse2));
+    ray_hit a, b;
+    const bool fa = intersect(*s, o, d, t_max, a), fb = intersect(*s, o, d, t_max, b, sse2);
+    CHECK(fa == fb);
+    if (fa && fb) {
+      CHECK(a.distance == b.distance);
+      CHECK(a.triangle == b.triangle);
+    }
+  }
+}
