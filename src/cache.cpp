@@ -39,7 +39,9 @@ float coverage_radius(const cache_record& r, const cache_options& o) { return o.
 // The weight the coverage tests use: Ward's w where it passes 1/a (for both Ward weightings, so
 // ward_continuous places the same records as ward), the Tabellion-Lamorlette w where positive;
 // else 0. record_weight (the interpolation's weight) is this, less 1/a for ward_continuous.
-inline float coverage_weight(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+// R is a cache_record or a record_bvh::key (anything with position, normal and radius).
+template <class R>
+inline float coverage_weight(const R& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
   const float d = glm::length(x - r.position);
   const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
   if (o.weight != cache_weight::tabellion_lamorlette) {
@@ -53,12 +55,14 @@ inline float coverage_weight(const cache_record& r, const glm::vec3& x, const gl
 }
 
 // record_weight and record_is_behind (cache.hpp), inline for the placement's hot loops.
-inline float weight_of(const cache_record& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
+template <class R>
+inline float weight_of(const R& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
   const float w = coverage_weight(r, x, n, o);
   // w > 1/a here, so w - 1/a > 0 (IEEE subtraction of two different floats is never 0).
   return o.weight == cache_weight::ward_continuous && w > 0.0f ? w - 1.0f / o.error_threshold : w;
 }
-inline bool is_behind(const cache_record& r, const glm::vec3& x, const glm::vec3& n) {
+template <class R>
+inline bool is_behind(const R& r, const glm::vec3& x, const glm::vec3& n) {
   return 0.5f * glm::dot(x - r.position, r.normal + n) < -behind_epsilon;
 }
 
@@ -89,6 +93,15 @@ int prediction_order(const cache_options& o) { return !o.use_gradients ? 0 : (o.
 // O(log n + k) for k records whose box holds the point.
 class record_bvh {
  public:
+  // What a query needs of a record to weigh it, in leaf order (32 bytes; the records themselves
+  // are ten times larger): the weights and is_behind read only these, bit for bit the record's.
+  struct key {
+    glm::vec3 position;
+    float radius;
+    glm::vec3 normal;
+    std::uint32_t index;  // the record's index
+  };
+
   // threads: how many cores the build may use (the two halves below the root are built in
   // parallel; the tree is the same for any count).
   void build(const std::vector<cache_record>& records, const cache_options& o, int threads = 1) {
@@ -103,11 +116,17 @@ class record_bvh {
       lo_[i] = records[i].position - glm::vec3(r);
       hi_[i] = records[i].position + glm::vec3(r);
     }
-    if (records.empty()) return;
+    if (records.empty()) {
+      keys_.clear();
+      return;
+    }
     const auto count = static_cast<std::uint32_t>(records.size());
     nodes_.push_back({});
     const std::uint32_t mid = split(nodes_[0], 0, count);
-    if (mid == 0) return;  // the root is a leaf
+    if (mid == 0) {  // the root is a leaf
+      fill_keys(records);
+      return;
+    }
     // Left and right subtrees into their own arrays (in parallel), then spliced: root, left root,
     // right root, the rest of the left, the rest of the right.
     std::vector<node> half[2];
@@ -131,6 +150,7 @@ class record_bvh {
         if (nd.count == 0) nd.first = remap(h, nd.first);
         nodes_[remap(h, k)] = nd;
       }
+    fill_keys(records);
   }
 
   // After radii changed but no record was added or moved: the same tree with new boxes. The
@@ -158,8 +178,10 @@ class record_bvh {
       nd.lo = lo;
       nd.hi = hi;
     }
+    fill_keys(records);
   }
 
+  // Calls f(key) for every record whose coverage box holds x.
   template <class F>
   void query(const glm::vec3& x, F&& f) const {
     if (nodes_.empty()) return;
@@ -170,7 +192,7 @@ class record_bvh {
       const node& nd = nodes_[stack[--top]];
       if (x.x < nd.lo.x || x.y < nd.lo.y || x.z < nd.lo.z || x.x > nd.hi.x || x.y > nd.hi.y || x.z > nd.hi.z) continue;
       if (nd.count > 0) {
-        for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) f(index_[k]);
+        for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) f(keys_[k]);
       } else {
         stack[top++] = nd.first;
         stack[top++] = nd.first + 1;
@@ -229,7 +251,16 @@ class record_bvh {
     out[slot] = nd;
   }
 
+  void fill_keys(const std::vector<cache_record>& records) {
+    keys_.resize(records.size());
+    for (std::size_t k = 0; k < records.size(); ++k) {
+      const cache_record& r = records[index_[k]];
+      keys_[k] = {r.position, r.radius, r.normal, index_[k]};
+    }
+  }
+
   const std::vector<cache_record>* records_ = nullptr;
+  std::vector<key> keys_;  // in index_ order
   std::vector<node> nodes_;
   std::vector<std::uint32_t> index_;
   std::vector<glm::vec3> lo_, hi_;
@@ -304,6 +335,61 @@ class point_grid {
 // (dt, db) to their gradient differences (per channel), two equations per neighbour:
 //     h11 dt + h12 db = dg.t,   h12 dt + h22 db = dg.b.
 // The normal matrix depends only on the offsets, so the three channels share it.
+// Points with normals added one at a time into a uniform grid of cells at least `cell` wide
+// over a box (a linked list per cell; positions and normals stored in insertion order): is there
+// one near a point? At most about 4 count + 64 cells.
+class seed_grid {
+ public:
+  void reset(const glm::vec3& lo, const glm::vec3& hi, float cell, std::size_t count) {
+    lo_ = lo;
+    const glm::vec3 ext = glm::max(hi - lo, glm::vec3(0.0f));
+    cell = std::max({cell, 1e-6f * std::max({ext.x, ext.y, ext.z}), 1e-30f});
+    for (;;) {
+      dims_ = glm::ivec3(glm::min(glm::floor(ext / cell), glm::vec3(1023.0f))) + 1;
+      if (double(dims_.x) * dims_.y * dims_.z <= 4.0 * double(count) + 64.0) break;
+      cell *= 1.25f;
+    }
+    inv_cell_ = 1.0f / cell;
+    head_.assign(std::size_t(dims_.x) * std::size_t(dims_.y) * std::size_t(dims_.z), none);
+    next_.clear();
+    position_.clear();
+    normal_.clear();
+  }
+  void insert(const glm::vec3& x, const glm::vec3& n) {
+    const std::size_t c = cell_index(cell_of(x));
+    next_.push_back(head_[c]);
+    position_.push_back(x);
+    normal_.push_back(n);
+    head_[c] = static_cast<std::uint32_t>(next_.size() - 1);
+  }
+  // Whether pred(position, normal) holds for an item in the cells that the box x +- r touches
+  // (a superset of the items within r of x); stops at the first that does.
+  template <class F>
+  bool any_near(const glm::vec3& x, float r, F&& pred) const {
+    const glm::ivec3 a = cell_of(x - glm::vec3(r)), b = cell_of(x + glm::vec3(r));
+    for (int z = a.z; z <= b.z; ++z)
+      for (int y = a.y; y <= b.y; ++y)
+        for (int xx = a.x; xx <= b.x; ++xx)
+          for (std::uint32_t k = head_[cell_index({xx, y, z})]; k != none; k = next_[k])
+            if (pred(position_[k], normal_[k])) return true;
+    return false;
+  }
+
+ private:
+  static constexpr std::uint32_t none = 0xffffffffu;
+  glm::ivec3 cell_of(const glm::vec3& q) const {
+    return glm::ivec3(glm::clamp((q - lo_) * inv_cell_, glm::vec3(0.0f), glm::vec3(dims_ - 1)));
+  }
+  std::size_t cell_index(const glm::ivec3& q) const {
+    return (std::size_t(q.z) * std::size_t(dims_.y) + std::size_t(q.y)) * std::size_t(dims_.x) + std::size_t(q.x);
+  }
+  glm::vec3 lo_{0.0f};
+  float inv_cell_ = 1.0f;
+  glm::ivec3 dims_{1};
+  std::vector<std::uint32_t> head_, next_;
+  std::vector<glm::vec3> position_, normal_;
+};
+
 void fit_hessians(std::vector<cache_record>& records, const cache_options& o, int threads) {
   const std::size_t count = records.size();
   std::vector<glm::vec3> where(count);
@@ -414,11 +500,12 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   bool at_record = false;
   const int order = prediction_order(o);
   std::size_t visited = 0;
-  bvh.query(x, [&](std::uint32_t i) {
+  bvh.query(x, [&](const record_bvh::key& key) {
     ++visited;
+    const float w = weight_of(key, x, n, o);
+    if (w <= 0.0f || is_behind(key, x, n)) return;
+    const std::uint32_t i = key.index;
     const cache_record& r = records[i];
-    const float w = weight_of(r, x, n, o);
-    if (w <= 0.0f || is_behind(r, x, n)) return;
     const glm::vec3 e = extrapolate(r, x, n, order, o.error_threshold);
     sum += w * e;
     wsum += w;
@@ -466,9 +553,10 @@ float median_spacing(const glm::vec3* p, std::size_t count, float diagonal) {
     return (std::uint64_t(std::uint32_t(q.x)) * 73856093u) ^ (std::uint64_t(std::uint32_t(q.y)) * 19349663u) ^
            (std::uint64_t(std::uint32_t(q.z)) * 83492791u);
   };
-  std::unordered_multimap<std::uint64_t, std::size_t> grid;
-  grid.reserve(count);
-  for (std::size_t i = 0; i < count; ++i) grid.emplace(key(p[i]), i);
+  // The hash grid as (key, point) pairs sorted by key: a cell's points are one equal range.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> grid(count);
+  for (std::size_t i = 0; i < count; ++i) grid[i] = {key(p[i]), static_cast<std::uint32_t>(i)};
+  std::sort(grid.begin(), grid.end());
   std::vector<float> nn;
   const std::size_t stride = std::max<std::size_t>(1, count / 1024);
   for (std::size_t i = 0; i < count; i += stride) {
@@ -479,8 +567,9 @@ float median_spacing(const glm::vec3* p, std::size_t count, float diagonal) {
         for (int dy = -ring; dy <= ring; ++dy)
           for (int dx = -ring; dx <= ring; ++dx) {
             const glm::vec3 c = (glm::vec3(q + glm::ivec3(dx, dy, dz)) + 0.5f) * cell;
-            auto range = grid.equal_range(key(c));
-            for (auto it = range.first; it != range.second; ++it) {
+            const std::uint64_t k = key(c);
+            auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, std::uint32_t(0)));
+            for (; it != grid.end() && it->first == k; ++it) {
               if (it->second == i) continue;
               const float d = glm::length(p[it->second] - p[i]);
               if (d > 0.0f) best = std::min(best, d);
@@ -833,6 +922,8 @@ class placement {
       lo = glm::min(lo, p_[i]);
       hi = glm::max(hi, p_[i]);
     }
+    lo_ = lo;
+    hi_ = hi;
     diagonal_ = glm::length(hi - lo);
     const float a = o_.error_threshold;
     if (o_.min_radius == 0.0f) {
@@ -849,7 +940,8 @@ class placement {
 
   void set_up() {
     bvh_.build(records_, o_);
-    for (auto* v : {&covered_, &dirty_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
+    for (auto* v : {&covered_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
+    dirty_.assign(count_, 1);  // the first coverage pass tests every point
     record_at_point_.assign(count_, -1);
     grid_of_points_.build(p_, count_);
     std::vector<std::uint64_t> key(count_);
@@ -874,10 +966,11 @@ class placement {
   }
 
   // 1. Coverage of every point whose answer can have changed (parallel, read-only on the
-  // records): open points and dirty points (in the reach of a record added or shrunk in the last
-  // round, within nearby_opinion's reach of a new record, or newly presumed inside). Every other
-  // point is covered by the same records with the same radii as when it was checked, and its
-  // opinions come from the same records, so its answer stands. The dark floor of the tests
+  // records): the dirty points (all of them in the first pass; then those in the reach of a
+  // record added or shrunk in the last round, within nearby_opinion's reach of a new record, or
+  // newly presumed inside). Every other point, open or covered, sees the same records with the
+  // same radii as when it was last checked, and its opinions come from the same records, so its
+  // answer stands. The dark floor of the tests
   // (floor_e_: 5% of the mean irradiance of the first round's records, a uniform sample of the
   // points) is fixed once set, so no answer depends on records far away.
   void coverage_pass(cache_round_stats& round) {
@@ -895,7 +988,7 @@ class placement {
     parallel_for(count_, threads_, 4096, [&](int worker, std::size_t b, std::size_t e) {
       tally& t = tallies[std::size_t(worker)];
       for (std::size_t i = b; i < e; ++i) {
-        if (own_invalid_[i] || (!dirty_[i] && (covered_[i] || (presumed_[i] && !contested_[i])))) continue;
+        if (own_invalid_[i] || !dirty_[i]) continue;
         std::size_t visited = 0;
         check_point(i, visited);
         ++t.checked;
@@ -971,21 +1064,40 @@ class placement {
   }
 
   // 2. Seeds: open points in the fixed order, at least `spacing` from this round's earlier seeds
-  // of a similar normal (each seed blocks the points around it); at the finest spacing every
-  // open point is a seed.
+  // of a similar normal; at the finest spacing every open point is a seed. The round's seeds go
+  // into a uniform grid of cells at least `spacing` wide, so a candidate looks at the seeds of
+  // the cells around it only (cost O(open points), whatever the spacing).
   std::vector<std::size_t> pick_seeds() {
     std::vector<std::size_t> seeds;
     const bool finest = !(spacing_ > finest_);
-    if (!finest) blocked_.assign(count_, 0);
-    for (std::size_t i : order_) {
-      if (!open(i) || (!finest && blocked_[i])) continue;
-      seeds.push_back(i);
-      if (finest) continue;
-      // Every point this seed blocks for the rest of the round.
-      const glm::vec3 c = p_[i], nc = n_[i];
-      grid_of_points_.for_each_in_sphere(c, spacing_, [&](std::uint32_t j) {
-        if (glm::length(p_[j] - c) < spacing_ && glm::dot(n_[j], nc) > 0.9f) blocked_[j] = 1;
+    if (finest) {
+      for (std::size_t i : order_)
+        if (open(i)) seeds.push_back(i);
+      return seeds;
+    }
+    seed_cells_.reset(lo_, hi_, spacing_, count_);
+    const float r2 = spacing_ * spacing_;
+    // The points are visited in a pseudo-random order: their open flags go into one small array
+    // first, and the positions and normals a few steps ahead are prefetched.
+    is_open_.resize(count_);
+    for (std::size_t i = 0; i < count_; ++i) is_open_[i] = open(i) ? 1 : 0;
+    constexpr std::size_t ahead = 16;
+    for (std::size_t k = 0; k < count_; ++k) {
+      if (k + ahead < count_) {
+        const std::size_t q = order_[k + ahead];
+        __builtin_prefetch(&p_[q]);
+        __builtin_prefetch(&n_[q]);
+      }
+      const std::size_t i = order_[k];
+      if (!is_open_[i]) continue;
+      const glm::vec3 x = p_[i], nx = n_[i];
+      const bool blocked = seed_cells_.any_near(x, spacing_, [&](const glm::vec3& c, const glm::vec3& nc) {
+        const glm::vec3 d = x - c;
+        return glm::dot(d, d) <= r2 && glm::length(x - c) < spacing_ && glm::dot(nx, nc) > 0.9f;
       });
+      if (blocked) continue;
+      seed_cells_.insert(x, nx);
+      seeds.push_back(i);
     }
     return seeds;
   }
@@ -1087,38 +1199,57 @@ class placement {
     if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return false;
     const float a = o_.error_threshold;
     bvh_.build(records_, o_, threads_);
-    // Candidates of each new record: records whose coverage box holds x_i (the tree is not
-    // rebuilt during the sequential pass below, so these are gathered first, in parallel).
-    std::vector<std::vector<std::uint32_t>> candidates(records_.size() - first_new);
+    // The pairs of each new record i: records j whose coverage box holds x_i, with their distance
+    // and whether their first-order predictions of each other disagree by more than a (neither
+    // depends on the radii, so both are found first, in parallel; the tree is not rebuilt during
+    // the sequential pass below).
+    struct pair {
+      std::uint32_t j;
+      bool disagree;
+      float d;
+    };
+    const bool shrink = o_.shrink_disagreeing;
+    std::vector<std::vector<pair>> candidates(records_.size() - first_new);
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
-        std::vector<std::uint32_t>& near = candidates[k];
-        bvh_.query(records_[first_new + k].position, [&](std::uint32_t j) { near.push_back(j); });
-        std::sort(near.begin(), near.end());
+        std::vector<pair>& near = candidates[k];
+        const std::size_t i = first_new + k;
+        const cache_record& ri = records_[i];
+        bvh_.query(ri.position, [&](const record_bvh::key& key) {
+          if (std::size_t(key.index) != i)
+            near.push_back({key.index, shrink && glm::dot(ri.normal, key.normal) > 0.9f, glm::length(ri.position - key.position)});
+        });
+        std::sort(near.begin(), near.end(), [](const pair& x, const pair& y) { return x.j < y.j; });
+        for (pair& q : near) {
+          // (disagree holds "similar normals" until here.)
+          if (q.disagree && q.d > 0.0f) {
+            const cache_record& rj = records_[q.j];
+            // Each record's first-order prediction of the other's irradiance (luminance).
+            const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
+            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
+            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
+            const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
+            q.disagree = err > a;
+          } else {
+            q.disagree = false;
+          }
+        }
       }
     });
     for (std::size_t i = first_new; i < records_.size(); ++i) {
-      for (std::uint32_t j : candidates[i - first_new]) {
-        if (std::size_t(j) == i) continue;
+      for (const pair& q : candidates[i - first_new]) {
         cache_record& ri = records_[i];
-        cache_record& rj = records_[j];
-        const float d = glm::length(ri.position - rj.position);
+        cache_record& rj = records_[q.j];
+        const float d = q.d;
         if (o_.neighbour_clamp) {
           ri.radius = std::max(o_.min_radius, std::min(ri.radius, rj.radius + d));
           rj.radius = std::max(o_.min_radius, std::min(rj.radius, ri.radius + d));
         }
-        if (o_.shrink_disagreeing && glm::dot(ri.normal, rj.normal) > 0.9f && d > 0.0f) {
-          // Each record's first-order prediction of the other's irradiance (luminance).
-          const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
-          const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
-          const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
-          const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
-          if (err > a) {
-            // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
-            const float r_gap = std::max(o_.min_radius, 0.4f * d / a);
-            ri.radius = std::min(ri.radius, r_gap);
-            rj.radius = std::min(rj.radius, r_gap);
-          }
+        if (q.disagree) {
+          // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
+          const float r_gap = std::max(o_.min_radius, 0.4f * d / a);
+          ri.radius = std::min(ri.radius, r_gap);
+          rj.radius = std::min(rj.radius, r_gap);
         }
       }
     }
@@ -1129,17 +1260,26 @@ class placement {
   // sphere holds its new one) are re-checked in the next coverage pass.
   void mark_dirty(std::size_t first_new) {
     const float a = o_.error_threshold;
-    for (std::size_t j = 0; j < records_.size(); ++j) {
-      const bool added = j >= first_new;
-      if (!added && records_[j].radius == old_radius_[j]) continue;
-      const float r = coverage_radius(records_[j], o_);
-      const float reach = added ? r : std::max(r, a * old_radius_[j]);
-      // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
-      grid_of_points_.for_each_in_sphere(records_[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty_[i] = 1; });
-      // nearby_opinion consults the records placed within nearby_reach of a point.
-      if (added && o_.nearby_opinion > 0.0f)
-        grid_of_points_.for_each_in_sphere(records_[j].position, nearby_reach_ * 1.0001f, [&](std::uint32_t i) { dirty_[i] = 1; });
-    }
+    // Worker 0 marks dirty_ itself, the others their own arrays, OR-ed in after (only ones are
+    // written, so the result does not depend on which worker marked what).
+    dirty_extra_.resize(std::size_t(std::max(threads_ - 1, 0)));
+    for (std::vector<std::uint8_t>& v : dirty_extra_) v.assign(count_, 0);
+    parallel_for(records_.size(), threads_, 256, [&](int worker, std::size_t b, std::size_t e) {
+      std::uint8_t* dirty = worker == 0 ? dirty_.data() : dirty_extra_[std::size_t(worker - 1)].data();
+      for (std::size_t j = b; j < e; ++j) {
+        const bool added = j >= first_new;
+        if (!added && records_[j].radius == old_radius_[j]) continue;
+        const float r = coverage_radius(records_[j], o_);
+        const float reach = added ? r : std::max(r, a * old_radius_[j]);
+        // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
+        grid_of_points_.for_each_in_sphere(records_[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
+        // nearby_opinion consults the records placed within nearby_reach of a point.
+        if (added && o_.nearby_opinion > 0.0f)
+          grid_of_points_.for_each_in_sphere(records_[j].position, nearby_reach_ * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
+      }
+    });
+    for (const std::vector<std::uint8_t>& v : dirty_extra_)
+      for (std::size_t i = 0; i < count_; ++i) dirty_[i] |= v[i];
   }
 
   // 7. Final interpolation (parallel) of every point that is not inside geometry.
@@ -1258,10 +1398,13 @@ class placement {
   record_bvh bvh_;
   point_grid grid_of_points_;
   std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
-  std::vector<std::uint8_t> blocked_;  // pick_seeds: within spacing of an earlier seed of the round
+  seed_grid seed_cells_;  // pick_seeds: the round's seeds so far
+  std::vector<std::uint8_t> is_open_;  // pick_seeds: open(i) of every point
+  glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
   std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
   std::vector<std::size_t> order_;             // the fixed pseudo-random order of the points
   std::vector<float> old_radius_;
+  std::vector<std::vector<std::uint8_t>> dirty_extra_;  // mark_dirty: workers 1, 2, ...' marks
   cache_stats stats_;
 };
 
