@@ -243,11 +243,11 @@ float ray_offset(const scene& s, const glm::vec3& p, const direct_options& o) no
 }
 
 // A shadow ray from o to the point q, stopping `off` short of q; true if it arrives.
-bool reaches(const scene& s, const glm::vec3& o, const glm::vec3& q, float off, const ray_options& ro) noexcept {
+bool reaches(const scene& s, const glm::vec3& o, const glm::vec3& q, float off) noexcept {
   const glm::vec3 d = q - o;
   const float len = glm::length(d);
   if (!(len > off)) return true;
-  return !occluded(s, o, d, 1.0f - off / len, ro);
+  return !occluded(s, o, d, 1.0f - off / len);
 }
 
 // The unoccluded closed form with the geometry the sampling needs.
@@ -402,15 +402,14 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
   const bool shadows = L.l.casts_shadows;
   const float off = ray_offset(s, p, options);
   const glm::vec3 o = p + off * n;
-  const ray_options& ro = options.rays;
   const bool hard = L.l.type != light_type::rect && L.l.radius == 0.0f;
   if (hard) {
     bool visible = true;
     if (shadows) {
       if (L.l.type == light_type::directional)
-        visible = !occluded(s, o, g.axis, std::numeric_limits<float>::infinity(), ro);
+        visible = !occluded(s, o, g.axis, std::numeric_limits<float>::infinity());
       else
-        visible = reaches(s, o, L.l.position, off, ro);
+        visible = reaches(s, o, L.l.position, off);
     }
     out.visibility = visible ? 1.0f : 0.0f;
     out.irradiance = visible ? g.e : glm::vec3(0.0f);
@@ -432,12 +431,12 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
       if (!(cos_r > 0.0f) || !(cos_l > 0.0f)) return;
       rw = cos_l / d2;
       w = cos_r * rw;
-      visible = !shadows || reaches(s, o, q, off, ro);
+      visible = !shadows || reaches(s, o, q, off);
     });
     closed_direction = v.visibility == 1.0f;
     if (!v.any_traced) {  // a sliver above the horizon: one ray to the clipped polygon's centroid
       const glm::vec3 q = p + glm::vec3(g.rect.centroid);
-      const bool visible = !shadows || reaches(s, o, q, off, ro);
+      const bool visible = !shadows || reaches(s, o, q, off);
       v.visibility = visible ? 1.0f : 0.0f;
       closed_direction = visible;
     }
@@ -467,10 +466,10 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
         if (!shadows) {
           visible = true;
         } else if (sun) {
-          visible = !occluded(s, o, d, std::numeric_limits<float>::infinity(), ro);
+          visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
         } else {
           const float t = sphere_distance(o, d, L.l.position, r) - off;
-          visible = !(t > 0.0f) || !occluded(s, o, d, t, ro);
+          visible = !(t > 0.0f) || !occluded(s, o, d, t);
         }
       });
       if (!v.any_traced) {  // a sliver above the horizon: one ray to the cone's point nearest the normal
@@ -486,10 +485,10 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
         bool visible = true;
         if (shadows) {
           if (sun) {
-            visible = !occluded(s, o, d, std::numeric_limits<float>::infinity(), ro);
+            visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
           } else {
             const float t = sphere_distance(o, d, L.l.position, r) - off;
-            visible = !(t > 0.0f) || !occluded(s, o, d, t, ro);
+            visible = !(t > 0.0f) || !occluded(s, o, d, t);
           }
         }
         v.visibility = visible ? 1.0f : 0.0f;

@@ -1,5 +1,6 @@
 // Ray queries over the scene's BVH (rays.hpp): Woop, Benthin and Wald's watertight triangle test,
-// eight triangles of a leaf at a time, and an ordered traversal with a fixed stack.
+// a leaf's triangles in vectorised loops (#pragma omp simd), and an ordered traversal with a
+// fixed stack.
 //
 // Compiled with -ffp-contract=off (CMakeLists.txt): the edge functions of two triangles that share
 // an edge must be exact negations of each other, which a fused multiply-add would break.
@@ -10,14 +11,6 @@
 #include <cstdint>
 #include <limits>
 
-#if defined(__GNUC__)
-#define HEMILIGHT_INLINE inline __attribute__((always_inline))
-#define HEMILIGHT_TARGET_AVX2 __attribute__((target("avx2")))
-#define HEMILIGHT_HAVE_AVX2_BUILD 1
-#else
-#define HEMILIGHT_INLINE inline
-#define HEMILIGHT_HAVE_AVX2_BUILD 0
-#endif
 
 namespace hemilight {
 
@@ -61,7 +54,7 @@ bool make_setup(const scene& s, const glm::vec3& origin, const glm::vec3& d, flo
 }
 
 // Slab test of a node's box against [0, t_max]; t_near is where the ray enters it.
-HEMILIGHT_INLINE bool hit_box(const bvh_node& b, const ray_setup& r, float t_max, float& t_near) noexcept {
+inline bool hit_box(const bvh_node& b, const ray_setup& r, float t_max, float& t_near) noexcept {
   const float x0 = (b.lo.x - r.ow[0]) * r.inv[0], x1 = (b.hi.x - r.ow[0]) * r.inv[0];
   const float y0 = (b.lo.y - r.ow[1]) * r.inv[1], y1 = (b.hi.y - r.ow[1]) * r.inv[1];
   const float z0 = (b.lo.z - r.ow[2]) * r.inv[2], z1 = (b.hi.z - r.ow[2]) * r.inv[2];
@@ -76,7 +69,7 @@ struct sheared {
   float ax, ay, az, bx, by, bz, cx, cy, cz;
 };
 
-HEMILIGHT_INLINE sheared shear(const ray_setup& r, std::uint32_t i) noexcept {
+inline sheared shear(const ray_setup& r, std::uint32_t i) noexcept {
   sheared t;
   t.az = r.c[0][2][i] - r.o[2];
   t.bz = r.c[1][2][i] - r.o[2];
@@ -106,7 +99,7 @@ float exact_triangle(const ray_setup& r, std::uint32_t i, float t_max) noexcept 
 
 // Any-hit over a leaf: eight lanes at a time (lanes past `count` read the next triangles or the
 // padding of the coordinate arrays and are masked out).
-HEMILIGHT_INLINE bool leaf_any(const ray_setup& r, std::uint32_t first, std::uint32_t count, float t_max) noexcept {
+inline bool leaf_any(const ray_setup& r, std::uint32_t first, std::uint32_t count, float t_max) noexcept {
   const std::uint32_t n8 = (count + 7u) & ~7u;
   int hit = 0, zero = 0;
 #pragma omp simd reduction(| : hit, zero)
@@ -134,7 +127,7 @@ HEMILIGHT_INLINE bool leaf_any(const ray_setup& r, std::uint32_t first, std::uin
 
 // Closest hit over a leaf: the smallest t below `best` (first in leaf order on ties); returns
 // the triangle's index or UINT32_MAX.
-HEMILIGHT_INLINE std::uint32_t leaf_closest(const ray_setup& r, std::uint32_t first, std::uint32_t count,
+inline std::uint32_t leaf_closest(const ray_setup& r, std::uint32_t first, std::uint32_t count,
                                             float& best) noexcept {
   alignas(32) float ts[scene::max_leaf_triangles + 8];
   const std::uint32_t n8 = (count + 7u) & ~7u;
@@ -169,7 +162,7 @@ HEMILIGHT_INLINE std::uint32_t leaf_closest(const ray_setup& r, std::uint32_t fi
 }
 
 template <bool any>
-HEMILIGHT_INLINE bool traverse(const scene& s, const ray_setup& r, float t_max, std::uint32_t* closest,
+inline bool traverse(const scene& s, const ray_setup& r, float t_max, std::uint32_t* closest,
                                float* closest_t) noexcept {
   const bvh_node* nodes = s.bvh().data();
   struct entry {
@@ -229,58 +222,28 @@ HEMILIGHT_INLINE bool traverse(const scene& s, const ray_setup& r, float t_max, 
   }
 }
 
-bool any_portable(const scene& s, const ray_setup& r, float t_max) noexcept {
+
+inline bool any_hit(const scene& s, const ray_setup& r, float t_max) noexcept {
   return traverse<true>(s, r, t_max, nullptr, nullptr);
 }
-bool closest_portable(const scene& s, const ray_setup& r, float t_max, std::uint32_t* i, float* t) noexcept {
+inline bool closest_hit(const scene& s, const ray_setup& r, float t_max, std::uint32_t* i, float* t) noexcept {
   return traverse<false>(s, r, t_max, i, t);
 }
-
-#if HEMILIGHT_HAVE_AVX2_BUILD
-HEMILIGHT_TARGET_AVX2 bool any_avx2(const scene& s, const ray_setup& r, float t_max) noexcept {
-  return traverse<true>(s, r, t_max, nullptr, nullptr);
-}
-HEMILIGHT_TARGET_AVX2 bool closest_avx2(const scene& s, const ray_setup& r, float t_max, std::uint32_t* i,
-                                        float* t) noexcept {
-  return traverse<false>(s, r, t_max, i, t);
-}
-
-bool cpu_has_avx2() noexcept {
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
-}
-#endif
 
 }  // namespace
 
-bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
-              const ray_options& options) noexcept {
+bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
   ray_setup r;
   if (!make_setup(s, origin, direction, t_max, r)) return false;
-#if HEMILIGHT_HAVE_AVX2_BUILD
-  if (options.avx2 && cpu_has_avx2()) return any_avx2(s, r, t_max);
-#else
-  (void)options;
-#endif
-  return any_portable(s, r, t_max);
+  return any_hit(s, r, t_max);
 }
 
-bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max, ray_hit& hit,
-               const ray_options& options) noexcept {
+bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max, ray_hit& hit) noexcept {
   ray_setup r;
   if (!make_setup(s, origin, direction, t_max, r)) return false;
   std::uint32_t i = 0;
   float t = 0.0f;
-  bool found;
-#if HEMILIGHT_HAVE_AVX2_BUILD
-  if (options.avx2 && cpu_has_avx2())
-    found = closest_avx2(s, r, t_max, &i, &t);
-  else
-#else
-  (void)options;
-#endif
-    found = closest_portable(s, r, t_max, &i, &t);
-  if (!found) return false;
+  if (!closest_hit(s, r, t_max, &i, &t)) return false;
   const scene::triangle& tri = s.triangles()[i];
   hit.distance = t;
   hit.drawable = i;

@@ -200,23 +200,3 @@ TEST_CASE("rays: both faces are hit; the closest of several is reported", "[rays
   CHECK(occluded(*s, {0.3f, -0.2f, 5.0f}, {0, 0, -1}, inf));
 }
 
-TEST_CASE("rays: the AVX2 and SSE2 builds give the same answers bit for bit", "[rays]") {
-  const scene_mesh m = hexagon_room(3);
-  const auto s = scene::create(m.desc());
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u(-4.5f, 4.5f);
-  ray_options sse2;
-  sse2.avx2 = false;
-  for (int k = 0; k < 2000; ++k) {
-    const glm::vec3 o(u(rng), u(rng) * 0.4f + 1.5f, u(rng)), d(u(rng), u(rng), u(rng));
-    const float t_max = k % 2 ? inf : 0.5f;
-    CHECK(occluded(*s, o, d, t_max) == occluded(*s, o, d, t_max, sse2));
-    ray_hit a, b;
-    const bool fa = intersect(*s, o, d, t_max, a), fb = intersect(*s, o, d, t_max, b, sse2);
-    CHECK(fa == fb);
-    if (fa && fb) {
-      CHECK(a.distance == b.distance);
-      CHECK(a.triangle == b.triangle);
-    }
-  }
-}

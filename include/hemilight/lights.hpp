@@ -128,7 +128,6 @@ struct direct_options {
   /// rasterizer's near distance (raster.hpp), so shadow rays and hemicubes skip the same
   /// neighbourhood. Must be finite and >= 0.
   float offset_scale = 1e-4f;
-  ray_options rays{};  ///< options of the shadow rays
 };
 
 /// The validated lights, prepared for evaluation (unit directions, frames, spot factors). Build it

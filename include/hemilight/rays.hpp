@@ -24,17 +24,21 @@
 // of 64 entries (the BVH's depth is at most 27: it splits at multiples of 32 triangles near the
 // median, so depth <= ceil(log2(2^31 / 32)) + 1).
 //
-// Leaves (up to scene::max_leaf_triangles = 32 triangles) are tested eight triangles at a time
-// from the per-coordinate arrays (scene::vertex_coordinates): an AVX2 build of the loop where the
-// CPU has AVX2 (checked at run time), otherwise the SSE2 build. Both compute the same bits.
+// Leaves (up to scene::max_leaf_triangles = 32 triangles) are tested in a loop the compiler
+// vectorises (#pragma omp simd; four lanes with SSE2) over the per-coordinate arrays
+// (scene::vertex_coordinates), in groups of eight (lanes past the leaf's end are masked).
 //
 // Thread safety: the queries are free functions of a const scene with no state of their own (no
-// caches, no counters, nothing static but the CPU check); any number of threads may query the
+// caches, no counters, nothing static); any number of threads may query the
 // same scene at once. No allocation.
 //
-// Cost (one core of a 2020s x86-64 server, AVX2; benchmarks/bench_rays.cpp, docs/lights.md):
-// O(log T) node visits plus 32 triangle tests per leaf visited; a shadow ray in the hexagon room
-// (1,062 triangles) or the Cornell box costs roughly 0.1-0.3 us.
+// Cost (one core of a shared AMD EPYC server, SSE2; benchmarks/bench_rays.cpp, docs/lights.md):
+// O(log T) node visits plus up to 32 triangle tests per leaf whose box the ray crosses. Shadow
+// rays: about 0.2 us in the Cornell box (5.3 M/s), 0.5 us in the open pavilion (2.1 M/s), 0.9 us
+// in the hexagon room at tessellation 3 (1.1 M/s: rays inside a room cross the boxes of most of
+// its 32-triangle leaves). Embree's rtcOccluded1 on the same rays is 3x to 14x faster (its BVH
+// has small leaves built for rays; this one is the rasterizer's).
+
 #pragma once
 
 #include "hemilight/scene.hpp"
@@ -53,27 +57,18 @@ struct ray_hit {
   bool front_face = false;       ///< the ray arrives on the front side (direction . normal < 0)
 };
 
-/// Options of the ray queries (for tests and comparisons; the defaults are what lights use).
-struct ray_options {
-  /// Use the AVX2 build of the leaf loop where the CPU has AVX2; false selects the SSE2 build.
-  /// Both give the same results bit for bit.
-  bool avx2 = true;
-};
-
 /// Any-hit query: true if some drawable triangle of `s` is hit at 0 < t < t_max by
 /// origin + t direction. Stops at the first hit found (not the nearest).
 /// Preconditions (not checked beyond what is stated): origin finite; t_max > 0 or +inf.
 /// A zero or non-finite direction, a NaN t_max or t_max <= 0 returns false. Cost: see the top
 /// of this header; thread-safe, no allocation.
-bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
-              const ray_options& options = {}) noexcept;
+bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
 
 /// Closest-hit query: the nearest drawable triangle hit at 0 < t < t_max, written to `hit`
 /// (untouched when there is none). Returns whether one was found. Triangles hit at exactly the
 /// same t: the first in BVH order among those in the first leaf that reaches that t (deterministic
 /// for a given scene and ray). Preconditions and cost as occluded() (it visits more nodes: no
 /// early exit, only the pruning of boxes farther than the nearest hit so far).
-bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max, ray_hit& hit,
-               const ray_options& options = {}) noexcept;
+bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max, ray_hit& hit) noexcept;
 
 }  // namespace hemilight
