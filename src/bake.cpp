@@ -190,6 +190,18 @@ void check_options(const bake_options& o) {
     throw_invalid_argument(std::string(who) + ": dilation " + std::to_string(o.dilation) + " must be >= -1");
   if (o.thread_count < 0)
     throw_invalid_argument(std::string(who) + ": thread_count " + std::to_string(o.thread_count) + " must be >= 0");
+  try {
+    validate_lights(o.lights.data(), o.lights.size());
+    validate_direct_options(o.direct);
+  } catch (const error& e) {
+    throw_invalid_argument(std::string(who) + ": " + e.what());
+  }
+  for (std::size_t c = 0; c < o.shadow_mask_lights.size(); ++c) {
+    const int l = o.shadow_mask_lights[c];
+    if (l < -1 || (l >= 0 && std::size_t(l) >= o.lights.size()))
+      throw_invalid_argument(std::string(who) + ": shadow_mask_lights[" + std::to_string(c) + "] = " + std::to_string(l) +
+                             " is not -1 or a light index (there are " + std::to_string(o.lights.size()) + " lights)");
+  }
 }
 
 }  // namespace
@@ -258,6 +270,7 @@ std::vector<std::string> write_bake_exrs(const bake_result& r, const std::string
     if (r.sh_l1[k].width > 0) put("_sh_l1_" + std::to_string(k) + ".exr", r.sh_l1[k]);
   for (std::size_t k = 0; k < r.hl2.size(); ++k)
     if (r.hl2[k].width > 0) put("_hl2_" + std::to_string(k) + ".exr", r.hl2[k]);
+  if (r.shadow_mask.width > 0) put("_shadow_mask.exr", r.shadow_mask);
   return written;
 }
 
@@ -560,25 +573,130 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
   return v;
 }
 
-// Samples inside geometry get the values of the valid texels around them in the lightmap (texel
-// dilation until every such texel is reached): the same chart, so the same side of the same
-// surface, never a record across a wall. Used by both modes.
-void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_options& o) {
-  const std::size_t count = pts.texel_of.size();
-  std::size_t invalid = 0;
-  for (std::uint8_t f : v.invalid) invalid += f;
-  if (invalid == 0) return;
-  std::vector<std::uint8_t> filled(std::size_t(o.width) * std::size_t(o.height), 0);
-  for (std::size_t i = 0; i < count; ++i)
-    if (!v.invalid[i]) filled[pts.texel_of[i]] = 1;
-  const auto fill = [&](std::vector<glm::vec3>& values) {
-    image tmp = image::make(o.width, o.height, 3);
-    for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * pts.texel_of[i], &values[i], sizeof(glm::vec3));
-    std::vector<std::uint8_t> f = filled;
+// Per-sample values at samples inside geometry (invalid[i] = 1) replaced by those of the valid
+// texels around them in the lightmap (texel dilation until every such texel is reached): the same
+// chart, so the same side of the same surface, never a record across a wall.
+class invalid_filler {
+ public:
+  invalid_filler(const sample_points& pts, const std::vector<std::uint8_t>& invalid, const bake_options& o)
+      : pts_(pts), invalid_(invalid), o_(o), filled_(std::size_t(o.width) * std::size_t(o.height), 0) {
+    for (std::size_t i = 0; i < invalid.size(); ++i) {
+      if (!invalid[i]) filled_[pts.texel_of[i]] = 1;
+      any_ = any_ || invalid[i];
+    }
+  }
+  bool needed() const { return any_; }
+  void operator()(std::vector<glm::vec3>& values) const {
+    if (!any_) return;
+    const std::size_t count = pts_.texel_of.size();
+    image tmp = image::make(o_.width, o_.height, 3);
+    for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * pts_.texel_of[i], &values[i], sizeof(glm::vec3));
+    std::vector<std::uint8_t> f = filled_;
     dilate(tmp, f, -1);
     for (std::size_t i = 0; i < count; ++i)
-      if (v.invalid[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts.texel_of[i], sizeof(glm::vec3));
-  };
+      if (invalid_[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts_.texel_of[i], sizeof(glm::vec3));
+  }
+
+ private:
+  const sample_points& pts_;
+  const std::vector<std::uint8_t>& invalid_;
+  const bake_options& o_;
+  std::vector<std::uint8_t> filled_;
+  bool any_ = false;
+};
+
+// What the lights give per sample (step 3b), computed once: e and sh are added to every pass
+// before its invalid samples are filled; hl2 (in the texel's lightmap frame) and the shadow mask
+// are filled once after the passes and written with the outputs.
+struct direct_values {
+  std::vector<glm::vec3> e;
+  sh_planes sh;                                // with output_sh_l1
+  std::array<std::vector<glm::vec3>, 3> hl2;   // with output_hl2
+  std::array<std::vector<glm::vec3>, 2> mask;  // with a shadow mask: channels (0, 1, 2) and (3, -, -)
+};
+
+// Step 3b: the lights' direct irradiance at every sample (parallel, in blocks so that
+// cancellation stays live; deterministic: each sample's value depends on its point only).
+direct_values direct_pass(const lightmap_samples& s, const sample_points& pts, const scene& sc, const light_set& lights,
+                          const bake_options& o, const std::function<bool()>& keep_going) {
+  const std::size_t count = pts.texel_of.size();
+  const bool mask = std::any_of(o.shadow_mask_lights.begin(), o.shadow_mask_lights.end(), [](int l) { return l >= 0; });
+  direct_values d;
+  d.e.assign(count, glm::vec3(0.0f));
+  if (o.output_sh_l1)
+    for (auto& plane : d.sh) plane.assign(count, glm::vec3(0.0f));
+  if (o.output_hl2)
+    for (auto& plane : d.hl2) plane.assign(count, glm::vec3(0.0f));
+  if (mask)
+    for (auto& plane : d.mask) plane.assign(count, glm::vec3(0.0f));
+  const std::size_t block = 4096;
+  for (std::size_t b = 0; b < count; b += block) {
+    if (keep_going && !keep_going()) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+    const std::size_t end = std::min(count, b + block);
+    parallel_for(end - b, o.thread_count, 64, [&](int, std::size_t lo, std::size_t hi) {
+      std::vector<light_sample> per_light(lights.size());
+      for (std::size_t i = b + lo; i < b + hi; ++i) {
+        const glm::vec3 n = pts.normals[i];
+        d.e[i] = direct_irradiance(sc, lights, pts.positions[i], n, o.direct, per_light.data());
+        if (mask)
+          for (std::size_t c = 0; c < 4; ++c) {
+            const int l = o.shadow_mask_lights[c];
+            if (l >= 0) d.mask[c / 3][i][int(c % 3)] = per_light[std::size_t(l)].visibility;
+          }
+        if (!o.output_sh_l1 && !o.output_hl2) continue;
+        const std::size_t k = pts.texel_of[i];
+        const frame f{s.tangent[k], s.bitangent[k], s.normal[k]};
+        for (const light_sample& ls : per_light) {
+          const float cos_n = glm::dot(n, ls.direction);
+          if (!(cos_n > 1e-4f)) continue;  // no light, or all of it at the horizon (E ~ 0)
+          const glm::vec3 flux = ls.irradiance / cos_n;  // radiance x solid angle from direction w
+          const glm::vec3& w = ls.direction;
+          if (o.output_sh_l1) {
+            d.sh[0][i] += 0.282094792f * flux;
+            d.sh[1][i] += (0.488602512f * w.y) * flux;
+            d.sh[2][i] += (0.488602512f * w.z) * flux;
+            d.sh[3][i] += (0.488602512f * w.x) * flux;
+          }
+          if (o.output_hl2)
+            for (std::size_t j = 0; j < 3; ++j) {
+              const glm::vec3 basis = f.to_world(glm::vec3(hl2_basis[j][0], hl2_basis[j][1], hl2_basis[j][2]));
+              d.hl2[j][i] += std::max(0.0f, glm::dot(basis, w)) * flux;
+            }
+        }
+      }
+    });
+  }
+  return d;
+}
+
+// A pass's irradiance (and SH, where the pass computed it) plus the lights' (step 3b).
+void add_direct(const direct_values& d, pass_values& v) {
+  for (std::size_t i = 0; i < v.e.size(); ++i) v.e[i] += d.e[i];
+  for (std::size_t c = 0; c < 4; ++c)
+    if (!v.sh[c].empty() && !d.sh[c].empty())
+      for (std::size_t i = 0; i < v.e.size(); ++i) v.sh[c][i] += d.sh[c][i];
+}
+
+// The lights' HL2 values and shadow mask at samples inside geometry (valid = 0 after all passes)
+// from the valid texels around them, as the passes' values are.
+void fill_direct_outputs(const sample_points& pts, const std::vector<std::uint8_t>& valid, const bake_options& o,
+                         direct_values& d) {
+  std::vector<std::uint8_t> invalid(valid.size());
+  for (std::size_t i = 0; i < valid.size(); ++i) invalid[i] = valid[i] ? 0 : 1;
+  const invalid_filler fill(pts, invalid, o);
+  if (!fill.needed()) return;
+  for (auto& plane : d.hl2)
+    if (!plane.empty()) fill(plane);
+  for (auto& plane : d.mask)
+    if (!plane.empty()) fill(plane);
+}
+
+// Samples inside geometry get the values of the valid texels around them (invalid_filler). Used
+// by both modes.
+void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_options& o) {
+  const invalid_filler fill(pts, v.invalid, o);
+  if (!fill.needed()) return;
+  const std::size_t count = pts.texel_of.size();
   fill(v.e);
   for (auto& plane : v.sh)
     if (!plane.empty()) fill(plane);
@@ -597,7 +715,7 @@ void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_o
 // Step 5 and 6: the lightmap images from the last pass (less the first with indirect_only),
 // dilated around every chart.
 void write_outputs(const lightmap_samples& s, const sample_points& pts, const pass_values& last, const pass_values* first,
-                   const std::vector<std::uint8_t>& valid, const bake_options& o, bake_result& r) {
+                   const direct_values* direct, const std::vector<std::uint8_t>& valid, const bake_options& o, bake_result& r) {
   const std::size_t texels = std::size_t(o.width) * std::size_t(o.height);
   const std::size_t count = pts.texel_of.size();
   r.irradiance = image::make(o.width, o.height, 3);
@@ -634,8 +752,19 @@ void write_outputs(const lightmap_samples& s, const sample_points& pts, const pa
       if (first)
         for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= first->cone[i].coefficients[t];
       h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
+      if (direct && !first)
+        for (std::size_t j = 0; j < 3; ++j) h[i][j] += direct->hl2[j][i];
     }
     for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = to_image([&](std::size_t i) { return h[i][j]; });
+  }
+  if (direct && !direct->mask[0].empty()) {
+    const image rgb = to_image([&](std::size_t i) { return direct->mask[0][i]; });
+    const image alpha = to_image([&](std::size_t i) { return direct->mask[1][i]; });
+    r.shadow_mask = image::make(o.width, o.height, 4);
+    for (std::size_t k = 0; k < texels; ++k) {
+      for (std::size_t c = 0; c < 3; ++c) r.shadow_mask.pixels[4 * k + c] = rgb.pixels[3 * k + c];
+      r.shadow_mask.pixels[4 * k + 3] = alpha.pixels[3 * k];
+    }
   }
   r.stats.dilated_texels = dilate(r.irradiance, filled, o.dilation);
 }
@@ -670,6 +799,15 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   co.progress = nullptr;
   std::vector<std::uint8_t> valid(count, 1);
   pass_values current, first;
+  const light_set lights(o.lights.data(), o.lights.size());
+  direct_values direct;
+  if (!lights.empty()) {
+    const auto td = std::chrono::steady_clock::now();
+    std::function<bool()> keep_going;
+    if (o.progress) keep_going = [&] { return o.progress(0.0f); };
+    direct = direct_pass(s, pts, *sc, lights, o, keep_going);
+    r.stats.direct_seconds = seconds_since(td);
+  }
   image texture;
   radiance_texture texture_view;
 
@@ -702,12 +840,14 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     if (o.progress) pass_progress = [&](float f) { return report(base + span * f); };
     current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, r.stats)
                           : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, r.stats);
+    if (!lights.empty()) add_direct(direct, current);
     fill_invalid_samples(pts, current, o);
     for (std::size_t i = 0; i < count; ++i) valid[i] = std::uint8_t(valid[i] & (current.invalid[i] ? 0 : 1));
     if (pass == 0 && o.indirect_only) first = current;
   }
   if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
-  write_outputs(s, pts, current, o.indirect_only ? &first : nullptr, valid, o, r);
+  if (!lights.empty()) fill_direct_outputs(pts, valid, o, direct);
+  write_outputs(s, pts, current, o.indirect_only ? &first : nullptr, lights.empty() ? nullptr : &direct, valid, o, r);
   r.stats.seconds = seconds_since(t0);
   return r;
 }

@@ -520,4 +520,6 @@ glm::vec3 direct_irradiance(const scene& s, const light_set& lights, const glm::
   return sum;
 }
 
+void validate_direct_options(const direct_options& options) { check_options(options); }
+
 }  // namespace hemilight

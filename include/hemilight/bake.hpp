@@ -27,6 +27,13 @@
 //      hemicube sees back faces, or the cache presumes them inside from an invalid sample on the
 //      same side of the same surface: cache.hpp) are filled by dilating the valid texels around
 //      them in the lightmap (the same chart: never light from across a wall), in both modes.
+//   3b. Lights (bake_options::lights, lights.hpp). Their direct irradiance E_L is computed at
+//      every sample once, with shadow rays (never interpolated: the cache sees only what the
+//      hemicubes gather), and every pass's irradiance is E_hemicube + E_L. So pass 1's radiance
+//      texture holds emission + albedo (E_hemicube + E_L) / pi and the bounces carry the lights'
+//      light; indirect_only (E_bounces - E_1) drops E_L with the emitters' first bounce. The SH
+//      and HL2 maps get each light's part along its direction (below), and an optional shadow
+//      mask holds the visibility of up to four lights per texel.
 //   4. Bounces. Pass 1 sees emission and sky. Pass k > 1 renders with a radiance texture (same
 //      size as the lightmap) holding, per texel, emission + albedo E_{k-1} / pi of the texel's
 //      owner, dilated like the lightmap. The result of pass `bounces` is the lightmap; with
@@ -45,7 +52,11 @@
 //      frame (lightmap_tangent_frame, hl2_from_cone): frame-correct for any tangent, exact for
 //      light within 35.26 degrees of the normal, otherwise cut at azimuthal order 3 (measured 1.7%
 //      RMS for a grazing side light, where going through L1 SH would give 25%; docs/bake.md).
-//      All of them are dilated like the irradiance.
+//      All of them are dilated like the irradiance. A light adds to them what radiance from one
+//      direction w (light_sample::direction) would: with F = E_L / (n . w), SH coefficient
+//      F Y(w) and HL2 value F max(0, b_k . w). Exact for hard lights; for soft ones w is the
+//      direction of the visible part's vector irradiance (the spread of a small disc or sphere
+//      is lost: L1 and the clamped cosine change by O(a^2) for a light of angular radius a).
 //
 // UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
 // its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
@@ -57,6 +68,7 @@
 
 #include "hemilight/cache.hpp"
 #include "hemilight/image_io.hpp"
+#include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
 
 #include <array>
@@ -112,6 +124,19 @@ struct bake_options {
   /// axes, OpenGL face table) instead of scene_desc::sky_radiance. Build it with
   /// cubemap::from_image (which checks every value). null: the constant sky.
   std::shared_ptr<const cubemap> environment;
+  /// Analytic lights (lights.hpp): direct light at every sample, added to every pass (step 3b at
+  /// the top of this header). Checked as validate_lights does ("bake_lightmap: lights[2].radius
+  /// = -1 is negative"). Cost: per sample and light one shadow ray (hard) or 12 (soft), 72 in a
+  /// penumbra (direct_options). Empty: no lights.
+  std::vector<light> lights;
+  /// Shadow rays of the lights: sample counts and ray offset (lights.hpp). Checked as
+  /// validate_direct_options does.
+  direct_options direct;
+  /// Shadow mask (bake_result::shadow_mask): channel c holds, per texel, the visibility in [0, 1]
+  /// of light shadow_mask_lights[c] (an index into lights), the mask that engines with real-time
+  /// direct light multiply it by; -1 leaves the channel 0. All -1 (the default): no mask. An
+  /// index past the lights is an error.
+  std::array<int, 4> shadow_mask_lights{{-1, -1, -1, -1}};
   /// Called from the calling thread with the fraction of the whole bake done, in [0, 1] and never
   /// decreasing; return
   /// false to cancel (error(status::cancelled) is thrown, nothing is returned). May be empty.
@@ -130,6 +155,7 @@ struct bake_stats {
   std::size_t records = 0;            ///< cache records, all passes
   std::vector<cache_stats> passes;    ///< the cache's statistics per pass
   double coverage_seconds = 0.0;      ///< step 1
+  double direct_seconds = 0.0;        ///< step 3b: the lights' direct irradiance (0 without lights)
   double seconds = 0.0;               ///< the whole bake (wall time)
 };
 
@@ -153,6 +179,10 @@ struct bake_result {
   /// interpolated HL2 cone series (top of this header). A uniform sky L gives pi L (1 + 1/sqrt 3) / 2
   /// in all three. With indirect_only: last pass minus first pass. Dilated.
   std::array<image, 3> hl2;
+  /// With shadow_mask_lights (else empty): W x H RGBA, channel c = the visibility of light
+  /// shadow_mask_lights[c] (lights.hpp's light_sample::visibility: 1 for a light that casts no
+  /// shadow, 0 where it is below the horizon or behind a rect), 0 for unused channels. Dilated.
+  image shadow_mask;
   bake_stats stats;
 };
 
@@ -265,7 +295,8 @@ frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], 
 
 /// Writes the bake's EXR files (write_exr, image_io.hpp) with names prefix + suffix:
 /// "_irradiance.exr", "_mask.exr" (bake_mask_image), and when present "_sh_l1_0.exr" ..
-/// "_sh_l1_3.exr" (coefficients Y00, Y1-1, Y10, Y11) and "_hl2_0.exr" .. "_hl2_2.exr". Returns
+/// "_sh_l1_3.exr" (coefficients Y00, Y1-1, Y10, Y11), "_hl2_0.exr" .. "_hl2_2.exr" and
+/// "_shadow_mask.exr" (RGBA). Returns
 /// the paths written, in that order. Errors: as write_exr (error(io) naming the file; files
 /// written before the failure stay).
 std::vector<std::string> write_bake_exrs(const bake_result& result, const std::string& prefix,

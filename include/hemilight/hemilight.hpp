@@ -10,6 +10,8 @@
 //   reference_scenes.hpp  the reference scenes (Cornell box, hexagon room, ...) by name
 //   raster.hpp    the software hemicube rasterizer
 //   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
+//   rays.hpp      shadow and closest-hit ray queries against a scene
+//   lights.hpp    sun, point, spot and rect lights: direct irradiance with shadow rays
 //   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
 //   bake.hpp      the lightmap baker: UV coverage, samples, bounces, dilation
 //   cubemap.hpp   environment cube maps: mappings, sampling, lookup fixup, filtering, SH
@@ -23,7 +25,9 @@
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
 #include "hemilight/integrate.hpp"
+#include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
+#include "hemilight/rays.hpp"
 #include "hemilight/reference_scenes.hpp"
 #include "hemilight/scene.hpp"

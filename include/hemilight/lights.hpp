@@ -130,6 +130,10 @@ struct direct_options {
   float offset_scale = 1e-4f;
 };
 
+/// Checks direct_options as direct_light does: throws error(invalid_argument) naming the field
+/// ("direct_options: penumbra_samples = 3 must be in [probe_samples = 4, 65536]"). Cost: O(1).
+void validate_direct_options(const direct_options& options);
+
 /// The validated lights, prepared for evaluation (unit directions, frames, spot factors). Build it
 /// once and share it between threads (immutable).
 class light_set {
