@@ -47,6 +47,8 @@ void hemilight_bake_options_init(hemilight_bake_options* options) {
   options->progress_user = nullptr;
   options->environment_rgb = nullptr;
   options->environment_size = 0;
+  options->lights = nullptr;
+  options->light_count = 0;
 }
 
 hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
@@ -119,6 +121,9 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     }
     if (!all_finite(o.sky_radiance, 3) || o.sky_radiance[0] < 0 || o.sky_radiance[1] < 0 || o.sky_radiance[2] < 0)
       return invalid(fn, "options->sky_radiance must be finite and >= 0");
+    std::vector<hemilight::light> lights;
+    const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
+    if (lights_status != HEMILIGHT_OK) return lights_status;
 
     // Concatenate the meshes (indices offset by the vertices before them).
     std::vector<glm::vec3> positions, normals;
@@ -180,6 +185,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     bo.use_cache = o.use_cache == 1;
     bo.thread_count = o.thread_count;
     bo.environment = environment;
+    bo.lights = std::move(lights);
     bo.output_sh_l1 = sh_l1_rgb != nullptr;
     bo.output_hl2 = hl2_rgb != nullptr;
     if (o.progress) {

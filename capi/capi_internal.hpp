@@ -6,6 +6,7 @@
 
 #include "hemilight/error.hpp"
 #include "hemilight/cubemap.hpp"
+#include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
 
 #include <memory>
@@ -15,11 +16,13 @@
 #include <exception>
 #include <new>
 #include <string>
+#include <vector>
 
 /// The opaque scene handle of the C ABI: a shared, immutable C++ scene.
 struct hemilight_scene {
   std::shared_ptr<const hemilight::scene> scene;
   std::shared_ptr<const hemilight::cubemap> sky;  ///< optional environment sky (null: the scene's constant sky)
+  std::shared_ptr<const hemilight::light_set> lights;  ///< optional lights (null: none)
 };
 
 namespace hemilight::capi {
@@ -60,6 +63,11 @@ int enum_value(const E& e) noexcept {
   std::memcpy(&v, &e, sizeof v);
   return v;
 }
+
+/// The C lights as C++ lights, checked: on a bad one, sets the error "function: what[i].field ..."
+/// (what = "lights" or "options->lights") and returns INVALID_ARGUMENT; else HEMILIGHT_OK.
+hemilight_status to_lights(const char* function, const char* what, const hemilight_light* lights, std::size_t count,
+                           std::vector<light>& out);
 
 /// True if all `count` floats are finite.
 inline bool all_finite(const float* v, std::size_t count) noexcept {

@@ -65,6 +65,10 @@ hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const
         r.translation_gradient[ch][k] = s.translation_gradient[std::size_t(ch)][k];
       }
     }
+    if (scene->lights) {
+      const glm::vec3 e = hemilight::direct_irradiance(*scene->scene, *scene->lights, x, n / len);
+      for (int ch = 0; ch < 3; ++ch) r.irradiance[ch] += e[ch];
+    }
     r.harmonic_mean_distance = s.harmonic_mean_distance;
     r.min_distance = s.min_distance;
     r.backface_fraction = s.backface_fraction;
@@ -169,6 +173,17 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     } catch (const hemilight::error& e) {
       // "cache_irradiance: normals[3] ..." -> "hemilight_cache_irradiance: normals[3] ..."
       return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
+    }
+    if (scene->lights) {
+      // Direct light at every point, never interpolated (parallel; each point's value depends on
+      // the point alone, so the result is the same for any thread count).
+      const hemilight::scene& sc = *scene->scene;
+      const hemilight::light_set& ls = *scene->lights;
+      const glm::vec3* p = reinterpret_cast<const glm::vec3*>(positions);
+      const glm::vec3* nn = reinterpret_cast<const glm::vec3*>(normals);
+      hemilight::parallel_for(count, o.thread_count, 256, [&](int, std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) r.irradiance[i] += hemilight::direct_irradiance(sc, ls, p[i], glm::normalize(nn[i]));
+      });
     }
     for (size_t i = 0; i < count; ++i)
       for (int c = 0; c < 3; ++c) irradiance_rgb[3 * i + size_t(c)] = r.irradiance[i][c];

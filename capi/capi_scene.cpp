@@ -1,9 +1,12 @@
-// The C ABI's scene entry points: hemilight_scene_create / hemilight_scene_release.
+// The C ABI's scene entry points: hemilight_scene_create / _release / _with_environment /
+// _with_lights, and the C lights (hemilight_light_init, to_lights).
 #include "capi_internal.hpp"
 
+#include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <string>
@@ -17,7 +20,83 @@ using hemilight::capi::invalid;
 
 }  // namespace
 
+namespace hemilight::capi {
+
+hemilight_status to_lights(const char* function, const char* what, const hemilight_light* lights, std::size_t count,
+                           std::vector<light>& out) {
+  if (count > 0 && !lights) return invalid(function, std::string(what) + " is NULL but the count is " + std::to_string(count));
+  std::vector<light> ls(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const hemilight_light& c = lights[i];
+    if (c.casts_shadows != 0 && c.casts_shadows != 1)
+      return invalid(function, std::string(what) + "[" + std::to_string(i) + "].casts_shadows = " +
+                                   std::to_string(c.casts_shadows) + " is not 0 or 1");
+    light& l = ls[i];
+    // Any int is a value of light_type (its underlying type is int): validate_lights names unknown ones.
+    l.type = static_cast<light_type>(enum_value(c.type));
+    l.color = {c.color[0], c.color[1], c.color[2]};
+    l.position = {c.position[0], c.position[1], c.position[2]};
+    l.direction = {c.direction[0], c.direction[1], c.direction[2]};
+    l.tangent = {c.tangent[0], c.tangent[1], c.tangent[2]};
+    l.width = c.width;
+    l.height = c.height;
+    l.radius = c.radius;
+    l.spot_inner = c.spot_inner;
+    l.spot_outer = c.spot_outer;
+    l.casts_shadows = c.casts_shadows == 1;
+  }
+  try {
+    validate_lights(ls.data(), ls.size());
+  } catch (const error& e) {
+    // "lights[2].spot_outer = ..." -> "function: what[2].spot_outer = ..."
+    std::string m = e.what();
+    if (m.compare(0, 6, "lights") == 0) m = what + m.substr(6);
+    return set_error(to_c(e.code()), std::string(function) + ": " + m);
+  }
+  out = std::move(ls);
+  return HEMILIGHT_OK;
+}
+
+}  // namespace hemilight::capi
+
 extern "C" {
+
+void hemilight_light_init(hemilight_light* light, hemilight_light_type type) {
+  if (!light) return;
+  const hemilight::light d;  // the C++ defaults, the same values
+  *light = hemilight_light{};
+  std::memcpy(&light->type, &type, sizeof type);  // stored as given, even if unknown (no enum load)
+  for (int k = 0; k < 3; ++k) {
+    light->color[k] = d.color[k];
+    light->position[k] = d.position[k];
+    light->direction[k] = d.direction[k];
+    light->tangent[k] = d.tangent[k];
+  }
+  light->width = d.width;
+  light->height = d.height;
+  light->radius = d.radius;
+  light->spot_inner = d.spot_inner;
+  light->spot_outer = d.spot_outer;
+  light->casts_shadows = d.casts_shadows ? 1 : 0;
+}
+
+hemilight_status hemilight_scene_with_lights(const hemilight_scene* scene, const hemilight_light* lights, size_t count,
+                                             hemilight_scene** out) {
+  const char* fn = "hemilight_scene_with_lights";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    std::vector<hemilight::light> ls;
+    const hemilight_status st = hemilight::capi::to_lights(fn, "lights", lights, count, ls);
+    if (st != HEMILIGHT_OK) return st;
+    auto handle = std::make_unique<hemilight_scene>();
+    handle->scene = scene->scene;  // shared geometry and sky, not copied
+    handle->sky = scene->sky;
+    if (!ls.empty()) handle->lights = std::make_shared<const hemilight::light_set>(ls.data(), ls.size());
+    *out = handle.release();
+    return HEMILIGHT_OK;
+  });
+}
 
 hemilight_status hemilight_scene_create(const float* positions, size_t vertex_count, const uint32_t* indices,
                                         size_t triangle_count, const float* triangle_radiance,
@@ -90,7 +169,8 @@ hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, 
       faces.pixels[i] = faces_rgb[i];
     }
     auto handle = std::make_unique<hemilight_scene>();
-    handle->scene = scene->scene;  // shared geometry, not copied
+    handle->scene = scene->scene;  // shared geometry and lights, not copied
+    handle->lights = scene->lights;
     handle->sky = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
     *out = handle.release();
     return HEMILIGHT_OK;

@@ -156,6 +156,55 @@ HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
 HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, const float* faces_rgb,
                                                                 int size, hemilight_scene** out);
 
+/* ---- lights ------------------------------------------------------------------------------------ */
+
+/* Analytic lights (include/hemilight/lights.hpp, docs/lights.md). Lights are not geometry:
+ * hemicubes never see them and shadow rays never hit them. Their direct irradiance (closed forms,
+ * shadows from shadow rays against the scene's triangles, either side) is added to what the
+ * hemicubes gather by hemilight_sample_irradiance and hemilight_cache_irradiance (scenes made by
+ * hemilight_scene_with_lights) and by the bakes (hemilight_bake_options::lights), at every point:
+ * never interpolated. */
+typedef enum hemilight_light_type {
+  HEMILIGHT_LIGHT_DIRECTIONAL = 0, /* the sun: a disc of directions */
+  HEMILIGHT_LIGHT_POINT = 1,       /* a point, or a sphere with radius */
+  HEMILIGHT_LIGHT_SPOT = 2,        /* a point light with a cone (glTF KHR_lights_punctual falloff) */
+  HEMILIGHT_LIGHT_RECT = 3         /* a one-sided emitting rectangle */
+} hemilight_light_type;
+
+/* One light. Fields a type does not use are ignored but must be finite. Units: metres (scene
+ * units), radians, W. */
+typedef struct hemilight_light {
+  hemilight_light_type type;
+  float color[3];      /* DIRECTIONAL: W/m^2 on a plane facing it; POINT, SPOT: W/sr; RECT: W/m^2/sr; each >= 0 */
+  float position[3];   /* POINT, SPOT: position; RECT: centre */
+  float direction[3];  /* DIRECTIONAL: direction of travel; SPOT: axis; RECT: normal of the lit side (any length > 0) */
+  float tangent[3];    /* RECT: direction of its width (any length > 0, not parallel to direction) */
+  float width, height; /* RECT: size, each > 0 */
+  float radius;        /* DIRECTIONAL: angular radius (rad, <= pi/2; the sun: 0.00465); POINT, SPOT: sphere radius; 0 = hard */
+  float spot_inner, spot_outer; /* SPOT: half-angles (rad), 0 <= inner <= outer <= pi/2; full inside inner, 0 outside outer,
+                                   between: clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1)^2 */
+  int casts_shadows;   /* 1: shadow rays decide visibility; 0: the light reaches every point in front of it */
+} hemilight_light;
+
+/* Fills *light with the defaults of `type`: color (1, 1, 1), position (0, 0, 0), direction
+ * (0, -1, 0), tangent (1, 0, 0), width = height = 1, radius 0 (hard), spot_inner 0, spot_outer
+ * pi/4 (glTF's default), casts_shadows 1. NULL is ignored; an unknown type is stored as given (and
+ * rejected where the light is used). */
+HEMILIGHT_API void hemilight_light_init(hemilight_light* light, hemilight_light_type type);
+
+/* A new scene handle with the geometry and sky of `scene` (shared, not copied: releasing either
+ * handle keeps the other valid) and `count` lights (copied; they replace any lights of `scene`;
+ * count 0 gives a scene without lights, lights may then be NULL). Release it with
+ * hemilight_scene_release. Errors (nothing written to *out): INVALID_ARGUMENT for NULL scene or
+ * out, NULL lights with count > 0, and a bad light, the message naming its index and field
+ * ("hemilight_scene_with_lights: lights[2].spot_outer = 1.7 is past pi/2"): an unknown type, NaN
+ * or Inf in any field, a negative colour, a zero direction (DIRECTIONAL, SPOT, RECT), a negative
+ * radius or a DIRECTIONAL radius past pi/2, spot angles out of order or past pi/2, RECT width or
+ * height <= 0 or a tangent zero or parallel to the normal, casts_shadows not 0 or 1.
+ * Cost: O(count). Shadow rays: include/hemilight/rays.hpp. */
+HEMILIGHT_API hemilight_status hemilight_scene_with_lights(const hemilight_scene* scene, const hemilight_light* lights,
+                                                           size_t count, hemilight_scene** out);
+
 /* ---- irradiance at a point: render + integrate ------------------------------------------------ */
 
 /* What one hemicube sees, reduced. Gradients follow the irradiance-caching convention, per colour
@@ -171,7 +220,10 @@ typedef struct hemilight_irradiance {
   float backface_fraction;          /* projected-solid-angle fraction seeing back faces, [0, 1] */
 } hemilight_irradiance;
 
-/* Renders the hemicube of resolution N at `position` with normal `normal` and integrates it.
+/* Renders the hemicube of resolution N at `position` with normal `normal` and integrates it. With
+ * a scene that has lights (hemilight_scene_with_lights), irradiance also holds their direct
+ * irradiance at the point (shadow rays from the point offset along the normal by 1e-4 x the
+ * scene's size); the gradients, distances and backface_fraction are the hemicube's alone.
  * The normal need not be unit length (it is normalised) but must be finite and nonzero. The point
  * itself does not see the surface it lies on; offset it from the surface if that surface is not in
  * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
@@ -244,7 +296,10 @@ typedef struct hemilight_cache_stats {
 
 /* Irradiance (RGB) at `count` points (positions and normals: 3 * count floats each; normals unit
  * length within 1e-3) through the irradiance cache: hemicubes are rendered at few points, the
- * rest is interpolated (docs and include/hemilight/cache.hpp). The result is deterministic: the
+ * rest is interpolated (docs and include/hemilight/cache.hpp). With a scene that has lights, their
+ * direct irradiance is computed at every point (shadow rays, never interpolated) and added; the
+ * cache interpolates only what the hemicubes gather. A point inside geometry gets the direct light
+ * its own shadow rays find (usually none). The result is deterministic: the
  * same input gives bitwise the same output for any thread_count. Points inside geometry (their
  * hemicube sees mostly back faces) are filled from valid records around them.
  * irradiance_rgb receives 3 * count floats; stats may be NULL.
@@ -299,6 +354,13 @@ typedef struct hemilight_bake_options {
    * instead of sky_radiance. environment_size: 1..16384 with a map, 0 without. */
   const float* environment_rgb;
   int environment_size;
+  /* Optional lights (default NULL, 0): light_count lights, read during the call only. Their direct
+   * irradiance is computed at every sample with shadow rays and added to every bounce, so the
+   * bounces carry it; indirect_only drops it with the emitters' first bounce; the directional
+   * maps get each light's part along its direction. Checked as hemilight_scene_with_lights does
+   * (the message names options->lights[i] and the field). */
+  const hemilight_light* lights;
+  size_t light_count;
 } hemilight_bake_options;
 
 /* Fills options with the defaults above. NULL is ignored. */

@@ -1,4 +1,5 @@
-/* C99 test of the C ABI's lightmap baker: hemilight_bake_options_init, hemilight_bake_lightmap.
+/* C99 test of the C ABI's lightmap baker: hemilight_bake_options_init, hemilight_bake_lightmap,
+ * with and without lights.
  * Reference: a uniform sky of radiance L over unoccluded up-facing quads gives E = pi L at every
  * texel (closed form). Bad input: every failure leaves the caller's buffers untouched.
  * Prints failing checks and a closing "N passed, N failed" line. */
@@ -132,6 +133,43 @@ int main(void) {
   CHECK_FAILS(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL, 0, hl2, 9 * W * H - 1, NULL),
               HEMILIGHT_ERROR_INVALID_ARGUMENT, "hl2_capacity");
   CHECK(untouched());
+
+  /* Lights: a hard sun travelling along (0, -1, -1)/sqrt2 with E = 2 adds E cos 45 degrees to
+   * the sky's pi at every texel (the quads are unoccluded; float closed forms: 1e-4); with
+   * indirect_only the sun is dropped with the first bounce (nothing bounces here: 0). */
+  {
+    hemilight_light sun[2];
+    hemilight_light_init(&sun[0], HEMILIGHT_LIGHT_DIRECTIONAL);
+    sun[0].direction[1] = sun[0].direction[2] = -1.0f;
+    sun[0].color[0] = sun[0].color[1] = sun[0].color[2] = 2.0f;
+    CHECK(o.lights == NULL && o.light_count == 0);
+    o.lights = sun;
+    o.light_count = 1;
+    CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL) == HEMILIGHT_OK);
+    ok = 1;
+    for (i = 0; i < 3 * W * H; ++i)
+      if (fabs(out[i] - (3.14159265 + 2.0 * sqrt(0.5))) > 1e-4) ok = 0;
+    CHECK(ok);
+    o.indirect_only = 1;
+    CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL) == HEMILIGHT_OK);
+    ok = 1;
+    for (i = 0; i < 3 * W * H; ++i)
+      if (out[i] != 0.0f) ok = 0;
+    CHECK(ok);
+    o.indirect_only = 0;
+    /* A bad light fails the call naming options->lights[i] and the field; nothing written. */
+    hemilight_light_init(&sun[1], HEMILIGHT_LIGHT_POINT);
+    sun[1].radius = -0.5f;
+    o.light_count = 2;
+    fill_sentinel();
+    CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                "hemilight_bake_lightmap: options->lights[1].radius");
+    o.lights = NULL;
+    CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                "options->lights is NULL");
+    CHECK(untouched());
+    o.light_count = 0;
+  }
 
   /* Bad input: a clear message, nothing written. */
   fill_sentinel();

@@ -1,5 +1,6 @@
 /* C99 test of the C ABI's irradiance entry points: hemilight_sample_irradiance,
- * hemilight_cache_options_init, hemilight_cache_irradiance. References: closed forms (a uniform
+ * hemilight_cache_options_init, hemilight_cache_irradiance, and the lights (hemilight_light_init,
+ * hemilight_scene_with_lights). References: closed forms (a uniform
  * sky gives pi L; Lambert's formula for a quad emitter, written here in C).
  * Prints failing checks and a closing "N passed, N failed" line. */
 #include "capi_check.h"
@@ -316,9 +317,165 @@ static void test_environment(void) {
   hemilight_scene_release(env);
 }
 
+/* Lights through the C ABI: each type against its closed form, a hard shadow, casts_shadows = 0,
+ * the cache adding direct light at every point, errors naming the light and field. */
+static void test_lights(void) {
+  const float zero_sky[3] = {0.0f, 0.0f, 0.0f};
+  const float origin[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, 0.0f, 1.0f};
+  /* A black 0.4 x 0.4 square at height 1 above the origin, facing down. */
+  const float pos[] = {-0.2f, -0.2f, 1.0f, -0.2f, 0.2f, 1.0f, 0.2f, 0.2f, 1.0f, 0.2f, -0.2f, 1.0f};
+  const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  const float rad[] = {0, 0, 0, 0, 0, 0};
+  const double rect_v[4][3] = {{-0.3, -0.2, 1.5}, {0.5, -0.2, 1.5}, {0.5, 0.4, 1.5}, {-0.3, 0.4, 1.5}};
+  const double pd[3] = {0, 0, 0}, nd[3] = {0, 0, 1};
+  hemilight_scene *empty = NULL, *square = NULL, *lit = NULL, *lit2 = (hemilight_scene*)&passed;
+  hemilight_light l[4];
+  hemilight_irradiance r;
+  float *gp = NULL, *gn = NULL, *go = NULL;
+  hemilight_cache_options co;
+  int i;
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, zero_sky, &empty) == HEMILIGHT_OK);
+  CHECK(hemilight_scene_create(pos, 4, idx, 2, rad, zero_sky, &square) == HEMILIGHT_OK);
+
+  /* Defaults. */
+  hemilight_light_init(&l[0], HEMILIGHT_LIGHT_SPOT);
+  CHECK(l[0].type == HEMILIGHT_LIGHT_SPOT && l[0].casts_shadows == 1 && l[0].radius == 0.0f && l[0].color[1] == 1.0f);
+  CHECK(fabs(l[0].spot_outer - pi / 4) < 1e-6 && l[0].direction[1] == -1.0f && l[0].width == 1.0f);
+  hemilight_light_init(NULL, HEMILIGHT_LIGHT_POINT); /* ignored */
+
+  /* Point light I = 3 at height 2: E = I / d^2 = 0.75 (hard: one closed form, float). */
+  hemilight_light_init(&l[0], HEMILIGHT_LIGHT_POINT);
+  l[0].position[2] = 2.0f;
+  l[0].color[0] = l[0].color[1] = l[0].color[2] = 3.0f;
+  CHECK(hemilight_scene_with_lights(empty, l, 1, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  CHECK(fabs(r.irradiance[0] / 0.75 - 1.0) < 1e-5);
+  hemilight_scene_release(lit);
+  /* Behind the black square: the shadow ray is blocked and the hemicube sees black: exactly 0. */
+  CHECK(hemilight_scene_with_lights(square, l, 1, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  CHECK(r.irradiance[0] == 0.0f);
+  hemilight_scene_release(lit);
+  l[0].casts_shadows = 0;
+  CHECK(hemilight_scene_with_lights(square, l, 1, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  CHECK(fabs(r.irradiance[0] / 0.75 - 1.0) < 1e-5);
+  hemilight_scene_release(lit);
+
+  /* Spot straight down from height 2, inner 0.1, outer 0.3 rad: under it the point value, at
+   * 0.2 rad off axis glTF's factor ((cos a - cos outer) / (cos inner - cos outer))^2, at 0.35 rad 0. */
+  hemilight_light_init(&l[0], HEMILIGHT_LIGHT_SPOT);
+  l[0].position[2] = 2.0f;
+  l[0].direction[1] = 0.0f;
+  l[0].direction[2] = -1.0f;
+  l[0].spot_inner = 0.1f;
+  l[0].spot_outer = 0.3f;
+  CHECK(hemilight_scene_with_lights(empty, l, 1, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  CHECK(fabs(r.irradiance[1] / 0.25 - 1.0) < 1e-5);
+  {
+    const double a = 0.2, x = 2.0 * tan(a), d2 = 4.0 + x * x;
+    const double t = (cos(a) - cos(0.3)) / (cos(0.1) - cos(0.3));
+    const float p2[3] = {(float)x, 0.0f, 0.0f};
+    const float p3[3] = {(float)(2.0 * tan(0.35)), 0.0f, 0.0f};
+    CHECK(hemilight_sample_irradiance(lit, p2, up, 16, &r) == HEMILIGHT_OK);
+    CHECK(fabs(r.irradiance[1] / (t * t * cos(a) / d2) - 1.0) < 1e-3);
+    CHECK(hemilight_sample_irradiance(lit, p3, up, 16, &r) == HEMILIGHT_OK);
+    CHECK(r.irradiance[1] == 0.0f);
+  }
+  hemilight_scene_release(lit);
+
+  /* Sun travelling along (0, -1, -1) / sqrt 2 with E = 2: E cos 45 degrees. RECT of radiance 0.5
+   * over the origin (0.8 x 0.6 at height 1.5, lit side down): Lambert's formula. Both at once. */
+  hemilight_light_init(&l[0], HEMILIGHT_LIGHT_DIRECTIONAL);
+  l[0].direction[1] = -1.0f;
+  l[0].direction[2] = -1.0f;
+  l[0].color[0] = l[0].color[1] = l[0].color[2] = 2.0f;
+  hemilight_light_init(&l[1], HEMILIGHT_LIGHT_RECT);
+  l[1].position[0] = 0.1f;
+  l[1].position[1] = 0.1f;
+  l[1].position[2] = 1.5f;
+  l[1].direction[1] = 0.0f;
+  l[1].direction[2] = -1.0f;
+  l[1].width = 0.8f;
+  l[1].height = 0.6f;
+  l[1].color[0] = l[1].color[1] = l[1].color[2] = 0.5f;
+  CHECK(hemilight_scene_with_lights(empty, l, 2, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  {
+    const double expected = 2.0 * sqrt(0.5) + 0.5 * lambert(rect_v, 4, pd, nd);
+    /* The rect's visibility is sampled (12 rays, all visible: exactly 1); the closed forms are
+     * evaluated in float (sun) and double (rect): 1e-5. */
+    CHECK(fabs(r.irradiance[2] / expected - 1.0) < 1e-5);
+  }
+
+  /* The cache with lights: the direct part is computed at every point (the empty scene's
+   * hemicubes see a black sky), so every point gets exactly the closed forms above, translated. */
+  hemilight_cache_options_init(&co);
+  co.resolution = 16;
+  if (grid_points(&gp, &gn, &go, 8)) {
+    CHECK(hemilight_cache_irradiance(lit, gp, gn, 64, &co, go, NULL) == HEMILIGHT_OK);
+    for (i = 0; i < 64; ++i) {
+      const double p[3] = {gp[3 * i], gp[3 * i + 1], gp[3 * i + 2]};
+      const double expected = 2.0 * sqrt(0.5) + 0.5 * lambert(rect_v, 4, p, nd);
+      CHECK(fabs(go[3 * i] / expected - 1.0) < 1e-5);
+    }
+  }
+  free(gp);
+  free(gn);
+  free(go);
+
+  /* with_environment keeps the lights; releasing the base handle keeps the lit one valid. */
+  {
+    float faces[6 * 2 * 2 * 3];
+    hemilight_scene* env = NULL;
+    for (i = 0; i < 6 * 2 * 2 * 3; ++i) faces[i] = 0.0f;
+    CHECK(hemilight_scene_with_environment(lit, faces, 2, &env) == HEMILIGHT_OK);
+    hemilight_scene_release(lit);
+    CHECK(hemilight_sample_irradiance(env, origin, up, 16, &r) == HEMILIGHT_OK);
+    CHECK(fabs(r.irradiance[2] / (2.0 * sqrt(0.5) + 0.5 * lambert(rect_v, 4, pd, nd)) - 1.0) < 1e-5);
+    hemilight_scene_release(env);
+  }
+
+  /* Errors name the light and field; *out is not written. */
+  hemilight_light_init(&l[0], HEMILIGHT_LIGHT_POINT);
+  hemilight_light_init(&l[1], HEMILIGHT_LIGHT_SPOT);
+  l[1].position[1] = NAN;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].position.y is nan");
+  l[1].position[1] = 0.0f;
+  l[1].spot_inner = 0.5f;
+  l[1].spot_outer = 0.4f;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].spot_inner");
+  hemilight_light_init(&l[1], (hemilight_light_type)9);
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].type = 9");
+  hemilight_light_init(&l[1], HEMILIGHT_LIGHT_RECT);
+  l[1].width = 0.0f;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].width");
+  hemilight_light_init(&l[1], HEMILIGHT_LIGHT_DIRECTIONAL);
+  l[1].color[2] = -1.0f;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].color.b");
+  l[1].color[2] = 1.0f;
+  l[1].direction[0] = l[1].direction[1] = l[1].direction[2] = 0.0f;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].direction is zero");
+  hemilight_light_init(&l[1], HEMILIGHT_LIGHT_POINT);
+  l[1].casts_shadows = 2;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].casts_shadows = 2");
+  CHECK_FAILS(hemilight_scene_with_lights(empty, NULL, 1, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights is NULL");
+  CHECK_FAILS(hemilight_scene_with_lights(NULL, l, 1, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK(lit2 == (hemilight_scene*)&passed);
+  /* No lights: a plain scene again. */
+  CHECK(hemilight_scene_with_lights(square, NULL, 0, &lit) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(lit, origin, up, 16, &r) == HEMILIGHT_OK);
+  CHECK(r.irradiance[0] == 0.0f);
+  hemilight_scene_release(lit);
+  hemilight_scene_release(square);
+  hemilight_scene_release(empty);
+}
+
 int main(void) {
   test_sample();
   test_environment();
+  test_lights();
   test_cache();
   test_cache_rules();
   printf("%d passed, %d failed\n", passed, failed);
