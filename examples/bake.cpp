@@ -1,7 +1,9 @@
 // hemilight_bake — the command-line lightmap baker (the README's main job).
 //
 //   hemilight_bake                      bakes the built-in scenes (hexagon room lit by the sky
-//                                       through its window, Cornell box) into out/
+//                                       through its window, the same with a sun shining in, the
+//                                       Cornell box with its emissive light and with it as a RECT
+//                                       light) into out/
 //   hemilight_bake MODEL [options]      bakes a model file (OBJ, or anything assimp reads)
 //
 // Writes, per scene NAME, into the output directory: NAME_irradiance.exr (RGB float irradiance
@@ -17,11 +19,22 @@
 // (clamped to [0, 1]), emissive colour (Ke) = emitted radiance, two-sided flag. All meshes share
 // one lightmap. The sky (constant radiance) is --sky.
 //
+// Lights (lights.hpp): --sun and --point (repeatable) add lights; a model's own punctual and area
+// lights (glTF KHR_lights_punctual, FBX, Collada: whatever assimp imports as aiLight) are baked
+// too. assimp gives each light's colour already multiplied by its intensity; the values are used
+// as they are, in the model's units: a point or spot light's value as intensity (W/sr; glTF's
+// candela), a directional light's as irradiance (W/m^2; glTF's lux), with no photometric
+// conversion, so that they stay on the scale of the model's emissive colours. Spot cone angles are
+// assimp's inner and outer angles (full angles in assimp's convention, halved here); an area light
+// becomes a RECT of assimp's size and its colour as radiance. Light positions and directions are
+// those assimp reports after its node transforms (aiProcess_PreTransformVertices applies them).
+//
 // Preview tone mapping: exposure k = 0.5 / (mean luminance of the sampled texels), then Reinhard
 // c k / (1 + c k) per channel, then the sRGB transfer curve, 8 bits. The EXR holds the raw values.
 #include "hemilight/bake.hpp"
 #include "hemilight/cubemap.hpp"
 #include "hemilight/image_io.hpp"
+#include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/reference_scenes.hpp"
 
@@ -65,6 +78,10 @@ const char* usage =
     "  --directional K    also write directional lightmaps: sh (L1 SH, 4 EXRs), hl2 (Half-Life 2\n"
     "                     basis, 3 EXRs) or both (default: none)\n"
     "  --environment F    sky from an OpenEXR cube map (ENVMAP_CUBE) instead of the constant sky\n"
+    "  --sun DX,DY,DZ,E[,A]  a sun: direction of travel, irradiance facing it (W/m^2), angular\n"
+    "                     radius in radians (default 0.00465, the sun's; 0 = hard)\n"
+    "  --point X,Y,Z,I[,R]   a point light (repeatable): position, intensity (W/sr), radius (default 0)\n"
+    "  --shadow-mask      also write NAME_shadow_mask.exr: the visibility of the first four lights\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -81,8 +98,26 @@ struct settings {
   std::string model, out = "out", environment;
   bake_options options;
   glm::vec3 sky{1.0f};
-  bool quiet = false;
+  bool quiet = false, shadow_mask = false;
 };
+
+// "a,b,c,d[,e]": 4 or 5 finite numbers.
+std::vector<float> parse_list(const std::string& name, const std::string& text, const char* form) {
+  std::vector<float> v;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = text.find(',', at);
+    const std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    char* end = nullptr;
+    const float x = std::strtof(item.c_str(), &end);
+    if (item.empty() || *end || !std::isfinite(x)) fail(name + " " + text + " is invalid: it must be " + form, 2);
+    v.push_back(x);
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  if (v.size() < 4 || v.size() > 5) fail(name + " " + text + " is invalid: it must be " + form, 2);
+  return v;
+}
 
 int parse_int(const std::string& name, const char* text, long lo, long hi) {
   char* end = nullptr;
@@ -147,6 +182,24 @@ settings parse(int argc, char** argv) {
       s.options.output_hl2 = v != "sh";
     } else if (a == "--environment") {
       s.environment = value();
+    } else if (a == "--sun") {
+      const std::vector<float> v = parse_list("--sun", value(), "DX,DY,DZ,E[,ANGLE] like 0.3,-1,0.2,20");
+      light l;
+      l.type = light_type::directional;
+      l.direction = {v[0], v[1], v[2]};
+      l.color = glm::vec3(v[3]);
+      l.radius = v.size() > 4 ? v[4] : 0.00465f;
+      s.options.lights.push_back(l);
+    } else if (a == "--point") {
+      const std::vector<float> v = parse_list("--point", value(), "X,Y,Z,I[,RADIUS] like 0,2.5,0,10");
+      light l;
+      l.type = light_type::point;
+      l.position = {v[0], v[1], v[2]};
+      l.color = glm::vec3(v[3]);
+      l.radius = v.size() > 4 ? v[4] : 0.0f;
+      s.options.lights.push_back(l);
+    } else if (a == "--shadow-mask") {
+      s.shadow_mask = true;
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -166,7 +219,41 @@ struct model {
   std::vector<glm::vec2> uvs;
   std::vector<std::uint32_t> indices;
   std::vector<material> materials;
+  std::vector<light> lights;
 };
+
+// A model's lights as lights.hpp's (see the top of this file for the mapping).
+std::vector<light> model_lights(const aiScene* sc, const std::string& path) {
+  std::vector<light> out;
+  for (unsigned i = 0; i < sc->mNumLights; ++i) {
+    const aiLight& a = *sc->mLights[i];
+    light l;
+    l.color = glm::max(glm::vec3(a.mColorDiffuse.r, a.mColorDiffuse.g, a.mColorDiffuse.b), glm::vec3(0.0f));
+    l.position = {a.mPosition.x, a.mPosition.y, a.mPosition.z};
+    l.direction = {a.mDirection.x, a.mDirection.y, a.mDirection.z};
+    switch (a.mType) {
+      case aiLightSource_DIRECTIONAL: l.type = light_type::directional; break;
+      case aiLightSource_POINT: l.type = light_type::point; break;
+      case aiLightSource_SPOT:
+        l.type = light_type::spot;
+        l.spot_outer = std::clamp(0.5f * a.mAngleOuterCone, 0.0f, 1.5707963f);
+        l.spot_inner = std::clamp(0.5f * a.mAngleInnerCone, 0.0f, l.spot_outer);
+        break;
+      case aiLightSource_AREA:
+        l.type = light_type::rect;
+        l.tangent = {a.mUp.x, a.mUp.y, a.mUp.z};
+        l.width = a.mSize.x;
+        l.height = a.mSize.y;
+        break;
+      default:
+        std::fprintf(stderr, "hemilight_bake: '%s' light %u ('%s') is of a type that cannot be baked; skipped\n", path.c_str(), i,
+                     a.mName.C_Str());
+        continue;
+    }
+    out.push_back(l);
+  }
+  return out;
+}
 
 model load_model(const std::string& path) {
   std::error_code ec;
@@ -222,6 +309,7 @@ model load_model(const std::string& path) {
     }
   }
   if (m.indices.empty()) fail("'" + path + "' has no triangles");
+  m.lights = model_lights(sc, path);
   return m;
 }
 
@@ -281,8 +369,11 @@ struct progress_bar {
   }
 };
 
-void bake_and_write(const std::string& name, const bake_input& in, const settings& s) {
+void bake_and_write(const std::string& name, const bake_input& in, const settings& s, const std::vector<light>& scene_lights) {
   bake_options o = s.options;
+  o.lights.insert(o.lights.end(), scene_lights.begin(), scene_lights.end());
+  if (s.shadow_mask)
+    for (std::size_t c = 0; c < 4 && c < o.lights.size(); ++c) o.shadow_mask_lights[c] = int(c);
   progress_bar bar;
   bar.label = name;
   bar.quiet = s.quiet;
@@ -304,6 +395,8 @@ void bake_and_write(const std::string& name, const bake_input& in, const setting
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
   std::string suffixes;
   for (const std::string& w : written) suffixes += w.substr(base.size() + 1) + ",";
+  if (!o.lights.empty())
+    std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
   std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}\n", st.seconds, st.coverage_seconds, base.c_str(),
               suffixes.c_str());
 }
@@ -327,14 +420,17 @@ void run_scenes(const settings& s) {
     // Built-in scenes: chart UVs generated for the lightmap size (2 texels of padding).
     const struct {
       const char* name;
-      scene_mesh mesh;
-    } scenes[] = {{"hexagon_room", hexagon_room(2)}, {"cornell_box", cornell_box()}};
+      lit_scene scene;
+    } scenes[] = {{"hexagon_room", {hexagon_room(2), {}}},
+                  {"hexagon_room_sun", hexagon_room_sunlit(2)},
+                  {"cornell_box", {cornell_box(), {}}},
+                  {"cornell_box_rect", cornell_box_rect_light()}};
     for (const auto& sc : scenes) {
-      scene_mesh m = sc.mesh;
+      scene_mesh m = sc.scene.mesh;
       generate_lightmap_uvs(m, std::max(8, s.options.width), std::max(8, s.options.width) >= 16 ? 2 : 0);
       bake_input in;
       in.scene = m.desc();
-      bake_and_write(sc.name, in, s);
+      bake_and_write(sc.name, in, s, sc.scene.lights);
     }
     return;
   }
@@ -351,7 +447,8 @@ void run_scenes(const settings& s) {
   in.normals = m.normals.data();
   std::string name = std::filesystem::path(s.model).stem().string();
   if (name.empty()) name = "model";
-  bake_and_write(name, in, s);
+  if (!m.lights.empty()) std::printf("%s: %zu light%s from the model\n", name.c_str(), m.lights.size(), m.lights.size() > 1 ? "s" : "");
+  bake_and_write(name, in, s, m.lights);
 }
 
 }  // namespace

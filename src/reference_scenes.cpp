@@ -264,4 +264,40 @@ scene_mesh open_street() {
   return m;
 }
 
+lit_scene hexagon_room_sunlit(int tessellation) {
+  lit_scene out;
+  out.mesh = hexagon_room(tessellation);
+  // The window's wall lies between corners 0 (0 degrees) and 1 (60 degrees): its outward normal
+  // points at azimuth 30 degrees. The sun travels inwards along it and 30 degrees down.
+  const float az = glm::radians(30.0f), el = glm::radians(30.0f);
+  light sun;
+  sun.type = light_type::directional;
+  sun.direction = glm::vec3(-std::cos(az) * std::cos(el), -std::sin(el), -std::sin(az) * std::cos(el));
+  sun.color = glm::vec3(20.0f);
+  sun.radius = 0.00465f;
+  out.lights.push_back(sun);
+  return out;
+}
+
+lit_scene cornell_box_rect_light() {
+  lit_scene out;
+  out.mesh = cornell_box();
+  glm::vec3 radiance(0.0f);
+  for (material& m : out.mesh.materials)
+    if (m.emission != glm::vec3(0.0f)) {
+      radiance = m.emission;
+      m.emission = glm::vec3(0.0f);
+    }
+  light rect;
+  rect.type = light_type::rect;
+  rect.position = glm::vec3(0.278f, 0.5478f, 0.2795f);
+  rect.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  rect.tangent = glm::vec3(1.0f, 0.0f, 0.0f);
+  rect.width = 0.13f;
+  rect.height = 0.105f;
+  rect.color = radiance;
+  out.lights.push_back(rect);
+  return out;
+}
+
 }  // namespace hemilight

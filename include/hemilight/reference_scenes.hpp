@@ -9,6 +9,7 @@
 // out, so no back face lies on a visible surface.
 #pragma once
 
+#include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
 
 #include <cstddef>
@@ -68,5 +69,22 @@ scene_mesh open_pavilion();
 /// 0.15 m base) along both kerbs. Every part is a closed box, so ground texels under buildings,
 /// bases and posts are inside geometry. Deterministic; 2 + 12 x (buildings + 32) triangles.
 scene_mesh open_street();
+
+/// A reference scene lit by analytic lights (lights.hpp) as well as by what its triangles emit.
+struct lit_scene {
+  scene_mesh mesh;
+  std::vector<light> lights;
+};
+
+/// The hexagon room (hexagon_room(tessellation), sky 1) with a soft sun shining in through its
+/// window: direction of travel 30 degrees below the horizon, straight in through the window's wall
+/// (azimuth 30 degrees + 180), irradiance 20 W/m^2 facing it (about 6 x the sky's pi on a
+/// horizontal plane), angular radius 0.00465 rad (the sun's).
+lit_scene hexagon_room_sunlit(int tessellation = 1);
+
+/// The Cornell box with its ceiling light as a RECT light (the same 0.13 x 0.105 m rectangle, lit
+/// side down, radiance (17, 12, 4)); the quad stays in the scene as a surface (albedo 0.78) but
+/// emits nothing, so the light is not counted twice.
+lit_scene cornell_box_rect_light();
 
 }  // namespace hemilight
