@@ -57,6 +57,38 @@ expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --directional hl2 --out 
 [ -e hl2only/quad_sh_l1_0.exr ] && { echo "FAIL: --directional hl2 wrote SH maps"; fails=$((fails + 1)); }
 [ -s hl2only/quad_hl2_1.exr ] || { echo "FAIL: --directional hl2 wrote no HL2 maps"; fails=$((fails + 1)); }
 
+# Lights: --sun and --point add lights, --shadow-mask writes their visibility.
+expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --sun 0.3,-1,0.2,5 --point 0.5,1,0.5,2,0.05 --shadow-mask --out lit
+grep -q "2 lights: direct light" ok.log || { echo "FAIL: expected 2 lights:"; cat ok.log; fails=$((fails + 1)); }
+[ -s lit/quad_shadow_mask.exr ] || { echo "FAIL: lit/quad_shadow_mask.exr not written"; fails=$((fails + 1)); }
+
+# A glTF 2.0 quad (the same floor) with a KHR_lights_punctual point light on a node at
+# (0.5, 1, 0.5): the model's own light is baked.
+python3 - <<'PY'
+import base64, json, struct
+data = struct.pack('<12f', 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0) + struct.pack('<8f', 0, 0, 0, 1, 1, 1, 1, 0) + \
+       struct.pack('<6H', 0, 1, 2, 0, 2, 3)
+gltf = {
+    "asset": {"version": "2.0"}, "extensionsUsed": ["KHR_lights_punctual"],
+    "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 1, 1], "intensity": 5}]}},
+    "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"mesh": 0}, {"name": "lamp", "translation": [0.5, 1, 0.5], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]}],
+    "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                    {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                  {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+}
+open('lamp.gltf', 'w').write(json.dumps(gltf))
+PY
+expect_ok lamp.gltf --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --out gltf
+grep -q "1 light from the model" ok.log || { echo "FAIL: the glTF's light was not read:"; cat ok.log; fails=$((fails + 1)); }
+
+expect_fail "--sun 1,2" "DX,DY,DZ,E" -- quad.obj --sun 1,2
+expect_fail "--point 0,0,0,x" "X,Y,Z,I" -- quad.obj --point 0,0,0,x
+expect_fail "lights\[0\].direction is zero" -- quad.obj --sun 0,0,0,1
 expect_fail "missing.obj" "no such file" -- missing.obj
 expect_fail "--directional sideways" "sh, hl2 or both" -- quad.obj --directional sideways
 expect_fail "nosky.exr" "no such file" -- quad.obj --environment nosky.exr
