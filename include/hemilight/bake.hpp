@@ -126,7 +126,7 @@ struct bake_options {
   std::shared_ptr<const cubemap> environment;
   /// Analytic lights (lights.hpp): direct light at every sample, added to every pass (step 3b at
   /// the top of this header). Checked as validate_lights does ("bake_lightmap: lights[2].radius
-  /// = -1 is negative"). Cost: per sample and light one shadow ray (hard) or 12 (soft), 72 in a
+  /// = -1 is negative"). Cost: per sample and light one shadow ray (hard) or 12 (soft), 264 in a
   /// penumbra (direct_options). Empty: no lights.
   std::vector<light> lights;
   /// Shadow rays of the lights: sample counts and ray offset (lights.hpp). Checked as
