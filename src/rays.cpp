@@ -1,254 +1,282 @@
-// Ray queries over the scene's BVH (rays.hpp): Woop, Benthin and Wald's watertight triangle test,
-// a leaf's triangles in vectorised loops (#pragma omp simd), and an ordered traversal with a
-// fixed stack.
-//
-// Compiled with -ffp-contract=off (CMakeLists.txt): the edge functions of two triangles that share
-// an edge must be exact negations of each other, which a fused multiply-add would break.
-#include "hemilight/rays.hpp"
+// Ray queries through Embree 3 (rays.hpp): one process-wide RTCDevice, one RTCScene per scene built
+// on its first query (std::call_once), the fallback traversal of rays_bvh.cpp when that build fails.
+#include "rays_internal.hpp"
 
-#include <algorithm>
+#include "hemilight/error.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <atomic>
 #include <cmath>
-#include <cstdint>
+#include <cstddef>
 #include <limits>
-
+#include <mutex>
+#include <new>
+#include <string>
 
 namespace hemilight {
+namespace detail {
 
 namespace {
 
-constexpr float infinity = std::numeric_limits<float>::infinity();
-constexpr int stack_capacity = 64;
-// 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Ize 2013), rounded up.
-constexpr float far_scale = 1.0000004f;
-constexpr float min_abs_direction = 1e-30f;
+// The Embree scene's settings (rays.hpp, "Acceleration structure"): robust traversal and triangle
+// test (watertight), and the quality that measured best for build time + memory against ray speed.
+constexpr RTCBuildQuality build_quality = RTC_BUILD_QUALITY_MEDIUM;
 
-// Everything a query derives from its ray once.
-struct ray_setup {
-  float o[3];    // origin, permuted axes (kx, ky, kz)
-  float sx, sy, sz;
-  float ow[3];   // origin, world axes (boxes)
-  float inv[3];  // reciprocal direction, world axes (boxes)
-  const float* c[3][3];  // c[vertex][i]: coordinate array of axis k_i (i = 0: kx, 1: ky, 2: kz)
+std::atomic<std::int64_t> device_bytes{0};
+std::atomic<bool> fail_builds{false};
+
+// The last message Embree's error callback gave on this thread (errors are reported to the thread
+// that made the failing call).
+thread_local std::string last_embree_message;
+
+void on_embree_error(void*, RTCError, const char* message) { last_embree_message = message ? message : ""; }
+
+bool on_embree_memory(void*, ssize_t bytes, bool) {
+  device_bytes.fetch_add(static_cast<std::int64_t>(bytes), std::memory_order_relaxed);
+  return true;  // never refuse: Embree reports its own allocation failures
+}
+
+const char* embree_error_name(RTCError e) {
+  switch (e) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_UNKNOWN: return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+  }
+  return "unknown error";
+}
+
+status status_of(RTCError e) {
+  if (e == RTC_ERROR_OUT_OF_MEMORY) return status::out_of_memory;
+  if (e == RTC_ERROR_UNSUPPORTED_CPU) return status::unsupported;
+  return status::internal;
+}
+
+std::string describe(const char* what, RTCError e) {
+  std::string m = std::string(what) + ": Embree " + embree_error_name(e);
+  if (!last_embree_message.empty()) m += " (" + last_embree_message + ")";
+  return m;
+}
+
+// The process's one RTCDevice, made on first use (a function-local static: thread-safe) and
+// released at exit (Embree counts the scenes' references to it, so a scene released later is fine).
+struct device_holder {
+  RTCDevice device = nullptr;
+  status failure = status::ok;
+  std::string message;
+
+  device_holder() {
+    last_embree_message.clear();
+    device = rtcNewDevice(nullptr);
+    if (!device) {
+      const RTCError e = rtcGetDeviceError(nullptr);
+      failure = status_of(e);
+      message = describe("rtcNewDevice failed", e);
+      return;
+    }
+    rtcSetDeviceErrorFunction(device, on_embree_error, nullptr);
+    rtcSetDeviceMemoryMonitorFunction(device, on_embree_memory, nullptr);
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED) != 0) {
+      // rays.hpp promises both faces; an Embree built with EMBREE_BACKFACE_CULLING cannot keep that.
+      failure = status::unsupported;
+      message = "this Embree was built with backface culling (EMBREE_BACKFACE_CULLING): hemilight needs both faces";
+      rtcReleaseDevice(device);
+      device = nullptr;
+    }
+  }
+  ~device_holder() {
+    if (device) rtcReleaseDevice(device);
+  }
+  device_holder(const device_holder&) = delete;
+  device_holder& operator=(const device_holder&) = delete;
 };
 
-bool make_setup(const scene& s, const glm::vec3& origin, const glm::vec3& d, float t_max, ray_setup& r) noexcept {
-  if (!(t_max > 0.0f) || s.bvh().empty()) return false;
-  const glm::vec3 a = glm::abs(d);
-  const float m = std::max(a.x, std::max(a.y, a.z));
-  if (!(m > 0.0f) || !std::isfinite(m) || !std::isfinite(d.x + d.y + d.z)) return false;
-  if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z)) return false;
-  const int kz = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-  const int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-  const int k[3] = {kx, ky, kz};
-  for (int i = 0; i < 3; ++i) {
-    r.o[i] = origin[k[i]];
-    r.ow[i] = origin[i];
-    const float di = std::fabs(d[i]) < min_abs_direction ? std::copysign(min_abs_direction, d[i]) : d[i];
-    r.inv[i] = 1.0f / di;
-    for (int v = 0; v < 3; ++v) r.c[v][i] = s.vertex_coordinates(v, k[i]);
-  }
-  r.sx = d[kx] / d[kz];
-  r.sy = d[ky] / d[kz];
-  r.sz = 1.0f / d[kz];
-  return true;
+const device_holder& shared_device() {
+  static const device_holder holder;
+  return holder;
 }
 
-// Slab test of a node's box against [0, t_max]; t_near is where the ray enters it.
-inline bool hit_box(const bvh_node& b, const ray_setup& r, float t_max, float& t_near) noexcept {
-  const float x0 = (b.lo.x - r.ow[0]) * r.inv[0], x1 = (b.hi.x - r.ow[0]) * r.inv[0];
-  const float y0 = (b.lo.y - r.ow[1]) * r.inv[1], y1 = (b.hi.y - r.ow[1]) * r.inv[1];
-  const float z0 = (b.lo.z - r.ow[2]) * r.inv[2], z1 = (b.hi.z - r.ow[2]) * r.inv[2];
-  const float tn = std::max(std::max(std::min(x0, x1), std::min(y0, y1)), std::max(std::min(z0, z1), 0.0f));
-  const float tf = std::min(std::min(std::max(x0, x1), std::max(y0, y1)), std::max(z0, z1)) * far_scale;
-  t_near = tn;
-  return tn <= std::min(tf, t_max);
+bool finite3(const glm::vec3& v) noexcept { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The checks of rays.hpp, before Embree sees the ray (it has no defined answer for NaN or Inf).
+bool valid_query(const glm::vec3& origin, const glm::vec3& d, float t_max) noexcept {
+  return t_max > 0.0f && finite3(origin) && finite3(d) && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f);
 }
 
-// The sheared vertex coordinates of one triangle (Woop et al., section 3).
-struct sheared {
-  float ax, ay, az, bx, by, bz, cx, cy, cz;
-};
+// Embree accepts tnear <= t <= tfar on its float t = rcp(den) * T, a few ulps from the true t
+// (an approximate reciprocal refined once). tnear = the smallest positive float gives t > 0; tfar
+// = t_max (1 - 2^-20) keeps a triangle at exactly t_max (a shadow ray's end point on a light)
+// out, at the price of hits in the last 1e-6 of the segment (+inf stays +inf).
+constexpr float far_margin = 1.0f - 1.0f / 1048576.0f;
 
-inline sheared shear(const ray_setup& r, std::uint32_t i) noexcept {
-  sheared t;
-  t.az = r.c[0][2][i] - r.o[2];
-  t.bz = r.c[1][2][i] - r.o[2];
-  t.cz = r.c[2][2][i] - r.o[2];
-  t.ax = (r.c[0][0][i] - r.o[0]) - r.sx * t.az;
-  t.ay = (r.c[0][1][i] - r.o[1]) - r.sy * t.az;
-  t.bx = (r.c[1][0][i] - r.o[0]) - r.sx * t.bz;
-  t.by = (r.c[1][1][i] - r.o[1]) - r.sy * t.bz;
-  t.cx = (r.c[2][0][i] - r.o[0]) - r.sx * t.cz;
-  t.cy = (r.c[2][1][i] - r.o[1]) - r.sy * t.cz;
-  return t;
-}
-
-// The exact path of one triangle (an edge function was 0 in float): edge functions in double
-// from the same float sheared coordinates. Returns t, or +inf for a miss.
-float exact_triangle(const ray_setup& r, std::uint32_t i, float t_max) noexcept {
-  const sheared s = shear(r, i);
-  const double u = double(s.cx) * double(s.by) - double(s.cy) * double(s.bx);
-  const double v = double(s.ax) * double(s.cy) - double(s.ay) * double(s.cx);
-  const double w = double(s.bx) * double(s.ay) - double(s.by) * double(s.ax);
-  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return infinity;
-  const double det = u + v + w;
-  if (det == 0.0) return infinity;
-  const double t = double(r.sz) * (u * double(s.az) + v * double(s.bz) + w * double(s.cz)) / det;
-  return t > 0.0 && t < double(t_max) ? static_cast<float>(t) : infinity;
-}
-
-// Any-hit over a leaf: eight lanes at a time (lanes past `count` read the next triangles or the
-// padding of the coordinate arrays and are masked out).
-inline bool leaf_any(const ray_setup& r, std::uint32_t first, std::uint32_t count, float t_max) noexcept {
-  const std::uint32_t n8 = (count + 7u) & ~7u;
-  int hit = 0, zero = 0;
-#pragma omp simd reduction(| : hit, zero)
-  for (std::uint32_t j = 0; j < n8; ++j) {
-    const sheared s = shear(r, first + j);
-    const float u = s.cx * s.by - s.cy * s.bx;
-    const float v = s.ax * s.cy - s.ay * s.cx;
-    const float w = s.bx * s.ay - s.by * s.ax;
-    const int live = j < count;
-    const int neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
-    const int pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    zero |= live & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
-    const float det = u + v + w;
-    const float t = r.sz * (u * s.az + v * s.bz + w * s.cz);
-    const float sign = det < 0.0f ? -1.0f : 1.0f;
-    const float tt = t * sign, ad = det * sign;
-    hit |= live & (1 - (neg & pos)) & (det != 0.0f) & (tt > 0.0f) & (tt < t_max * ad);
-  }
-  if (hit) return true;
-  if (!zero) return false;
-  for (std::uint32_t j = 0; j < count; ++j)
-    if (exact_triangle(r, first + j, t_max) < infinity) return true;
-  return false;
-}
-
-// Closest hit over a leaf: the smallest t below `best` (first in leaf order on ties); returns
-// the triangle's index or UINT32_MAX.
-inline std::uint32_t leaf_closest(const ray_setup& r, std::uint32_t first, std::uint32_t count,
-                                            float& best) noexcept {
-  alignas(32) float ts[scene::max_leaf_triangles + 8];
-  const std::uint32_t n8 = (count + 7u) & ~7u;
-  const float t_max = best;
-  int zero = 0;
-#pragma omp simd reduction(| : zero)
-  for (std::uint32_t j = 0; j < n8; ++j) {
-    const sheared s = shear(r, first + j);
-    const float u = s.cx * s.by - s.cy * s.bx;
-    const float v = s.ax * s.cy - s.ay * s.cx;
-    const float w = s.bx * s.ay - s.by * s.ax;
-    const int live = j < count;
-    const int neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
-    const int pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    zero |= live & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
-    const float det = u + v + w;
-    const float t = r.sz * (u * s.az + v * s.bz + w * s.cz);
-    const float sign = det < 0.0f ? -1.0f : 1.0f;
-    const float tt = t * sign, ad = det * sign;
-    const int hit = live & (1 - (neg & pos)) & (det != 0.0f) & (tt > 0.0f) & (tt < t_max * ad);
-    ts[j] = hit ? tt / ad : infinity;
-  }
-  if (zero)
-    for (std::uint32_t j = 0; j < count; ++j) ts[j] = exact_triangle(r, first + j, t_max);
-  std::uint32_t found = UINT32_MAX;
-  for (std::uint32_t j = 0; j < count; ++j)
-    if (ts[j] < best) {
-      best = ts[j];
-      found = first + j;
-    }
-  return found;
-}
-
-template <bool any>
-inline bool traverse(const scene& s, const ray_setup& r, float t_max, std::uint32_t* closest,
-                               float* closest_t) noexcept {
-  const bvh_node* nodes = s.bvh().data();
-  struct entry {
-    std::uint32_t node;
-    float t_near;
-  };
-  entry stack[stack_capacity];
-  int top = 0;
-  float best = t_max;
-  std::uint32_t found = UINT32_MAX;
-  float t_root;
-  if (!hit_box(nodes[0], r, best, t_root)) return false;
-  std::uint32_t node = 0;
-  for (;;) {
-    const bvh_node& nd = nodes[node];
-    if (nd.count > 0) {
-      if (any) {
-        if (leaf_any(r, nd.first, nd.count, t_max)) return true;
-      } else {
-        const std::uint32_t f = leaf_closest(r, nd.first, nd.count, best);
-        if (f != UINT32_MAX) found = f;
-      }
-    } else {
-      std::uint32_t near_child = nd.first, far_child = nd.first + 1;
-      float tn0, tn1;
-      const bool h0 = hit_box(nodes[near_child], r, best, tn0);
-      const bool h1 = hit_box(nodes[far_child], r, best, tn1);
-      if (h0 && h1) {
-        if (tn1 < tn0) {
-          std::swap(near_child, far_child);
-          std::swap(tn0, tn1);
-        }
-        stack[top++] = {far_child, tn1};
-        node = near_child;
-        continue;
-      }
-      if (h0 || h1) {
-        node = h0 ? near_child : far_child;
-        continue;
-      }
-    }
-    for (;;) {
-      if (top == 0) {
-        if (!any && found != UINT32_MAX) {
-          *closest = found;
-          *closest_t = best;
-          return true;
-        }
-        return false;
-      }
-      const entry e = stack[--top];
-      if (any || e.t_near <= best) {
-        node = e.node;
-        break;
-      }
-    }
-  }
-}
-
-
-inline bool any_hit(const scene& s, const ray_setup& r, float t_max) noexcept {
-  return traverse<true>(s, r, t_max, nullptr, nullptr);
-}
-inline bool closest_hit(const scene& s, const ray_setup& r, float t_max, std::uint32_t* i, float* t) noexcept {
-  return traverse<false>(s, r, t_max, i, t);
+void set_ray(RTCRay& r, const glm::vec3& o, const glm::vec3& d, float t_max) noexcept {
+  r.org_x = o.x;
+  r.org_y = o.y;
+  r.org_z = o.z;
+  r.dir_x = d.x;
+  r.dir_y = d.y;
+  r.dir_z = d.z;
+  r.tnear = std::numeric_limits<float>::denorm_min();
+  r.tfar = std::isinf(t_max) ? t_max : t_max * far_margin;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
 }
 
 }  // namespace
 
-bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
-  ray_setup r;
-  if (!make_setup(s, origin, direction, t_max, r)) return false;
-  return any_hit(s, r, t_max);
+struct ray_accel {
+  std::once_flag once;
+  std::atomic<bool> done{false};  // the fast path: acquire load instead of call_once
+  RTCScene rtc = nullptr;         // null for an empty scene or a failed build
+  status failure = status::ok;
+  std::string message;
+
+  ray_accel() = default;
+  ray_accel(const ray_accel&) = delete;
+  ray_accel& operator=(const ray_accel&) = delete;
+  ~ray_accel() {
+    if (rtc) rtcReleaseScene(rtc);
+  }
+};
+
+std::shared_ptr<ray_accel> make_ray_accel() { return std::make_shared<ray_accel>(); }
+
+namespace {
+
+// Builds a's Embree scene from s's drawable triangles (geometry 0, primitive i = triangles()[i]).
+// Never throws: a failure is kept in a (status, message) and the queries use the fallback.
+void build(const scene& s, ray_accel& a) noexcept {
+  if (s.triangles().empty()) return;  // nothing to hit: no Embree at all
+  try {
+    if (fail_builds.load()) {
+      a.failure = status::out_of_memory;
+      a.message = "prepare_rays: Embree out of memory (simulated by a test)";
+      return;
+    }
+    const device_holder& d = shared_device();
+    if (!d.device) {
+      a.failure = d.failure;
+      a.message = "prepare_rays: " + d.message;
+      return;
+    }
+    last_embree_message.clear();
+    rtcGetDeviceError(d.device);  // clear this thread's error code
+    RTCScene rtc = rtcNewScene(d.device);
+    RTCError e = rtcGetDeviceError(d.device);
+    if (!rtc || e != RTC_ERROR_NONE) {
+      if (rtc) rtcReleaseScene(rtc);
+      a.failure = status_of(e);
+      a.message = describe("prepare_rays: rtcNewScene failed", e);
+      return;
+    }
+    rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(rtc, build_quality);
+    const std::vector<scene::triangle>& tris = s.triangles();
+    const std::vector<glm::vec3>& positions = s.positions();
+    const std::vector<std::uint32_t>& indices = s.indices();
+    RTCGeometry g = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float* vb = g ? static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                3 * sizeof(float), positions.size()))
+                  : nullptr;
+    unsigned* ib = vb ? static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                      3 * sizeof(unsigned), tris.size()))
+                      : nullptr;
+    if (ib) {
+      for (std::size_t i = 0; i < positions.size(); ++i) {
+        vb[3 * i] = positions[i].x;
+        vb[3 * i + 1] = positions[i].y;
+        vb[3 * i + 2] = positions[i].z;
+      }
+      for (std::size_t i = 0; i < tris.size(); ++i)
+        for (std::size_t k = 0; k < 3; ++k) ib[3 * i + k] = indices[3 * std::size_t(tris[i].index) + k];
+      rtcCommitGeometry(g);
+      rtcAttachGeometryByID(rtc, g, 0);
+    }
+    if (g) rtcReleaseGeometry(g);
+    if (ib) rtcCommitScene(rtc);
+    e = rtcGetDeviceError(d.device);
+    if (!ib || e != RTC_ERROR_NONE) {
+      rtcReleaseScene(rtc);
+      if (e == RTC_ERROR_NONE) e = RTC_ERROR_OUT_OF_MEMORY;
+      a.failure = status_of(e);
+      a.message = describe("prepare_rays: building the Embree scene failed", e);
+      return;
+    }
+    a.rtc = rtc;
+  } catch (...) {  // std::bad_alloc from our strings; Embree itself reports through its error code
+    a.failure = status::out_of_memory;
+    a.message.clear();
+  }
 }
 
-bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max, ray_hit& hit) noexcept {
-  ray_setup r;
-  if (!make_setup(s, origin, direction, t_max, r)) return false;
-  std::uint32_t i = 0;
-  float t = 0.0f;
-  if (!closest_hit(s, r, t_max, &i, &t)) return false;
-  const scene::triangle& tri = s.triangles()[i];
-  hit.distance = t;
+ray_accel* built(const scene& s) noexcept {
+  ray_accel* a = ray_access::of(s);
+  if (!a) return nullptr;
+  if (!a->done.load(std::memory_order_acquire))
+    std::call_once(a->once, [&] {
+      build(s, *a);
+      a->done.store(true, std::memory_order_release);
+    });
+  return a;
+}
+
+}  // namespace
+
+bool rays_use_embree(const scene& s) noexcept {
+  const ray_accel* a = built(s);
+  return a && a->rtc;
+}
+
+std::int64_t embree_device_bytes() noexcept { return device_bytes.load(std::memory_order_relaxed); }
+
+void fail_embree_builds_for_testing(bool fail) noexcept { fail_builds.store(fail); }
+
+}  // namespace detail
+
+void prepare_rays(const scene& s) {
+  const detail::ray_accel* a = detail::built(s);
+  if (a && a->failure != status::ok)
+    throw error(a->failure, a->message.empty() ? std::string("prepare_rays: out of memory") : a->message);
+}
+
+bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
+  if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
+  const detail::ray_accel* a = detail::built(s);
+  if (!a || !a->rtc) return detail::occluded_bvh(s, origin, direction, t_max);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  detail::set_ray(r, origin, direction, t_max);
+  rtcOccluded1(a->rtc, &context, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
+               ray_hit& hit) noexcept {
+  if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
+  const detail::ray_accel* a = detail::built(s);
+  if (!a || !a->rtc) return detail::intersect_bvh(s, origin, direction, t_max, hit);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  detail::set_ray(rh.ray, origin, direction, t_max);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(a->rtc, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  const std::uint32_t i = rh.hit.primID;
+  hit.distance = rh.ray.tfar;
   hit.drawable = i;
-  hit.triangle = tri.index;
-  hit.front_face = glm::dot(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0), direction) < 0.0f;
+  hit.triangle = s.triangles()[i].index;
+  // Embree's Ng is (v1 - v0) x (v2 - v0) up to scale: our front normal.
+  hit.front_face = rh.hit.Ng_x * direction.x + rh.hit.Ng_y * direction.y + rh.hit.Ng_z * direction.z < 0.0f;
   return true;
 }
 

@@ -1,4 +1,5 @@
 #include "hemilight/scene.hpp"
+#include "rays_internal.hpp"
 
 #include <algorithm>
 #include <array>
@@ -151,6 +152,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
   }
   s->build_bvh();
+  s->rays_ = detail::make_ray_accel();  // built on the first ray query (rays.cpp)
   return s;
 }
 

@@ -29,6 +29,11 @@
 
 namespace hemilight {
 
+namespace detail {
+struct ray_accel;   // rays.hpp's Embree scene, built on the first ray query (src/rays_internal.hpp)
+struct ray_access;
+}  // namespace detail
+
 /// Per-triangle material: what the hemicube sees of a triangle and what a bounce needs.
 struct material {
   glm::vec3 emission{0.0f};  ///< emitted radiance (W m^-2 sr^-1 or any unit), each channel >= 0
@@ -112,7 +117,8 @@ class scene {
   ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
   /// Zero-area triangles (repeated indices, collinear or coincident positions) are accepted and
   /// never drawn. Cost: O(T log^2 T) for T triangles (1M triangles: about a second on one core);
-  /// memory about 140 bytes per triangle.
+  /// memory about 140 bytes per triangle. The ray queries' Embree scene (rays.hpp) is not built
+  /// here but on the first ray query or prepare_rays() call.
   static std::shared_ptr<const scene> create(const scene_desc& desc);
 
   std::size_t vertex_count() const noexcept { return positions_.size(); }
@@ -176,6 +182,9 @@ class scene {
   std::vector<triangle> triangles_;
   std::vector<float> coordinates_;  // vertex_coordinates(): 9 arrays of triangles_.size() + 8
   std::vector<bvh_node> nodes_;
+  // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
+  friend struct detail::ray_access;
+  std::shared_ptr<detail::ray_accel> rays_;
 };
 
 }  // namespace hemilight

@@ -1,0 +1,49 @@
+// Internal to hemilight (not installed): the scene's ray acceleration structure behind rays.hpp.
+//
+// scene (scene.hpp) holds a std::shared_ptr<detail::ray_accel>, made by scene::create with
+// make_ray_accel() (a few dozen bytes: a once flag and null handles). rays.cpp builds the Embree
+// scene into it on the first ray query or prepare_rays() call; ray_access reads it.
+// The tests (tests/test_rays.cpp) and bench_rays include this header for the hooks below.
+#pragma once
+
+#include "hemilight/rays.hpp"
+#include "hemilight/scene.hpp"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <memory>
+
+namespace hemilight {
+namespace detail {
+
+struct ray_accel;  // defined in rays.cpp
+
+/// A new, unbuilt ray_accel (scene::create calls it). Throws std::bad_alloc.
+std::shared_ptr<ray_accel> make_ray_accel();
+
+/// The private member of scene that holds its ray_accel (null only for a scene not made by create).
+struct ray_access {
+  static ray_accel* of(const scene& s) noexcept { return s.rays_.get(); }
+};
+
+/// The fallback queries over the scene's own BVH (rays_bvh.cpp): rays.hpp's contract, without Embree.
+/// rays.cpp uses them when the Embree scene could not be built; the tests run both.
+bool occluded_bvh(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
+bool intersect_bvh(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
+                   ray_hit& hit) noexcept;
+
+/// Whether the scene's queries go through Embree: builds the Embree scene first if it is not built
+/// yet (as a query would) and returns false if that failed (the queries then use the fallback).
+bool rays_use_embree(const scene& s) noexcept;
+
+/// Bytes Embree's shared device holds now (its memory monitor: buffers, BVHs, build scratch), for
+/// bench_rays' bytes-per-triangle figure. 0 before the device exists.
+std::int64_t embree_device_bytes() noexcept;
+
+/// Test hook: while set, building an Embree scene fails as if Embree ran out of memory (scenes
+/// already built keep theirs; a scene whose build failed keeps the fallback). Tests only.
+void fail_embree_builds_for_testing(bool fail) noexcept;
+
+}  // namespace detail
+}  // namespace hemilight
