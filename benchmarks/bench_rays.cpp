@@ -1,8 +1,13 @@
 // Shadow rays per second (rays.hpp occluded(), one thread), on the reference scenes, beside
-// Embree 3's rtcOccluded1 on the same rays when Embree is installed (optional: libembree-dev).
+// Embree 3's rtcOccluded1 on the same rays, and the cost of the Embree scene rays.hpp builds.
 // items_per_second = rays per second.
-//   name: rays/<method>/<scene>   method: ours (occluded()),
-//         ours_closest (intersect(), closest hit), embree (rtcOccluded1), embree_closest (rtcIntersect1)
+//   name: rays/<method>/<scene>   method: ours (occluded(): Embree behind our checks and lazy build),
+//         ours_closest (intersect(), closest hit), fallback and fallback_closest (the traversal of
+//         the scene's own BVH that the queries use when Embree fails, src/rays_bvh.cpp),
+//         embree (rtcOccluded1 on a scene of our settings), embree_closest (rtcIntersect1),
+//         embree_not_robust (rtcOccluded1 without RTC_SCENE_FLAG_ROBUST)
+//   name: rays/build/<scene>: prepare_rays() on a new scene (wall time: Embree builds on its own
+//         threads); counter bytes_per_triangle from Embree's memory monitor.
 // Rays: 4096 per scene, fixed (seed 2024): from 256 area-weighted surface points
 // (bench_points.hpp, lifted by 1e-4 of the scene size along the normal, the light module's ray
 // offset) towards pseudo-random points of a light, 16 per surface point, stopping 1e-4 of the
@@ -17,12 +22,10 @@
 
 #include "bench_points.hpp"
 #include "host_steal.hpp"
+#include "rays_internal.hpp"
 
 #include <benchmark/benchmark.h>
-
-#if defined(HEMILIGHT_BENCH_EMBREE)
 #include <embree3/rtcore.h>
-#endif
 
 #include <cmath>
 #include <cstdint>
@@ -93,8 +96,9 @@ bench_scene& get_scene(std::size_t index) {
   return b;
 }
 
-void ours(benchmark::State& state, std::size_t scene_index, bool closest) {
+void ours(benchmark::State& state, std::size_t scene_index, bool closest, bool fallback) {
   bench_scene& b = get_scene(scene_index);
+  prepare_rays(*b.built);  // the lazy build, outside the timed loop
   std::size_t k = 0, blocked = 0, total = 0;
   const bench::cpu_ticks before = bench::read_cpu_ticks();
   for (auto _ : state) {
@@ -102,9 +106,11 @@ void ours(benchmark::State& state, std::size_t scene_index, bool closest) {
     bool hit;
     if (closest) {
       ray_hit h;
-      hit = intersect(*b.built, r.origin, r.direction, r.t_max, h);
+      hit = fallback ? detail::intersect_bvh(*b.built, r.origin, r.direction, r.t_max, h)
+                     : intersect(*b.built, r.origin, r.direction, r.t_max, h);
     } else {
-      hit = occluded(*b.built, r.origin, r.direction, r.t_max);
+      hit = fallback ? detail::occluded_bvh(*b.built, r.origin, r.direction, r.t_max)
+                     : occluded(*b.built, r.origin, r.direction, r.t_max);
     }
     benchmark::DoNotOptimize(hit);
     blocked += hit ? 1 : 0;
@@ -116,15 +122,35 @@ void ours(benchmark::State& state, std::size_t scene_index, bool closest) {
   state.counters["steal"] = bench::steal_fraction(before, bench::read_cpu_ticks());
 }
 
-#if defined(HEMILIGHT_BENCH_EMBREE)
+// prepare_rays() on a fresh copy of the scene each iteration (scene::create is not timed).
+void build(benchmark::State& state, std::size_t scene_index) {
+  const bench_scene& b = get_scene(scene_index);
+  double bytes = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::shared_ptr<const scene> s = scene::create(b.mesh.desc());
+    const std::int64_t before = detail::embree_device_bytes();
+    state.ResumeTiming();
+    prepare_rays(*s);
+    state.PauseTiming();
+    bytes = double(detail::embree_device_bytes() - before);
+    s.reset();
+    state.ResumeTiming();
+  }
+  state.counters["bytes_per_triangle"] = bytes / double(b.built->drawable_triangle_count());
+  state.counters["triangles"] = double(b.built->drawable_triangle_count());
+}
+
+// Raw Embree with rays.hpp's settings (robust, medium quality), single-threaded device; or without
+// RTC_SCENE_FLAG_ROBUST (what robustness costs).
 struct embree_scene {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 };
 
-embree_scene& get_embree(std::size_t index) {
-  static std::vector<embree_scene> list(scenes().size());
-  embree_scene& e = list[index];
+embree_scene& get_embree(std::size_t index, bool robust) {
+  static std::vector<embree_scene> list(2 * scenes().size());
+  embree_scene& e = list[2 * index + (robust ? 1 : 0)];
   if (e.scene) return e;
   const bench_scene& b = get_scene(index);
   e.device = rtcNewDevice("threads=1");
@@ -138,15 +164,17 @@ embree_scene& get_embree(std::size_t index) {
     for (int c = 0; c < 3; ++c) vb[3 * i + std::size_t(c)] = b.mesh.positions[i][c];
   for (std::size_t i = 0; i < b.mesh.indices.size(); ++i) ib[i] = b.mesh.indices[i];
   rtcCommitGeometry(geom);
+  rtcSetSceneFlags(e.scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+  rtcSetSceneBuildQuality(e.scene, RTC_BUILD_QUALITY_MEDIUM);
   rtcAttachGeometry(e.scene, geom);
   rtcReleaseGeometry(geom);
   rtcCommitScene(e.scene);
   return e;
 }
 
-void embree(benchmark::State& state, std::size_t scene_index, bool closest) {
+void embree(benchmark::State& state, std::size_t scene_index, bool closest, bool robust) {
   const bench_scene& b = get_scene(scene_index);
-  embree_scene& e = get_embree(scene_index);
+  embree_scene& e = get_embree(scene_index, robust);
   std::size_t k = 0, blocked = 0, total = 0;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -186,7 +214,6 @@ void embree(benchmark::State& state, std::size_t scene_index, bool closest) {
   state.counters["occluded"] = total ? double(blocked) / double(total) : 0.0;
   state.counters["steal"] = bench::steal_fraction(before, bench::read_cpu_ticks());
 }
-#endif
 
 }  // namespace
 
@@ -194,12 +221,14 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   for (std::size_t s = 0; s < scenes().size(); ++s) {
     const std::string scene_name = scenes()[s].name;
-    benchmark::RegisterBenchmark(("rays/ours/" + scene_name).c_str(), ours, s, false);
-    benchmark::RegisterBenchmark(("rays/ours_closest/" + scene_name).c_str(), ours, s, true);
-#if defined(HEMILIGHT_BENCH_EMBREE)
-    benchmark::RegisterBenchmark(("rays/embree/" + scene_name).c_str(), embree, s, false);
-    benchmark::RegisterBenchmark(("rays/embree_closest/" + scene_name).c_str(), embree, s, true);
-#endif
+    benchmark::RegisterBenchmark(("rays/ours/" + scene_name).c_str(), ours, s, false, false);
+    benchmark::RegisterBenchmark(("rays/ours_closest/" + scene_name).c_str(), ours, s, true, false);
+    benchmark::RegisterBenchmark(("rays/fallback/" + scene_name).c_str(), ours, s, false, true);
+    benchmark::RegisterBenchmark(("rays/fallback_closest/" + scene_name).c_str(), ours, s, true, true);
+    benchmark::RegisterBenchmark(("rays/embree/" + scene_name).c_str(), embree, s, false, true);
+    benchmark::RegisterBenchmark(("rays/embree_closest/" + scene_name).c_str(), embree, s, true, true);
+    benchmark::RegisterBenchmark(("rays/embree_not_robust/" + scene_name).c_str(), embree, s, false, false);
+    benchmark::RegisterBenchmark(("rays/build/" + scene_name).c_str(), build, s)->UseRealTime();
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
