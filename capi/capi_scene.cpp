@@ -3,6 +3,7 @@
 #include "capi_internal.hpp"
 
 #include "hemilight/lights.hpp"
+#include "hemilight/rays.hpp"
 #include "hemilight/scene.hpp"
 
 #include <cmath>
@@ -89,6 +90,9 @@ hemilight_status hemilight_scene_with_lights(const hemilight_scene* scene, const
     std::vector<hemilight::light> ls;
     const hemilight_status st = hemilight::capi::to_lights(fn, "lights", lights, count, ls);
     if (st != HEMILIGHT_OK) return st;
+    // The ray structure now (shared by every handle of this geometry), so that an Embree failure
+    // is an error here rather than slower shadow rays later.
+    if (!ls.empty()) hemilight::prepare_rays(*scene->scene);
     auto handle = std::make_unique<hemilight_scene>();
     handle->scene = scene->scene;  // shared geometry and sky, not copied
     handle->sky = scene->sky;

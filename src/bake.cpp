@@ -5,6 +5,7 @@
 #include "hemilight/geometry.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
+#include "hemilight/rays.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -803,6 +804,8 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   direct_values direct;
   if (!lights.empty()) {
     const auto td = std::chrono::steady_clock::now();
+    // The ray structure now, so that an Embree failure is an error here, not a slower fallback.
+    prepare_rays(*sc);
     std::function<bool()> keep_going;
     if (o.progress) keep_going = [&] { return o.progress(0.0f); };
     direct = direct_pass(s, pts, *sc, lights, o, keep_going);

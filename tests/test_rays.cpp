@@ -206,7 +206,7 @@ TEST_CASE("rays: t_max is respected (exclusive) and t is in units of |direction|
   CHECK_FALSE(q.intersect(*empty, o, {0, 0, 1}, inf, h));
 }
 
-TEST_CASE("rays: both faces are hit; the closest of several is reported", "[rays]") {
+TEST_CASE("rays: both faces are hit, and the closest of several is reported", "[rays]") {
   const backend& q = backends[GENERATE(0, 1)];
   INFO("backend " << q.name);
   scene_mesh m;
