@@ -295,7 +295,7 @@ void cornell(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
+  if (argc < 2 || argv[1][0] == '-') {
     std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K]\n");
     return 2;
   }
