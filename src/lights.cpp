@@ -163,10 +163,20 @@ float sphere_distance(const glm::vec3& o, const glm::vec3& w, const glm::vec3& c
   return disc > 0.0f ? b - std::sqrt(disc) : b;
 }
 
-// The adaptive estimator of lights.hpp. sample(u, weight, radiance_weight, direction, visible)
-// maps u in [0, 1]^2 to a point of the light's extent (rects: the rectangle; cones: x = the cap's
-// equal-area radius, 1 at the rim, y = the angle), fills the sample's weight (0: below the
-// horizon, not traced) and traces it.
+// The adaptive estimator of lights.hpp. sample(u, probe) maps u in [0, 1]^2 to a point of the
+// light's extent (rects: the rectangle; cones: x = the cap's equal-area radius, 1 at the rim,
+// y = the angle) and fills the probe: its weight (0: below the horizon, not traced) and either
+// the shadow ray that decides its visibility or the visibility itself. The estimator traces the
+// probes' rays in batches (occluded_many: one origin, Embree packets).
+struct probe {
+  float w = 0.0f, rw = 0.0f;  // weight and radiance weight
+  glm::vec3 d{0.0f};          // unit direction (for the mean direction)
+  glm::vec3 ray{0.0f};        // shadow ray direction, when `trace`
+  float t_max = 0.0f;
+  bool trace = false;         // visibility = !occluded(o, ray, t_max)
+  bool visible = false;       // the visibility when not traced
+};
+
 struct visibility_result {
   float visibility = 0.0f;
   glm::vec3 direction{0.0f};  // sum of V * radiance weight * direction (not normalised)
@@ -187,30 +197,53 @@ constexpr outline cone_outline{{{1.0f - inset, 0.0625f}, {1.0f - inset, 0.1875f}
                                 {1.0f - inset, 0.8125f}, {1.0f - inset, 0.9375f}}};
 
 template <class Sample>
-visibility_result estimate(const direct_options& o, std::uint64_t seed, const outline& edge, Sample&& sample) {
+visibility_result estimate(const scene& sc, const glm::vec3& origin, const direct_options& o, std::uint64_t seed,
+                           const outline& edge, Sample&& sample) {
   const auto s0 = static_cast<std::uint32_t>(seed), s1 = static_cast<std::uint32_t>(seed >> 32);
   double sum_w = 0.0, sum_wv = 0.0;
   glm::dvec3 dir(0.0);
   int traced = 0, seen = 0;
-  const auto one = [&](const glm::vec2& u, bool keep) {
-    float w = 0.0f, rw = 0.0f;
-    glm::vec3 d(0.0f);
-    bool visible = false;
-    sample(u, w, rw, d, visible);
-    if (!(w > 0.0f)) return;
-    ++traced;
-    seen += visible ? 1 : 0;
-    if (!keep) return;
-    sum_w += double(w);
-    if (visible) {
-      sum_wv += double(w);
-      dir += double(rw) * glm::dvec3(d);
+  constexpr int chunk = 16;
+  probe pr[chunk];
+  glm::vec3 rays[chunk];
+  float t_max[chunk];
+  bool hit[chunk];
+  // Samples [first, last) of the sequence "outline points (0-7), then the (0, 2)-sequence": each
+  // chunk's probes first, their shadow rays in one batch, then accumulated in order.
+  const auto run = [&](int first, int last) {
+    for (int base = first; base < last; base += chunk) {
+      const int n = std::min(chunk, last - base);
+      int m = 0;
+      for (int j = 0; j < n; ++j) {
+        const int k = base + j;
+        pr[j] = probe{};
+        sample(k < 8 ? edge.points[k] : sequence_sample(static_cast<std::uint32_t>(k - 8), s0, s1), pr[j]);
+        if (pr[j].w > 0.0f && pr[j].trace) {
+          rays[m] = pr[j].ray;
+          t_max[m] = pr[j].t_max;
+          ++m;
+        }
+      }
+      occluded_many(sc, origin, rays, t_max, static_cast<std::size_t>(m), hit);
+      m = 0;
+      for (int j = 0; j < n; ++j) {
+        const probe& p = pr[j];
+        if (!(p.w > 0.0f)) continue;
+        const bool visible = p.trace ? !hit[m++] : p.visible;
+        ++traced;
+        seen += visible ? 1 : 0;
+        if (base + j < 8) continue;  // the outline decides only
+        sum_w += double(p.w);
+        if (visible) {
+          sum_wv += double(p.w);
+          dir += double(p.rw) * glm::dvec3(p.d);
+        }
+      }
     }
   };
   // Probes: the outline (decides only; not part of the estimate, which it would bias towards the
   // edges) and the sequence's first probe_samples samples (kept).
-  for (const glm::vec2& u : edge.points) one(u, false);
-  for (int k = 0; k < o.probe_samples; ++k) one(sequence_sample(static_cast<std::uint32_t>(k), s0, s1), true);
+  run(0, 8 + o.probe_samples);
   visibility_result r;
   if (traced > 0 && (seen == 0 || seen == traced)) {
     r.any_traced = true;
@@ -218,8 +251,7 @@ visibility_result estimate(const direct_options& o, std::uint64_t seed, const ou
     r.direction = glm::vec3(dir);
     return r;
   }
-  for (int k = o.probe_samples; k < o.penumbra_samples; ++k)
-    one(sequence_sample(static_cast<std::uint32_t>(k), s0, s1), true);
+  run(8 + o.probe_samples, 8 + o.penumbra_samples);
   r.any_traced = sum_w > 0.0;
   r.visibility = r.any_traced ? static_cast<float>(sum_wv / sum_w) : 0.0f;
   r.direction = glm::vec3(dir);
@@ -421,17 +453,25 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
   bool closed_direction = false;  // the closed form's direction is right (fully visible, fully above)
   if (L.l.type == light_type::rect) {
     const glm::vec3 c = L.l.position, t = L.l.tangent * L.l.width, b = L.bitangent * L.l.height, nl = L.l.direction;
-    v = estimate(options, seed, rect_outline, [&](const glm::vec2& u, float& w, float& rw, glm::vec3& d, bool& visible) {
+    v = estimate(s, o, options, seed, rect_outline, [&](const glm::vec2& u, probe& pb) {
       const glm::vec3 q = c + (u.x - 0.5f) * t + (u.y - 0.5f) * b;
       const glm::vec3 to = q - o;
       const float d2 = glm::dot(to, to);
       if (!(d2 > 0.0f)) return;
-      d = to / std::sqrt(d2);
-      const float cos_r = glm::dot(n, d), cos_l = -glm::dot(nl, d);
+      pb.d = to / std::sqrt(d2);
+      const float cos_r = glm::dot(n, pb.d), cos_l = -glm::dot(nl, pb.d);
       if (!(cos_r > 0.0f) || !(cos_l > 0.0f)) return;
-      rw = cos_l / d2;
-      w = cos_r * rw;
-      visible = !shadows || reaches(s, o, q, off);
+      pb.rw = cos_l / d2;
+      pb.w = cos_r * pb.rw;
+      pb.visible = true;
+      if (shadows) {  // reaches(s, o, q, off), traced by the estimator
+        const float len = glm::length(to);
+        if (len > off) {
+          pb.trace = true;
+          pb.ray = to;
+          pb.t_max = 1.0f - off / len;
+        }
+      }
     });
     closed_direction = v.visibility == 1.0f;
     if (!v.any_traced) {  // a sliver above the horizon: one ray to the clipped polygon's centroid
@@ -457,19 +497,25 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
     } else {
       const frame f = make_frame(g.axis);
       const float r = L.l.radius;
-      v = estimate(options, seed, cone_outline, [&](const glm::vec2& u, float& w, float& rw, glm::vec3& d, bool& visible) {
-        d = cone_direction(f, h_max, u);
-        const float cos_r = glm::dot(n, d);
+      v = estimate(s, o, options, seed, cone_outline, [&](const glm::vec2& u, probe& pb) {
+        pb.d = cone_direction(f, h_max, u);
+        const float cos_r = glm::dot(n, pb.d);
         if (!(cos_r > 0.0f)) return;
-        w = cos_r;
-        rw = 1.0f;
-        if (!shadows) {
-          visible = true;
-        } else if (sun) {
-          visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
+        pb.w = cos_r;
+        pb.rw = 1.0f;
+        pb.visible = true;
+        if (!shadows) return;
+        if (sun) {
+          pb.trace = true;
+          pb.ray = pb.d;
+          pb.t_max = std::numeric_limits<float>::infinity();
         } else {
-          const float t = sphere_distance(o, d, L.l.position, r) - off;
-          visible = !(t > 0.0f) || !occluded(s, o, d, t);
+          const float t = sphere_distance(o, pb.d, L.l.position, r) - off;
+          if (t > 0.0f) {
+            pb.trace = true;
+            pb.ray = pb.d;
+            pb.t_max = t;
+          }
         }
       });
       if (!v.any_traced) {  // a sliver above the horizon: one ray to the cone's point nearest the normal

@@ -6,6 +6,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -255,6 +256,71 @@ bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& directio
   detail::set_ray(r, origin, direction, t_max);
   rtcOccluded1(a->rtc, &context, &r);
   return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+namespace {
+
+// One Embree packet of up to N rays from `origin` (N = 4 or 8: RTCRay4 / RTCRay8), lanes past
+// `count` and invalid rays inactive (valid mask 0, answered false without tracing).
+template <std::size_t N, class Packet>
+void occluded_packet(RTCScene rtc, RTCIntersectContext& context, const glm::vec3& origin, const glm::vec3* directions,
+                     const float* t_max, std::size_t count, bool* out) noexcept {
+  alignas(32) int valid[N];
+  Packet r;
+  int live = 0;
+  for (std::size_t j = 0; j < N; ++j) {
+    const bool ok = j < count && detail::valid_query(origin, directions[j], t_max[j]);
+    valid[j] = ok ? -1 : 0;
+    live += ok ? 1 : 0;
+    const glm::vec3 d = ok ? directions[j] : glm::vec3(0.0f, 0.0f, 1.0f);
+    const float t = ok ? t_max[j] : 1.0f;
+    r.org_x[j] = origin.x;
+    r.org_y[j] = origin.y;
+    r.org_z[j] = origin.z;
+    r.dir_x[j] = d.x;
+    r.dir_y[j] = d.y;
+    r.dir_z[j] = d.z;
+    r.tnear[j] = std::numeric_limits<float>::denorm_min();
+    r.tfar[j] = std::isinf(t) ? t : t * detail::far_margin;
+    r.time[j] = 0.0f;
+    r.mask[j] = 0xffffffffu;
+    r.id[j] = 0;
+    r.flags[j] = 0;
+  }
+  if (live > 0) {
+    if constexpr (N == 8)
+      rtcOccluded8(valid, rtc, &context, &r);
+    else
+      rtcOccluded4(valid, rtc, &context, &r);
+  }
+  for (std::size_t j = 0; j < count; ++j) out[j] = valid[j] != 0 && r.tfar[j] < 0.0f;  // tfar = -inf on a hit
+}
+
+}  // namespace
+
+void occluded_many(const scene& s, const glm::vec3& origin, const glm::vec3* directions, const float* t_max,
+                   std::size_t count, bool* out) noexcept {
+  if (count == 0) return;
+  if (s.triangles().empty() || !detail::finite3(origin)) {
+    for (std::size_t i = 0; i < count; ++i) out[i] = false;
+    return;
+  }
+  const detail::ray_accel* a = detail::built(s);
+  if (!a || !a->rtc) {
+    for (std::size_t i = 0; i < count; ++i)
+      out[i] = detail::valid_query(origin, directions[i], t_max[i]) &&
+               detail::occluded_bvh(s, origin, directions[i], t_max[i]);
+    return;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t base = 0; base < count; base += 8) {
+    const std::size_t n = std::min<std::size_t>(8, count - base);
+    if (n <= 4)
+      occluded_packet<4, RTCRay4>(a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+    else
+      occluded_packet<8, RTCRay8>(a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+  }
 }
 
 bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,

@@ -288,3 +288,86 @@ TEST_CASE("rays: a failed Embree build is reported by prepare_rays and the queri
   // A scene made afterwards gets Embree again.
   CHECK(detail::rays_use_embree(*scene::create(cornell_box().desc())));
 }
+
+TEST_CASE("rays: occluded_many answers as occluded() ray by ray, invalid rays and count 0 included", "[rays]") {
+  for (const named_mesh& nm : {named_mesh{"cornell_box", cornell_box()}, named_mesh{"hexagon_room_3", hexagon_room(3)},
+                               named_mesh{"open_pavilion", open_pavilion()},
+                               named_mesh{"sky_and_occluders", sky_and_occluders()}}) {
+    INFO("scene " << nm.name);
+    const auto s = scene::create(nm.mesh.desc());
+    const std::vector<ref_triangle> tris = reference_triangles(nm.mesh);
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    const glm::vec3 lo = s->bounds_lo(), hi = s->bounds_hi();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    int rays = 0, differ = 0;
+    for (int bundle = 0; bundle < 300; ++bundle) {
+      const glm::vec3 o = lo + (hi - lo) * glm::vec3(u01(rng), u01(rng), u01(rng)) * 1.2f - 0.1f * (hi - lo);
+      const std::size_t count = std::size_t(bundle % 21);  // 0 to 20: packets of 8, the last of 1 to 8
+      glm::vec3 dirs[20];
+      float t_max[20];
+      bool out[20];
+      for (std::size_t i = 0; i < count; ++i) {
+        dirs[i] = glm::normalize(glm::vec3(gauss(rng), gauss(rng), gauss(rng))) * (0.5f + 2.0f * u01(rng));
+        t_max[i] = i % 4 == 0 ? inf : s->size() * (0.05f + 0.95f * u01(rng)) / glm::length(dirs[i]);
+        switch ((bundle + int(i)) % 11) {  // invalid rays among the valid ones
+          case 0: dirs[i] = glm::vec3(0.0f); break;
+          case 1: dirs[i].y = nan; break;
+          case 2: dirs[i].x = inf; break;
+          case 3: t_max[i] = 0.0f; break;
+          case 4: t_max[i] = nan; break;
+          case 5: t_max[i] = -1.0f; break;
+          default: break;
+        }
+        out[i] = !occluded(*s, o, dirs[i], t_max[i]);  // overwritten: every entry must be written
+      }
+      occluded_many(*s, o, dirs, t_max, count, out);
+      for (std::size_t i = 0; i < count; ++i) {
+        ++rays;
+        const bool one = occluded(*s, o, dirs[i], t_max[i]);
+        if (out[i] != one) {
+          INFO("bundle " << bundle << " ray " << i << ": batch " << out[i] << " single " << one);
+          CHECK(near_an_edge(tris, glm::dvec3(o), glm::dvec3(dirs[i]), double(t_max[i]), 1e-5));
+          ++differ;
+        }
+        if (!std::isfinite(dirs[i].x) || !std::isfinite(dirs[i].y) || dirs[i] == glm::vec3(0.0f) ||
+            !(t_max[i] > 0.0f))
+          CHECK_FALSE(out[i]);
+      }
+    }
+    CHECK(differ <= rays / 100);
+    // A non-finite origin: every answer false; count 0 with null pointers does nothing.
+    glm::vec3 d[3] = {{0.0f, 1.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}};
+    float t[3] = {inf, inf, inf};
+    bool out[3] = {true, true, true};
+    occluded_many(*s, glm::vec3(nan, 0.0f, 0.0f), d, t, 3, out);
+    CHECK_FALSE((out[0] || out[1] || out[2]));
+    occluded_many(*s, glm::vec3(0.0f), nullptr, nullptr, 0, nullptr);
+  }
+}
+
+TEST_CASE("rays: occluded_many through the fallback answers as occluded_bvh", "[rays]") {
+  detail::fail_embree_builds_for_testing(true);
+  const auto s = scene::create(hexagon_room(3).desc());
+  try {
+    prepare_rays(*s);
+  } catch (const error&) {
+  }
+  detail::fail_embree_builds_for_testing(false);
+  REQUIRE_FALSE(detail::rays_use_embree(*s));
+  std::mt19937 rng(5);
+  std::normal_distribution<float> gauss(0.0f, 1.0f);
+  for (int bundle = 0; bundle < 50; ++bundle) {
+    const glm::vec3 o(0.3f * gauss(rng), 1.0f + 0.3f * gauss(rng), 0.3f * gauss(rng));
+    glm::vec3 dirs[12];
+    float t_max[12];
+    bool out[12];
+    for (int i = 0; i < 12; ++i) {
+      dirs[i] = glm::vec3(gauss(rng), gauss(rng), gauss(rng));
+      t_max[i] = i == 5 ? 0.0f : (i % 3 == 0 ? inf : 2.0f);
+    }
+    occluded_many(*s, o, dirs, t_max, 12, out);
+    for (int i = 0; i < 12; ++i) CHECK(out[i] == (t_max[i] > 0.0f && detail::occluded_bvh(*s, o, dirs[i], t_max[i])));
+  }
+}
