@@ -647,6 +647,9 @@ direct_values direct_pass(const lightmap_samples& s, const sample_points& pts, c
         if (!o.output_sh_l1 && !o.output_hl2) continue;
         const std::size_t k = pts.texel_of[i];
         const frame f{s.tangent[k], s.bitangent[k], s.normal[k]};
+        std::array<glm::vec3, 3> basis{};  // the texel's HL2 vectors in world space
+        if (o.output_hl2)
+          for (std::size_t j = 0; j < 3; ++j) basis[j] = f.to_world(glm::vec3(hl2_basis[j][0], hl2_basis[j][1], hl2_basis[j][2]));
         for (const light_sample& ls : per_light) {
           const float cos_n = glm::dot(n, ls.direction);
           if (!(cos_n > 1e-4f)) continue;  // no light, or all of it at the horizon (E ~ 0)
@@ -659,10 +662,7 @@ direct_values direct_pass(const lightmap_samples& s, const sample_points& pts, c
             d.sh[3][i] += (0.488602512f * w.x) * flux;
           }
           if (o.output_hl2)
-            for (std::size_t j = 0; j < 3; ++j) {
-              const glm::vec3 basis = f.to_world(glm::vec3(hl2_basis[j][0], hl2_basis[j][1], hl2_basis[j][2]));
-              d.hl2[j][i] += std::max(0.0f, glm::dot(basis, w)) * flux;
-            }
+            for (std::size_t j = 0; j < 3; ++j) d.hl2[j][i] += std::max(0.0f, glm::dot(basis[j], w)) * flux;
         }
       }
     });

@@ -266,47 +266,66 @@ class record_bvh {
   std::vector<glm::vec3> lo_, hi_;
 };
 
+// The cells of a uniform grid over a box: cubes of side >= `cell`, grown by 1.25x until there are
+// at most 4 count + 64 of them (at most 1024 per axis). point_grid and seed_grid share them.
+struct grid_cells {
+  glm::vec3 lo{0.0f};
+  float inv_cell = 1.0f;
+  glm::ivec3 dims{1};
+
+  void fit(const glm::vec3& box_lo, const glm::vec3& ext, float cell, std::size_t count) {
+    lo = box_lo;
+    for (;;) {
+      dims = glm::ivec3(glm::min(glm::floor(ext / cell), glm::vec3(1023.0f))) + 1;
+      if (double(dims.x) * dims.y * dims.z <= 4.0 * double(count) + 64.0) break;
+      cell *= 1.25f;
+    }
+    inv_cell = 1.0f / cell;
+  }
+  std::size_t size() const { return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z); }
+  glm::ivec3 cell_of(const glm::vec3& q) const {
+    return glm::ivec3(glm::clamp((q - lo) * inv_cell, glm::vec3(0.0f), glm::vec3(dims - 1)));  // NaN-free for finite q
+  }
+  std::size_t index(const glm::ivec3& q) const {
+    return (std::size_t(q.z) * std::size_t(dims.y) + std::size_t(q.y)) * std::size_t(dims.x) + std::size_t(q.x);
+  }
+};
+
 // A uniform grid over the points (cells in CSR order), built once: which points lie in a
 // sphere. Placement uses it to find the points whose coverage a new or shrunk record can change.
 class point_grid {
  public:
   void build(const glm::vec3* p, std::size_t count) {
-    lo_ = glm::vec3(std::numeric_limits<float>::max());
-    glm::vec3 hi(-std::numeric_limits<float>::max());
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::size_t i = 0; i < count; ++i) {
-      lo_ = glm::min(lo_, p[i]);
+      lo = glm::min(lo, p[i]);
       hi = glm::max(hi, p[i]);
     }
     p_ = p;
-    const glm::vec3 ext = count ? glm::max(hi - lo_, glm::vec3(0.0f)) : glm::vec3(0.0f);
-    // About one cell per point over the box (points on surfaces fill few cells), at most 4 count + 64.
+    const glm::vec3 ext = count ? glm::max(hi - lo, glm::vec3(0.0f)) : glm::vec3(0.0f);
+    // About one cell per point over the box (points on surfaces fill few cells).
     float cell = std::cbrt(std::max(ext.x * ext.y * ext.z, 0.0f) / float(std::max<std::size_t>(count, 1)));
     cell = std::max({cell, 1e-3f * std::max({ext.x, ext.y, ext.z}), 1e-30f});
-    for (;;) {
-      dims_ = glm::ivec3(glm::min(glm::floor(ext / cell), glm::vec3(1023.0f))) + 1;
-      if (double(dims_.x) * dims_.y * dims_.z <= 4.0 * double(count) + 64.0) break;
-      cell *= 1.25f;
-    }
-    inv_cell_ = 1.0f / cell;
-    const std::size_t cells = std::size_t(dims_.x) * std::size_t(dims_.y) * std::size_t(dims_.z);
+    cells_.fit(lo, ext, cell, count);
+    const std::size_t cells = cells_.size();
     start_.assign(cells + 1, 0u);
-    for (std::size_t i = 0; i < count; ++i) ++start_[cell_index(cell_of(p[i])) + 1];
+    for (std::size_t i = 0; i < count; ++i) ++start_[cells_.index(cells_.cell_of(p[i])) + 1];
     for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
     points_.resize(count);
     std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < count; ++i) points_[fill[cell_index(cell_of(p[i]))]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < count; ++i) points_[fill[cells_.index(cells_.cell_of(p[i]))]++] = static_cast<std::uint32_t>(i);
   }
 
   // Calls f(i) for every point i with |p_i - c| <= r.
   template <class F>
   void for_each_in_sphere(const glm::vec3& c, float r, F&& f) const {
     if (points_.empty()) return;
-    const glm::ivec3 a = cell_of(c - glm::vec3(r)), b = cell_of(c + glm::vec3(r));
+    const glm::ivec3 a = cells_.cell_of(c - glm::vec3(r)), b = cells_.cell_of(c + glm::vec3(r));
     const float r2 = r * r;
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
         for (int x = a.x; x <= b.x; ++x) {
-          const std::size_t cell = cell_index({x, y, z});
+          const std::size_t cell = cells_.index({x, y, z});
           for (std::uint32_t k = start_[cell]; k < start_[cell + 1]; ++k) {
             const glm::vec3 d = p_[points_[k]] - c;
             if (glm::dot(d, d) <= r2) f(points_[k]);
@@ -315,18 +334,8 @@ class point_grid {
   }
 
  private:
-  glm::ivec3 cell_of(const glm::vec3& q) const {
-    const glm::vec3 t = glm::clamp((q - lo_) * inv_cell_, glm::vec3(0.0f), glm::vec3(dims_ - 1));
-    return glm::ivec3(t);  // NaN-free: the clamp of a finite point
-  }
-  std::size_t cell_index(const glm::ivec3& q) const {
-    return (std::size_t(q.z) * std::size_t(dims_.y) + std::size_t(q.y)) * std::size_t(dims_.x) + std::size_t(q.x);
-  }
-
   const glm::vec3* p_ = nullptr;
-  glm::vec3 lo_{0.0f};
-  float inv_cell_ = 1.0f;
-  glm::ivec3 dims_{1};
+  grid_cells cells_;
   std::vector<std::uint32_t> start_, points_;
 };
 
@@ -341,22 +350,15 @@ class point_grid {
 class seed_grid {
  public:
   void reset(const glm::vec3& lo, const glm::vec3& hi, float cell, std::size_t count) {
-    lo_ = lo;
     const glm::vec3 ext = glm::max(hi - lo, glm::vec3(0.0f));
-    cell = std::max({cell, 1e-6f * std::max({ext.x, ext.y, ext.z}), 1e-30f});
-    for (;;) {
-      dims_ = glm::ivec3(glm::min(glm::floor(ext / cell), glm::vec3(1023.0f))) + 1;
-      if (double(dims_.x) * dims_.y * dims_.z <= 4.0 * double(count) + 64.0) break;
-      cell *= 1.25f;
-    }
-    inv_cell_ = 1.0f / cell;
-    head_.assign(std::size_t(dims_.x) * std::size_t(dims_.y) * std::size_t(dims_.z), none);
+    cells_.fit(lo, ext, std::max({cell, 1e-6f * std::max({ext.x, ext.y, ext.z}), 1e-30f}), count);
+    head_.assign(cells_.size(), none);
     next_.clear();
     position_.clear();
     normal_.clear();
   }
   void insert(const glm::vec3& x, const glm::vec3& n) {
-    const std::size_t c = cell_index(cell_of(x));
+    const std::size_t c = cells_.index(cells_.cell_of(x));
     next_.push_back(head_[c]);
     position_.push_back(x);
     normal_.push_back(n);
@@ -366,26 +368,18 @@ class seed_grid {
   // (a superset of the items within r of x); stops at the first that does.
   template <class F>
   bool any_near(const glm::vec3& x, float r, F&& pred) const {
-    const glm::ivec3 a = cell_of(x - glm::vec3(r)), b = cell_of(x + glm::vec3(r));
+    const glm::ivec3 a = cells_.cell_of(x - glm::vec3(r)), b = cells_.cell_of(x + glm::vec3(r));
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
         for (int xx = a.x; xx <= b.x; ++xx)
-          for (std::uint32_t k = head_[cell_index({xx, y, z})]; k != none; k = next_[k])
+          for (std::uint32_t k = head_[cells_.index({xx, y, z})]; k != none; k = next_[k])
             if (pred(position_[k], normal_[k])) return true;
     return false;
   }
 
  private:
   static constexpr std::uint32_t none = 0xffffffffu;
-  glm::ivec3 cell_of(const glm::vec3& q) const {
-    return glm::ivec3(glm::clamp((q - lo_) * inv_cell_, glm::vec3(0.0f), glm::vec3(dims_ - 1)));
-  }
-  std::size_t cell_index(const glm::ivec3& q) const {
-    return (std::size_t(q.z) * std::size_t(dims_.y) + std::size_t(q.y)) * std::size_t(dims_.x) + std::size_t(q.x);
-  }
-  glm::vec3 lo_{0.0f};
-  float inv_cell_ = 1.0f;
-  glm::ivec3 dims_{1};
+  grid_cells cells_;
   std::vector<std::uint32_t> head_, next_;
   std::vector<glm::vec3> position_, normal_;
 };

@@ -421,9 +421,22 @@ glm::vec3 unoccluded_irradiance(const light_set& lights, std::size_t i, const gl
   return closed_form(lights.prepared_light(i), p, n).e;
 }
 
+namespace {
+light_sample direct_light_unchecked(const scene& s, const light_set& lights, std::size_t i, const glm::vec3& p,
+                                    const glm::vec3& n, const direct_options& options);
+}  // namespace
+
 light_sample direct_light(const scene& s, const light_set& lights, std::size_t i, const glm::vec3& p, const glm::vec3& n,
                           const direct_options& options) {
   check_options(options);
+  return direct_light_unchecked(s, lights, i, p, n, options);
+}
+
+namespace {
+// direct_light with the options already checked (direct_irradiance checks them once per point,
+// not once per light).
+light_sample direct_light_unchecked(const scene& s, const light_set& lights, std::size_t i, const glm::vec3& p,
+                                    const glm::vec3& n, const direct_options& options) {
   assert(i < lights.size());
   assert(std::fabs(glm::length(n) - 1.0f) < 1e-3f);
   const light_set::prepared& L = lights.prepared_light(i);
@@ -554,12 +567,14 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
   return out;
 }
 
+}  // namespace
+
 glm::vec3 direct_irradiance(const scene& s, const light_set& lights, const glm::vec3& p, const glm::vec3& n,
                             const direct_options& options, light_sample* per_light) {
   check_options(options);
   glm::vec3 sum(0.0f);
   for (std::size_t i = 0; i < lights.size(); ++i) {
-    const light_sample ls = direct_light(s, lights, i, p, n, options);
+    const light_sample ls = direct_light_unchecked(s, lights, i, p, n, options);
     sum += ls.irradiance;
     if (per_light) per_light[i] = ls;
   }
