@@ -108,6 +108,29 @@ float exact_triangle(const ray_setup& r, std::uint32_t i, float t_max) noexcept 
   return t > 0.0 && t < double(t_max) ? static_cast<float>(t) : infinity;
 }
 
+// One lane of the leaf loops: Woop, Benthin and Wald's edge functions in float for triangle
+// first + j. hit: inside (no mixed signs), det != 0 and 0 < t < t_max, with t = tt / ad; zero: an
+// edge function is exactly 0 (the exact retry decides).
+struct lane_result {
+  int hit, zero;
+  float tt, ad;
+};
+inline lane_result lane(const ray_setup& r, std::uint32_t first, std::uint32_t j, std::uint32_t count, float t_max) noexcept {
+  const sheared s = shear(r, first + j);
+  const float u = s.cx * s.by - s.cy * s.bx;
+  const float v = s.ax * s.cy - s.ay * s.cx;
+  const float w = s.bx * s.ay - s.by * s.ax;
+  const int live = j < count;
+  const int neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
+  const int pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+  const float det = u + v + w;
+  const float t = r.sz * (u * s.az + v * s.bz + w * s.cz);
+  const float sign = det < 0.0f ? -1.0f : 1.0f;
+  const float tt = t * sign, ad = det * sign;
+  return {live & (1 - (neg & pos)) & (det != 0.0f) & (tt > 0.0f) & (tt < t_max * ad),
+          live & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f)), tt, ad};
+}
+
 // Any-hit over a leaf: eight lanes at a time (lanes past `count` read the next triangles or the
 // padding of the coordinate arrays and are masked out).
 inline bool leaf_any(const ray_setup& r, std::uint32_t first, std::uint32_t count, float t_max) noexcept {
@@ -115,19 +138,9 @@ inline bool leaf_any(const ray_setup& r, std::uint32_t first, std::uint32_t coun
   int hit = 0, zero = 0;
 #pragma omp simd reduction(| : hit, zero)
   for (std::uint32_t j = 0; j < n8; ++j) {
-    const sheared s = shear(r, first + j);
-    const float u = s.cx * s.by - s.cy * s.bx;
-    const float v = s.ax * s.cy - s.ay * s.cx;
-    const float w = s.bx * s.ay - s.by * s.ax;
-    const int live = j < count;
-    const int neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
-    const int pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    zero |= live & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
-    const float det = u + v + w;
-    const float t = r.sz * (u * s.az + v * s.bz + w * s.cz);
-    const float sign = det < 0.0f ? -1.0f : 1.0f;
-    const float tt = t * sign, ad = det * sign;
-    hit |= live & (1 - (neg & pos)) & (det != 0.0f) & (tt > 0.0f) & (tt < t_max * ad);
+    const lane_result l = lane(r, first, j, count, t_max);
+    hit |= l.hit;
+    zero |= l.zero;
   }
   if (hit) return true;
   if (!zero) return false;
@@ -146,20 +159,9 @@ inline std::uint32_t leaf_closest(const ray_setup& r, std::uint32_t first, std::
   int zero = 0;
 #pragma omp simd reduction(| : zero)
   for (std::uint32_t j = 0; j < n8; ++j) {
-    const sheared s = shear(r, first + j);
-    const float u = s.cx * s.by - s.cy * s.bx;
-    const float v = s.ax * s.cy - s.ay * s.cx;
-    const float w = s.bx * s.ay - s.by * s.ax;
-    const int live = j < count;
-    const int neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
-    const int pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    zero |= live & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
-    const float det = u + v + w;
-    const float t = r.sz * (u * s.az + v * s.bz + w * s.cz);
-    const float sign = det < 0.0f ? -1.0f : 1.0f;
-    const float tt = t * sign, ad = det * sign;
-    const int hit = live & (1 - (neg & pos)) & (det != 0.0f) & (tt > 0.0f) & (tt < t_max * ad);
-    ts[j] = hit ? tt / ad : infinity;
+    const lane_result l = lane(r, first, j, count, t_max);
+    zero |= l.zero;
+    ts[j] = l.hit ? l.tt / l.ad : infinity;
   }
   if (zero)
     for (std::uint32_t j = 0; j < count; ++j) ts[j] = exact_triangle(r, first + j, t_max);
