@@ -24,7 +24,11 @@ namespace hemilight {
 
 namespace {
 
-constexpr float max_weight = 1e12f;  // caps Ward's 1/0 at a record's own position and normal
+constexpr float max_weight = 1e12f;
+// placement::candidate_count: seed candidates per seed spacing along a surface (so about 9 per
+// spacing x spacing square); 3 keeps the seeds' spacing as with every point a candidate (the
+// records, hemicube counts and errors: docs/cache.md) while checking a third fewer points.
+constexpr double candidates_per_spacing = 3.0;  // caps Ward's 1/0 at a record's own position and normal
 constexpr float behind_epsilon = 1e-6f;
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -39,10 +43,16 @@ float coverage_radius(const cache_record& r, const cache_options& o) { return o.
 // The weight the coverage tests use: Ward's w where it passes 1/a (for both Ward weightings, so
 // ward_continuous places the same records as ward), the Tabellion-Lamorlette w where positive;
 // else 0. record_weight (the interpolation's weight) is this, less 1/a for ward_continuous.
-// R is a cache_record or a record_bvh::key (anything with position, normal and radius).
+// R is a cache_record or a record_lists::key (anything with position, normal and radius).
 template <class R>
 inline float coverage_weight(const R& r, const glm::vec3& x, const glm::vec3& n, const cache_options& o) {
-  const float d = glm::length(x - r.position);
+  // Both weights are 0 beyond d = a R (Ward: d / R >= a makes w <= 1/a; T-L: d / (R/2) >= 2a makes
+  // w <= 0). Points beyond it by more than float rounding (1e-4 relative: the arithmetic below
+  // rounds by ~1e-7) are rejected without the square roots and the division: the same result.
+  const glm::vec3 dx = x - r.position;
+  const float reach = o.error_threshold * r.radius;
+  if (glm::dot(dx, dx) > 1.0002f * reach * reach) return 0.0f;
+  const float d = glm::length(dx);
   const float ndot = std::sqrt(std::max(0.0f, 1.0f - glm::dot(n, r.normal)));
   if (o.weight != cache_weight::tabellion_lamorlette) {
     const float denom = d / r.radius + ndot;
@@ -66,6 +76,24 @@ inline bool is_behind(const R& r, const glm::vec3& x, const glm::vec3& n) {
   return 0.5f * glm::dot(x - r.position, r.normal + n) < -behind_epsilon;
 }
 
+// What a record's first-order prediction needs, compact (a third of a cache_record): predict()
+// gives bit for bit extrapolate(record, x, n, 1).
+struct linear_model {
+  glm::vec3 position, normal, irradiance;
+  std::array<glm::vec3, 3> rotation_gradient, translation_gradient;
+  explicit linear_model(const cache_record& r)
+      : position(r.position), normal(r.normal), irradiance(r.irradiance), rotation_gradient(r.rotation_gradient),
+        translation_gradient(r.translation_gradient) {}
+  glm::vec3 predict(const glm::vec3& x, const glm::vec3& n) const {
+    glm::vec3 e = irradiance;
+    const glm::vec3 rot = glm::cross(normal, n);
+    const glm::vec3 dx = x - position;
+    for (int c = 0; c < 3; ++c)
+      e[c] += glm::dot(rot, rotation_gradient[std::size_t(c)]) + glm::dot(dx, translation_gradient[std::size_t(c)]);
+    return e;
+  }
+};
+
 // A record's prediction at (x, n): order 0 = E_i, 1 = with the gradient terms, 2 = also with the
 // second-order term 1/2 dx^T H dx, clamped per channel to +-a E_i (the error a allows: a record
 // whose irradiance is 0, in an umbra, stays 0 instead of bending towards its lit neighbours).
@@ -88,13 +116,14 @@ glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3
 // The order of the predictions that options ask for.
 int prediction_order(const cache_options& o) { return !o.use_gradients ? 0 : (o.second_order ? 2 : 1); }
 
-// A bounding-volume hierarchy over the records' coverage spheres, rebuilt after every round
-// (records are only added between rounds, so queries never race with insertion). Query cost
-// O(log n + k) for k records whose box holds the point.
+// A bounding-volume hierarchy over the records' coverage boxes (centre +- a R), rebuilt after
+// every round's new records are appended (limit_radii finds each new record's neighbours with it:
+// the records of every leaf whose box holds the new record's position). Median splits on the
+// longest axis of the centres, leaves of at most 4 records: the tree, and so the neighbours, depend
+// only on the positions and radii, not on the thread count.
 class record_bvh {
  public:
-  // What a query needs of a record to weigh it, in leaf order (32 bytes; the records themselves
-  // are ten times larger): the weights and is_behind read only these, bit for bit the record's.
+  // What a query reports of a record (32 bytes; the records themselves are ten times larger).
   struct key {
     glm::vec3 position;
     float radius;
@@ -105,16 +134,12 @@ class record_bvh {
   // threads: how many cores the build may use (the two halves below the root are built in
   // parallel; the tree is the same for any count).
   void build(const std::vector<cache_record>& records, const cache_options& o, int threads = 1) {
-    records_ = &records;
     nodes_.clear();
-    index_.resize(records.size());
-    std::iota(index_.begin(), index_.end(), 0u);
-    lo_.resize(records.size());
-    hi_.resize(records.size());
+    items_.resize(records.size());
     for (std::size_t i = 0; i < records.size(); ++i) {
       const float r = coverage_radius(records[i], o);
-      lo_[i] = records[i].position - glm::vec3(r);
-      hi_[i] = records[i].position + glm::vec3(r);
+      items_[i] = {records[i].position, records[i].position - glm::vec3(r), records[i].position + glm::vec3(r),
+                   static_cast<std::uint32_t>(i)};
     }
     if (records.empty()) {
       keys_.clear();
@@ -153,35 +178,7 @@ class record_bvh {
     fill_keys(records);
   }
 
-  // After radii changed but no record was added or moved: the same tree with new boxes. The
-  // tree's shape depends only on the positions (split() orders centres), so this gives exactly
-  // what build() would, in O(n) instead of O(n log n). Parents precede their children in nodes_,
-  // so one backward pass sees every child before its parent.
-  void refit(const std::vector<cache_record>& records, const cache_options& o) {
-    for (std::size_t i = 0; i < records.size(); ++i) {
-      const float r = coverage_radius(records[i], o);
-      lo_[i] = records[i].position - glm::vec3(r);
-      hi_[i] = records[i].position + glm::vec3(r);
-    }
-    for (std::size_t k = nodes_.size(); k-- > 0;) {
-      node& nd = nodes_[k];
-      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-      if (nd.count > 0) {
-        for (std::uint32_t j = nd.first; j < nd.first + nd.count; ++j) {
-          lo = glm::min(lo, lo_[index_[j]]);
-          hi = glm::max(hi, hi_[index_[j]]);
-        }
-      } else {
-        lo = glm::min(nodes_[nd.first].lo, nodes_[nd.first + 1].lo);
-        hi = glm::max(nodes_[nd.first].hi, nodes_[nd.first + 1].hi);
-      }
-      nd.lo = lo;
-      nd.hi = hi;
-    }
-    fill_keys(records);
-  }
-
-  // Calls f(key) for every record whose coverage box holds x.
+  // Calls f(key) for every record of every leaf whose box holds x.
   template <class F>
   void query(const glm::vec3& x, F&& f) const {
     if (nodes_.empty()) return;
@@ -205,18 +202,25 @@ class record_bvh {
     glm::vec3 lo, hi;
     std::uint32_t first, count;  // leaf: records [first, first + count); inner: children first, first + 1
   };
+  // A record while the tree is built: its centre, its box, its index (items_ is reordered).
+  struct item {
+    glm::vec3 centre, lo, hi;
+    std::uint32_t index;
+  };
 
-  // Sets nd's box over index_[begin, end); returns 0 if it stays a leaf (<= 4 records), else
-  // the split point after a median split on the longest axis of the centres (index_ reordered).
+  // Sets nd's box over items_[begin, end); returns 0 if it stays a leaf (<= 4 records), else
+  // the split point after a median split on the longest axis of the centres (items_ reordered:
+  // which records fall on either side is fixed by a total order, their order within a side is not
+  // and does not matter).
   std::uint32_t split(node& nd, std::uint32_t begin, std::uint32_t end) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     glm::vec3 clo = lo, chi = hi;
     for (std::uint32_t k = begin; k < end; ++k) {
-      const std::uint32_t i = index_[k];
-      lo = glm::min(lo, lo_[i]);
-      hi = glm::max(hi, hi_[i]);
-      clo = glm::min(clo, (*records_)[i].position);
-      chi = glm::max(chi, (*records_)[i].position);
+      const item& it = items_[k];
+      lo = glm::min(lo, it.lo);
+      hi = glm::max(hi, it.hi);
+      clo = glm::min(clo, it.centre);
+      chi = glm::max(chi, it.centre);
     }
     nd.lo = lo;
     nd.hi = hi;
@@ -228,15 +232,14 @@ class record_bvh {
     const glm::vec3 ext = chi - clo;
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     const std::uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(index_.begin() + begin, index_.begin() + mid, index_.begin() + end,
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       const float pa = (*records_)[a].position[axis], pb = (*records_)[b].position[axis];
-                       return pa < pb || (pa == pb && a < b);  // total order: deterministic
-                     });
+    std::nth_element(items_.begin() + begin, items_.begin() + mid, items_.begin() + end, [axis](const item& a, const item& b) {
+      const float pa = a.centre[axis], pb = b.centre[axis];
+      return pa < pb || (pa == pb && a.index < b.index);  // total order: deterministic
+    });
     nd.count = 0;
     return mid;
   }
-  // Builds the subtree of index_[begin, end) with its root at out[slot]; children are allocated
+  // Builds the subtree of items_[begin, end) with its root at out[slot]; children are allocated
   // in pairs (left, right = left + 1). Depth stays below 64 because every split halves the range.
   void build_into(std::vector<node>& out, std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
     node nd{};
@@ -254,16 +257,142 @@ class record_bvh {
   void fill_keys(const std::vector<cache_record>& records) {
     keys_.resize(records.size());
     for (std::size_t k = 0; k < records.size(); ++k) {
-      const cache_record& r = records[index_[k]];
-      keys_[k] = {r.position, r.radius, r.normal, index_[k]};
+      const cache_record& r = records[items_[k].index];
+      keys_[k] = {r.position, r.radius, r.normal, items_[k].index};
     }
   }
 
-  const std::vector<cache_record>* records_ = nullptr;
-  std::vector<key> keys_;  // in index_ order
+  std::vector<item> items_;
+  std::vector<key> keys_;  // in items_ order
   std::vector<node> nodes_;
-  std::vector<std::uint32_t> index_;
-  std::vector<glm::vec3> lo_, hi_;
+};
+
+// Which records can cover each point: per point, the records whose coverage sphere (radius a R)
+// held it when they were added. Radii only shrink after a record is added (cache.hpp: limits),
+// so the records that cover a point now are among them, and a query at a point reads one short
+// list instead of searching a structure. A record whose sphere shrank past the point stays in the
+// list; the weight test drops it. Every query in placement and in the final interpolation is at
+// one of the points. Lists live in one pool: a full list moves to the end of the pool with twice
+// the room. Queries are read-only and may run in parallel; add, append and set_radius may not run
+// during them.
+class record_lists {
+ public:
+  // What a query needs of a record to weigh it (32 bytes; the records themselves are ten times
+  // larger): the weights and is_behind read only these, bit for bit the record's.
+  struct key {
+    glm::vec3 position;
+    float radius;
+    glm::vec3 normal;
+    std::uint32_t index;  // the record's index
+  };
+
+  // owners: how many workers may append at once (each to the points it owns, owner()).
+  void reset(std::size_t points, int owners) {
+    keys_.clear();
+    std::size_t pools = 1;  // a power of two: owner() is a mask
+    while (pools < std::size_t(std::max(owners, 1))) pools *= 2;
+    pools_.assign(pools, {});
+    compacted_size_.assign(pools, 0);
+    inline_.assign(points * inline_room, 0);
+    begin_.assign(points, 0);
+    size_.assign(points, 0);
+    room_.assign(points, 0);
+  }
+
+  std::size_t size() const { return keys_.size(); }
+  const key& operator[](std::size_t i) const { return keys_[i]; }
+  void add(const cache_record& r) { keys_.push_back({r.position, r.radius, r.normal, static_cast<std::uint32_t>(keys_.size())}); }
+  // A record's radius after it shrank.
+  void set_radius(std::size_t index, float radius) { keys_[index].radius = radius; }
+
+  std::size_t owners() const { return pools_.size(); }
+
+  // Which owner's pool holds the overflow of `point`'s list: appends to points of different
+  // owners may run in parallel. Blocks of 64 points, so that owners do not share cache lines.
+  std::size_t owner(std::size_t point) const { return (point >> 6) & (pools_.size() - 1); }
+
+  // Lays the overflow lists of owner w's points out again in the order of `points` (a
+  // permutation of all points), each with room for its records only, when its pool has grown to
+  // more than twice its size at the last layout: lists that queries read one after another lie
+  // one after another.
+  void lay_out(std::size_t w, const std::vector<std::uint32_t>& points) {
+    std::vector<std::uint32_t>& pool = pools_[w];
+    if (pool.size() <= 2 * compacted_size_[w] + 1024) return;
+    std::vector<std::uint32_t> fresh;
+    fresh.reserve(pool.size() / 2);
+    for (std::uint32_t point : points) {
+      if (owner(point) != w) continue;
+      if (size_[point] <= inline_room) {  // no overflow: no room kept in the new pool either
+        begin_[point] = room_[point] = 0;
+        continue;
+      }
+      const auto at = static_cast<std::uint32_t>(fresh.size());
+      const std::uint32_t over = size_[point] - inline_room;
+      fresh.insert(fresh.end(), pool.begin() + begin_[point], pool.begin() + begin_[point] + over);
+      begin_[point] = at;
+      room_[point] = over;
+    }
+    pool.swap(fresh);
+    compacted_size_[w] = pool.size();
+  }
+
+  // Lists `record` at `point`.
+  void append(std::uint32_t point, std::uint32_t record) {
+    const std::uint32_t k = size_[point]++;
+    if (k < inline_room) {
+      inline_[std::size_t(point) * inline_room + k] = record;
+      return;
+    }
+    const std::uint32_t over = k - inline_room;
+    std::vector<std::uint32_t>& pool = pools_[owner(point)];
+    if (over == room_[point]) {
+      const std::uint32_t room = room_[point] ? 2 * room_[point] : 4;
+      const auto at = static_cast<std::uint32_t>(pool.size());
+      pool.resize(pool.size() + room);
+      std::copy_n(pool.begin() + begin_[point], over, pool.begin() + at);
+      begin_[point] = at;
+      room_[point] = room;
+    }
+    pool[begin_[point] + over] = record;
+  }
+
+  // Drops from the list at `point` the records for which keep(key) is false (point's list only:
+  // lists of different points may be compacted in parallel).
+  template <class F>
+  void compact(std::size_t point, F&& keep) {
+    std::uint32_t* in = inline_.data() + point * inline_room;
+    std::uint32_t* over = size_[point] > inline_room ? pools_[owner(point)].data() + begin_[point] : nullptr;
+    const auto at = [&](std::uint32_t k) -> std::uint32_t& { return k < inline_room ? in[k] : over[k - inline_room]; };
+    std::uint32_t kept = 0;
+    for (std::uint32_t k = 0; k < size_[point]; ++k)
+      if (keep(keys_[at(k)])) {
+        const std::uint32_t v = at(k);
+        at(kept++) = v;
+      }
+    size_[point] = kept;
+  }
+
+  // Calls f(key) for every record listed at `point`: a superset of the records whose coverage
+  // sphere holds it, in no particular order.
+  template <class F>
+  void query(std::size_t point, F&& f) const {
+    const std::uint32_t n = size_[point];
+    const std::uint32_t* in = inline_.data() + point * inline_room;
+    for (std::uint32_t k = 0; k < std::min(n, inline_room); ++k) f(keys_[in[k]]);
+    if (n > inline_room) {
+      const std::uint32_t* over = pools_[owner(point)].data() + begin_[point];
+      for (std::uint32_t k = 0; k < n - inline_room; ++k) f(keys_[over[k]]);
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t inline_room = 4;  // entries per point kept inline (most lists are short)
+  std::vector<key> keys_;
+  std::vector<std::uint32_t> inline_;  // per point, its first inline_room entries
+  std::vector<std::vector<std::uint32_t>> pools_;
+  std::vector<std::size_t> compacted_size_;  // per pool: its size after the last lay_out
+  // Per point: its list's length, and where the entries beyond inline_room lie in pools_[owner(point)].
+  std::vector<std::uint32_t> begin_, size_, room_;
 };
 
 // The cells of a uniform grid over a box: cubes of side >= `cell`, grown by 1.25x until there are
@@ -301,20 +430,31 @@ class point_grid {
       lo = glm::min(lo, p[i]);
       hi = glm::max(hi, p[i]);
     }
-    p_ = p;
     const glm::vec3 ext = count ? glm::max(hi - lo, glm::vec3(0.0f)) : glm::vec3(0.0f);
     // About one cell per point over the box (points on surfaces fill few cells).
     float cell = std::cbrt(std::max(ext.x * ext.y * ext.z, 0.0f) / float(std::max<std::size_t>(count, 1)));
     cell = std::max({cell, 1e-3f * std::max({ext.x, ext.y, ext.z}), 1e-30f});
     cells_.fit(lo, ext, cell, count);
     const std::size_t cells = cells_.size();
+    std::vector<std::uint32_t> cell_of(count);
     start_.assign(cells + 1, 0u);
-    for (std::size_t i = 0; i < count; ++i) ++start_[cells_.index(cells_.cell_of(p[i])) + 1];
+    for (std::size_t i = 0; i < count; ++i) {
+      cell_of[i] = static_cast<std::uint32_t>(cells_.index(cells_.cell_of(p[i])));
+      ++start_[cell_of[i] + 1];
+    }
     for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
     points_.resize(count);
+    where_.resize(count);
     std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < count; ++i) points_[fill[cells_.index(cells_.cell_of(p[i]))]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t k = fill[cell_of[i]]++;
+      points_[k] = static_cast<std::uint32_t>(i);
+      where_[k] = p[i];  // positions in cell order: a query reads them in sequence
+    }
   }
+
+  // The points cell by cell (rows of cells in x, then y, then z): neighbours near each other.
+  const std::vector<std::uint32_t>& cell_order() const { return points_; }
 
   // Calls f(i) for every point i with |p_i - c| <= r.
   template <class F>
@@ -323,20 +463,21 @@ class point_grid {
     const glm::ivec3 a = cells_.cell_of(c - glm::vec3(r)), b = cells_.cell_of(c + glm::vec3(r));
     const float r2 = r * r;
     for (int z = a.z; z <= b.z; ++z)
-      for (int y = a.y; y <= b.y; ++y)
-        for (int x = a.x; x <= b.x; ++x) {
-          const std::size_t cell = cells_.index({x, y, z});
-          for (std::uint32_t k = start_[cell]; k < start_[cell + 1]; ++k) {
-            const glm::vec3 d = p_[points_[k]] - c;
-            if (glm::dot(d, d) <= r2) f(points_[k]);
-          }
+      for (int y = a.y; y <= b.y; ++y) {
+        // The cells a.x..b.x of a row are consecutive in CSR order: one run of points.
+        const std::size_t row = cells_.index({a.x, y, z});
+        const std::uint32_t end = start_[row + std::size_t(b.x - a.x) + 1];
+        for (std::uint32_t k = start_[row]; k < end; ++k) {
+          const glm::vec3 d = where_[k] - c;
+          if (glm::dot(d, d) <= r2) f(points_[k]);
         }
+      }
   }
 
  private:
-  const glm::vec3* p_ = nullptr;
   grid_cells cells_;
   std::vector<std::uint32_t> start_, points_;
+  std::vector<glm::vec3> where_;
 };
 
 // Second-order terms (fit_record_hessians in cache.hpp). For record i, in its tangent frame
@@ -368,12 +509,20 @@ class seed_grid {
   // (a superset of the items within r of x); stops at the first that does.
   template <class F>
   bool any_near(const glm::vec3& x, float r, F&& pred) const {
+    // x's own cell first: the item that answers is most often there.
+    const glm::ivec3 own = cells_.cell_of(x);
+    const std::size_t own_index = cells_.index(own);
+    for (std::uint32_t k = head_[own_index]; k != none; k = next_[k])
+      if (pred(position_[k], normal_[k])) return true;
     const glm::ivec3 a = cells_.cell_of(x - glm::vec3(r)), b = cells_.cell_of(x + glm::vec3(r));
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
-        for (int xx = a.x; xx <= b.x; ++xx)
-          for (std::uint32_t k = head_[cells_.index({xx, y, z})]; k != none; k = next_[k])
+        for (int xx = a.x; xx <= b.x; ++xx) {
+          const std::size_t c = cells_.index({xx, y, z});
+          if (c == own_index) continue;
+          for (std::uint32_t k = head_[c]; k != none; k = next_[k])
             if (pred(position_[k], normal_[k])) return true;
+        }
     return false;
   }
 
@@ -382,6 +531,43 @@ class seed_grid {
   grid_cells cells_;
   std::vector<std::uint32_t> head_, next_;
   std::vector<glm::vec3> position_, normal_;
+};
+
+// Record indices at positions, added one at a time into a uniform grid of cells at least `cell`
+// wide over a box (a linked list per cell): which records lie near a point. At most about
+// 4 count + 64 cells.
+class record_cells {
+ public:
+  void reset(const glm::vec3& lo, const glm::vec3& hi, float cell, std::size_t count) {
+    const glm::vec3 ext = glm::max(hi - lo, glm::vec3(0.0f));
+    cells_.fit(lo, ext, std::max({cell, 1e-6f * std::max({ext.x, ext.y, ext.z}), 1e-30f}), count);
+    head_.assign(cells_.size(), none);
+    next_.clear();
+    item_.clear();
+  }
+  void insert(const glm::vec3& x, std::uint32_t item) {
+    const std::size_t c = cells_.index(cells_.cell_of(x));
+    next_.push_back(head_[c]);
+    item_.push_back(item);
+    head_[c] = static_cast<std::uint32_t>(next_.size() - 1);
+  }
+  // Whether pred(item) holds for an item in the cells that the box x +- r touches (a superset of
+  // the items within r of x); stops at the first that does.
+  template <class F>
+  bool any_near(const glm::vec3& x, float r, F&& pred) const {
+    const glm::ivec3 a = cells_.cell_of(x - glm::vec3(r)), b = cells_.cell_of(x + glm::vec3(r));
+    for (int z = a.z; z <= b.z; ++z)
+      for (int y = a.y; y <= b.y; ++y)
+        for (int xx = a.x; xx <= b.x; ++xx)
+          for (std::uint32_t k = head_[cells_.index({xx, y, z})]; k != none; k = next_[k])
+            if (pred(item_[k])) return true;
+    return false;
+  }
+
+ private:
+  static constexpr std::uint32_t none = 0xffffffffu;
+  grid_cells cells_;
+  std::vector<std::uint32_t> head_, next_, item_;
 };
 
 void fit_hessians(std::vector<cache_record>& records, const cache_options& o, int threads) {
@@ -482,10 +668,26 @@ struct coverage_detail {
 // predict for the point, and `own` whether one of them sits at the point itself.
 // `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered),
 // `cone` the same of the HL2 cones, `detail` (optional) what coverage_detail describes.
-float interpolate(const std::vector<cache_record>& records, const record_bvh& bvh, const glm::vec3& x,
+float interpolate(const std::vector<cache_record>& records, const record_lists& lists, std::size_t point, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
                   coverage_detail* detail = nullptr) {
+  // 1. The covering records and their weights, then in record order: the sums below do not
+  // depend on how the grid lists records (the same order as interpolate_records).
+  struct covering {
+    std::uint32_t index;
+    float w;
+  };
+  thread_local std::vector<covering> cover;
+  cover.clear();
+  std::size_t visited = 0;
+  lists.query(point, [&](const record_lists::key& key) {
+    ++visited;
+    const float w = weight_of(key, x, n, o);
+    if (w > 0.0f && !is_behind(key, x, n)) cover.push_back({key.index, w});
+  });
+  std::sort(cover.begin(), cover.end(), [](const covering& p, const covering& q) { return p.index < q.index; });
+  // 2. The weighted sums.
   glm::vec3 sum(0.0f);
   std::array<glm::vec3, 4> sh_sum{};
   hl2_cone cone_sum;
@@ -493,12 +695,9 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   const int order = prediction_order(o);
-  std::size_t visited = 0;
-  bvh.query(x, [&](const record_bvh::key& key) {
-    ++visited;
-    const float w = weight_of(key, x, n, o);
-    if (w <= 0.0f || is_behind(key, x, n)) return;
-    const std::uint32_t i = key.index;
+  for (const covering& c : cover) {
+    const std::uint32_t i = c.index;
+    const float w = c.w;
     const cache_record& r = records[i];
     const glm::vec3 e = extrapolate(r, x, n, order, o.error_threshold);
     sum += w * e;
@@ -506,8 +705,8 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
     if (sh)
       for (std::size_t k = 0; k < 4; ++k) sh_sum[k] += w * r.sh_l1[k];
     if (cone) {
-      const hl2_cone c = rotate_hl2_cone(r.cone, r.normal, cone_sum.reference);
-      for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * c.coefficients[k];
+      const hl2_cone rc = rotate_hl2_cone(r.cone, r.normal, cone_sum.reference);
+      for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * rc.coefficients[k];
     }
     const float l = luminance(e);
     lo = std::min(lo, l);
@@ -522,7 +721,7 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
       detail->first_order = std::max(detail->first_order, std::fabs(l - li) / std::max({li, detail->floor, 1e-30f}));
     }
     at_record = at_record || r.position == x;
-  });
+  }
   out = wsum > 0.0f ? glm::max(sum / wsum, glm::vec3(0.0f)) : glm::vec3(0.0f);
   if (sh)
     for (std::size_t k = 0; k < 4; ++k) (*sh)[k] = wsum > 0.0f ? sh_sum[k] / wsum : glm::vec3(0.0f);
@@ -537,40 +736,23 @@ float interpolate(const std::vector<cache_record>& records, const record_bvh& bv
   return wsum;
 }
 
-// Median distance from a point to its nearest neighbour, over up to 1024 evenly strided points,
-// found with a hash grid (cell = bounding-box diagonal / sqrt(count): points on surfaces).
-float median_spacing(const glm::vec3* p, std::size_t count, float diagonal) {
+// Median distance from a point to its nearest other point (at a distance > 0), over up to 1024
+// evenly strided points, found in the point grid within spheres of radius diagonal / sqrt(count)
+// (about the spacing of points on surfaces), doubled up to four times that; a point with no
+// neighbour that near is left out.
+float median_spacing(const glm::vec3* p, std::size_t count, float diagonal, const point_grid& grid) {
   if (count < 2 || !(diagonal > 0.0f)) return 0.0f;
-  const float cell = diagonal / std::sqrt(float(count));
-  auto key = [&](const glm::vec3& v) {
-    const auto q = glm::ivec3(glm::floor(v / cell));
-    return (std::uint64_t(std::uint32_t(q.x)) * 73856093u) ^ (std::uint64_t(std::uint32_t(q.y)) * 19349663u) ^
-           (std::uint64_t(std::uint32_t(q.z)) * 83492791u);
-  };
-  // The hash grid as (key, point) pairs sorted by key: a cell's points are one equal range.
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> grid(count);
-  for (std::size_t i = 0; i < count; ++i) grid[i] = {key(p[i]), static_cast<std::uint32_t>(i)};
-  std::sort(grid.begin(), grid.end());
+  const float reach = diagonal / std::sqrt(float(count));
   std::vector<float> nn;
   const std::size_t stride = std::max<std::size_t>(1, count / 1024);
   for (std::size_t i = 0; i < count; i += stride) {
     float best = std::numeric_limits<float>::infinity();
-    for (int ring = 1; ring <= 4 && !std::isfinite(best); ring *= 2) {
-      const glm::ivec3 q = glm::ivec3(glm::floor(p[i] / cell));
-      for (int dz = -ring; dz <= ring; ++dz)
-        for (int dy = -ring; dy <= ring; ++dy)
-          for (int dx = -ring; dx <= ring; ++dx) {
-            const glm::vec3 c = (glm::vec3(q + glm::ivec3(dx, dy, dz)) + 0.5f) * cell;
-            const std::uint64_t k = key(c);
-            auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, std::uint32_t(0)));
-            for (; it != grid.end() && it->first == k; ++it) {
-              if (it->second == i) continue;
-              const float d = glm::length(p[it->second] - p[i]);
-              if (d > 0.0f) best = std::min(best, d);
-            }
-          }
-    }
-    if (std::isfinite(best)) nn.push_back(best);
+    for (float r = reach; r <= 4.0f * reach && !(best <= r); r *= 2.0f)
+      grid.for_each_in_sphere(p[i], r, [&](std::uint32_t j) {
+        const float d = glm::length(p[j] - p[i]);
+        if (d > 0.0f) best = std::min(best, d);
+      });
+    if (best <= 4.0f * reach) nn.push_back(best);
   }
   if (nn.empty()) return 0.0f;
   std::nth_element(nn.begin(), nn.begin() + std::ptrdiff_t(nn.size() / 2), nn.end());
@@ -617,6 +799,36 @@ std::uint64_t mix(std::uint64_t x) {
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
   return x ^ (x >> 31);
+}
+
+// The points 0..count-1 sorted by mix(i) (a bijection, so no two keys are equal): the fixed
+// pseudo-random order of placement. A least-significant-digit radix sort, four passes of 16 bits.
+std::vector<std::uint32_t> pseudo_random_order(std::size_t count) {
+  std::vector<std::uint64_t> key(count), key_tmp(count);
+  std::vector<std::uint32_t> idx(count), idx_tmp(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    key[i] = mix(i);
+    idx[i] = static_cast<std::uint32_t>(i);
+  }
+  std::vector<std::uint32_t> start(1u << 16);
+  for (int shift = 0; shift < 64; shift += 16) {
+    std::fill(start.begin(), start.end(), 0u);
+    for (std::uint64_t k : key) ++start[(k >> shift) & 0xffffu];
+    std::uint32_t sum = 0;
+    for (std::uint32_t& c : start) {
+      const std::uint32_t n = c;
+      c = sum;
+      sum += n;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t at = start[(key[i] >> shift) & 0xffffu]++;
+      key_tmp[at] = key[i];
+      idx_tmp[at] = idx[i];
+    }
+    key.swap(key_tmp);
+    idx.swap(idx_tmp);
+  }
+  return idx;
 }
 
 // Per-texel weights of the HL2 cone series (cache.hpp, hl2_cone): w[term][texel] such that
@@ -819,15 +1031,23 @@ std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_recor
 namespace {
 
 // One run of cache_irradiance (cache.hpp), as a chain of named stages over shared state:
-//   derive_radii -> [ coverage_pass -> pick_seeds -> render_seeds -> append_records
+//   derive_radii -> set_up -> [ coverage_pass -> pick_seeds -> render_seeds -> append_records
 //                     -> limit_radii -> mark_dirty ]* -> fit_hessians -> interpolate_all
 //                     -> fill_invalid
 // Per point the state is: covered (a record's weight passes 1/a and the opinions agree), own
 // invalid sample (inside geometry: its own hemicube saw back faces), presumed inside (within the
 // exclusion ball of an invalid sample on the same side of the same surface), contested (presumed
 // inside, but a valid record covers it too: the point may be on either side of a contact, so it
-// gets its own hemicube). A point is open (a seed candidate) when it is none of covered, own
-// invalid or presumed-but-uncontested.
+// gets its own hemicube). A point is open when it is none of covered, own invalid or
+// presumed-but-uncontested; an open point is a seed candidate when its rank in the fixed
+// pseudo-random order is below the round's candidate_count.
+// Where the time goes and why each structure is there: docs/cache.md, "Placement".
+// The structures, each kept up to date as records are added:
+//   lists_      per point, the records whose sphere held it (coverage and final interpolation)
+//   bvh_        the records' boxes, rebuilt each round (limit_radii's neighbours)
+//   members_    per record, the points in its sphere (mark_dirty, when it shrinks)
+//   record_cells_  the records' positions (nearby_records_agree)
+//   models_     per record, its first-order model, compact (limit_radii, nearby_records_agree)
 class placement {
  public:
   placement(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const irradiance_sampler& sampler,
@@ -837,18 +1057,22 @@ class placement {
   cache_result run() {
     const auto start = std::chrono::steady_clock::now();
     threads_ = resolve_thread_count(o_.thread_count);
+    grid_of_points_.build(p_, count_);
     derive_radii();
     set_up();
     for (;;) {
       cache_round_stats round;
       round.spacing = spacing_;
+      candidates_ = candidate_count();
       timed(round.coverage_seconds, [&] { coverage_pass(round); });
-      const std::size_t open = count_open();
+      const std::size_t open = open_candidates();
       round.open_points = open;
-      report(1.0f - float(open) / float(count_));
+      report(1.0f - float(open_list_.size()) / float(count_));
       if (open == 0) {
         stats_.round_details.push_back(round);
-        break;
+        if (candidates_ == count_) break;
+        spacing_ = std::max(finest_, 0.5f * spacing_);  // nothing to place among this round's candidates
+        continue;
       }
       std::vector<std::size_t> seeds;
       timed(round.seed_seconds, [&] { seeds = pick_seeds(); });
@@ -857,13 +1081,8 @@ class placement {
       round.seeds = seeds.size();
       timed(round.update_seconds, [&] {
         const std::size_t first_new = append_records(seeds, samples, round);
-        const bool limited = limit_radii(first_new);
+        limit_radii(first_new);
         mark_dirty(first_new);
-        // Only radii changed since limit_radii built the tree (if it did): refit its boxes.
-        if (limited)
-          bvh_.refit(records_, o_);
-        else
-          bvh_.build(records_, o_, threads_);
       });
       stats_.round_details.push_back(round);
       ++stats_.rounds;
@@ -921,7 +1140,7 @@ class placement {
     diagonal_ = glm::length(hi - lo);
     const float a = o_.error_threshold;
     if (o_.min_radius == 0.0f) {
-      const float spacing = median_spacing(p_, count_, diagonal_);
+      const float spacing = median_spacing(p_, count_, diagonal_, grid_of_points_);
       o_.min_radius = spacing > 0.0f ? spacing / a : std::max(diagonal_, 1e-3f) * 1e-3f;
     }
     if (o_.max_radius == 0.0f) o_.max_radius = 0.2f * diagonal_;
@@ -933,16 +1152,20 @@ class placement {
   }
 
   void set_up() {
-    bvh_.build(records_, o_);
+    lists_.reset(count_, threads_);
+    record_cells_.reset(lo_, hi_, std::max(nearby_reach_, finest_), count_);
     for (auto* v : {&covered_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
     dirty_.assign(count_, 1);  // the first coverage pass tests every point
+    dirty_list_.resize(count_);
+    std::iota(dirty_list_.begin(), dirty_list_.end(), std::uint32_t(0));
+    in_open_list_.assign(count_, 0);
+    open_list_.clear();
     record_at_point_.assign(count_, -1);
-    grid_of_points_.build(p_, count_);
-    std::vector<std::uint64_t> key(count_);
-    for (std::size_t i = 0; i < count_; ++i) key[i] = mix(i);
-    order_.resize(count_);
-    std::iota(order_.begin(), order_.end(), std::size_t(0));
-    std::sort(order_.begin(), order_.end(), [&](std::size_t x, std::size_t y) { return key[x] < key[y]; });
+    cell_rank_.resize(count_);
+    for (std::size_t k = 0; k < count_; ++k) cell_rank_[grid_of_points_.cell_order()[k]] = static_cast<std::uint32_t>(k);
+    order_ = pseudo_random_order(count_);
+    rank_.resize(count_);
+    for (std::size_t k = 0; k < count_; ++k) rank_[order_[k]] = static_cast<std::uint32_t>(k);
     // The coverage tests weigh records with Ward's own weight under ward_continuous too, so that
     // both place the same records (only the final interpolation differs; cache.hpp).
     coverage_options_ = o_;
@@ -953,18 +1176,32 @@ class placement {
 
   bool inside(std::size_t i) const { return own_invalid_[i] || (presumed_[i] && !contested_[i]); }
   bool open(std::size_t i) const { return !covered_[i] && !inside(i); }
-  std::size_t count_open() const {
-    std::size_t open_points = 0;
-    for (std::size_t i = 0; i < count_; ++i) open_points += open(i) ? 1u : 0u;
-    return open_points;
+  float radius_of(std::size_t j) const { return lists_[j].radius; }  // compact: the record's radius
+
+  // The seed candidates of the round: the points of rank below this count. At spacing s only
+  // about candidates_per_spacing^2 points per s x s area of surface take part (the first ones in
+  // the fixed pseudo-random order: a uniform sample); the coverage of the others is checked when a
+  // finer spacing makes them candidates, so a point is not checked again and again while records
+  // are coarse. At the finest spacing, and from spacing candidates_per_spacing x finest on, every
+  // point.
+  std::size_t candidate_count() const {
+    if (!(spacing_ > finest_)) return count_;
+    const double share = double(candidates_per_spacing) * double(finest_) / double(spacing_);
+    return share >= 1.0 ? count_ : std::max<std::size_t>(1, std::size_t(double(count_) * share * share));
+  }
+  // How many open points are candidates (open_list_ is in rank order: a prefix).
+  std::size_t open_candidates() const {
+    return std::size_t(std::lower_bound(open_list_.begin(), open_list_.end(), candidates_,
+                                        [&](std::uint32_t i, std::size_t k) { return rank_[i] < k; }) - open_list_.begin());
   }
 
-  // 1. Coverage of every point whose answer can have changed (parallel, read-only on the
-  // records): the dirty points (all of them in the first pass; then those in the reach of a
-  // record added or shrunk in the last round, within nearby_opinion's reach of a new record, or
-  // newly presumed inside). Every other point, open or covered, sees the same records with the
+  // 1. Coverage of every candidate point whose answer can have changed (parallel, read-only on
+  // the records): the dirty points (all of them at first; then those in the reach of a record
+  // added or shrunk since they were last checked, within nearby_opinion's reach of a new record,
+  // or newly presumed inside). Every other point, open or covered, sees the same records with the
   // same radii as when it was last checked, and its opinions come from the same records, so its
-  // answer stands. The dark floor of the tests
+  // answer stands. Dirty points that are not yet candidates stay dirty until they are (at the
+  // finest spacing every point is). The dark floor of the tests
   // (floor_e_: 5% of the mean irradiance of the first round's records, a uniform sample of the
   // points) is fixed once set, so no answer depends on records far away.
   void coverage_pass(cache_round_stats& round) {
@@ -979,10 +1216,12 @@ class placement {
       std::array<std::size_t, cache_stats::histogram_buckets> histogram{};
     };
     std::vector<tally> tallies(static_cast<std::size_t>(threads_));
-    parallel_for(count_, threads_, 4096, [&](int worker, std::size_t b, std::size_t e) {
+    in_cell_order(dirty_list_, dirty_);  // neighbouring points one after another: the same records
+    parallel_for(dirty_list_.size(), threads_, 1024, [&](int worker, std::size_t b, std::size_t e) {
       tally& t = tallies[std::size_t(worker)];
-      for (std::size_t i = b; i < e; ++i) {
-        if (own_invalid_[i] || !dirty_[i]) continue;
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t i = dirty_list_[k];
+        if (own_invalid_[i] || rank_[i] >= candidates_) continue;
         std::size_t visited = 0;
         check_point(i, visited);
         ++t.checked;
@@ -997,7 +1236,58 @@ class placement {
       round.max_records_visited = std::max(round.max_records_visited, t.max_visited);
       for (std::size_t k = 0; k < t.histogram.size(); ++k) stats_.records_visited_histogram[k] += t.histogram[k];
     }
-    std::fill(dirty_.begin(), dirty_.end(), std::uint8_t(0));
+    update_open_list();
+  }
+
+  // The open points in the fixed order (open_list_): a point's answer changes only in a coverage
+  // pass that checks it, or when it becomes inside (then it is dropped here), so the checked
+  // points that are open join the list and the list drops what is no longer open.
+  void update_open_list() {
+    std::size_t deferred = 0;
+    for (std::uint32_t i : dirty_list_) {
+      if (rank_[i] >= candidates_) {  // not checked: stays dirty
+        dirty_list_[deferred++] = i;
+        continue;
+      }
+      dirty_[i] = 0;
+      if (open(i) && !in_open_list_[i]) {
+        in_open_list_[i] = 1;
+        open_list_.push_back(i);
+      }
+    }
+    dirty_list_.resize(deferred);
+    std::size_t kept = 0;
+    for (std::uint32_t i : open_list_) {
+      if (open(i))
+        open_list_[kept++] = i;
+      else
+        in_open_list_[i] = 0;
+    }
+    open_list_.resize(kept);
+    if (open_list_.size() > count_ / 16) {  // a long list: the order itself, filtered
+      open_list_.clear();
+      for (std::uint32_t i : order_)
+        if (in_open_list_[i]) open_list_.push_back(i);
+    } else {  // a short one: sorted by rank
+      for (std::uint32_t& i : open_list_) i = rank_[i];
+      std::sort(open_list_.begin(), open_list_.end());
+      for (std::uint32_t& k : open_list_) k = order_[k];
+    }
+  }
+
+  // Sorts `list`, the indices of the points whose flag is set, in the point grid's cell order (so
+  // that points one after another query the same records): a long list by a scan of the flags in
+  // that order, a short one by sorting.
+  void in_cell_order(std::vector<std::uint32_t>& list, const std::vector<std::uint8_t>& flag) const {
+    if (list.size() > count_ / 16) {
+      list.clear();
+      for (std::uint32_t i : grid_of_points_.cell_order())
+        if (flag[i]) list.push_back(i);
+    } else {
+      for (std::uint32_t& i : list) i = cell_rank_[i];
+      std::sort(list.begin(), list.end());
+      for (std::uint32_t& k : list) k = grid_of_points_.cell_order()[k];
+    }
   }
 
   // The coverage test of one point (coverage_pass); `visited` counts the records the query saw.
@@ -1008,7 +1298,14 @@ class placement {
     bool own = false;
     coverage_detail detail;
     detail.floor = floor_e_;
-    const float w = interpolate(records_, bvh_, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
+    // Records whose sphere shrank past the point never cover it again (radii only shrink): out
+    // of its list (the margin is coverage_weight's).
+    lists_.compact(i, [&](const record_lists::key& key) {
+      const glm::vec3 dx = p_[i] - key.position;
+      const float reach = o_.error_threshold * key.radius;
+      return glm::dot(dx, dx) <= 1.0002f * reach * reach;
+    });
+    const float w = interpolate(records_, lists_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
     // Presumed inside: a valid record that covers the point contests the presumption (the point
@@ -1045,16 +1342,15 @@ class placement {
     const glm::vec3 x = p_[i], nx = n_[i];
     const float la = std::max(detail.last_prediction, 0.0f);
     const float tolerance = o_.error_threshold * std::max(la, floor_e_);
-    bool ok = true;
-    grid_of_points_.for_each_in_sphere(x, nearby_reach_, [&](std::uint32_t j) {
-      const std::int32_t k = record_at_point_[j];
-      if (!ok || k < 0 || std::uint32_t(k) == detail.last) return;
-      const cache_record& rb = records_[std::size_t(k)];
-      if (glm::dot(rb.normal, nx) <= 0.9f || record_is_behind(rb, x, nx)) return;
-      const float lb = luminance(glm::max(extrapolate(rb, x, nx, o_.use_gradients ? 1 : 0), glm::vec3(0.0f)));
-      if (std::fabs(lb - la) > tolerance) ok = false;
+    const float r2 = nearby_reach_ * nearby_reach_;
+    return !record_cells_.any_near(x, nearby_reach_, [&](std::uint32_t k) {
+      const linear_model& rb = models_[k];
+      const glm::vec3 d = rb.position - x;
+      if (k == detail.last || glm::dot(d, d) > r2) return false;
+      if (glm::dot(rb.normal, nx) <= 0.9f || is_behind(rb, x, nx)) return false;
+      const float lb = luminance(glm::max(o_.use_gradients ? rb.predict(x, nx) : rb.irradiance, glm::vec3(0.0f)));
+      return std::fabs(lb - la) > tolerance;
     });
-    return ok;
   }
 
   // 2. Seeds: open points in the fixed order, at least `spacing` from this round's earlier seeds
@@ -1065,25 +1361,22 @@ class placement {
     std::vector<std::size_t> seeds;
     const bool finest = !(spacing_ > finest_);
     if (finest) {
-      for (std::size_t i : order_)
-        if (open(i)) seeds.push_back(i);
+      seeds.assign(open_list_.begin(), open_list_.begin() + std::ptrdiff_t(open_candidates()));
       return seeds;
     }
-    seed_cells_.reset(lo_, hi_, spacing_, count_);
+    seed_cells_.reset(lo_, hi_, spacing_, open_list_.size());
     const float r2 = spacing_ * spacing_;
-    // The points are visited in a pseudo-random order: their open flags go into one small array
-    // first, and the positions and normals a few steps ahead are prefetched.
-    is_open_.resize(count_);
-    for (std::size_t i = 0; i < count_; ++i) is_open_[i] = open(i) ? 1 : 0;
+    // The points are visited in a pseudo-random order: the positions and normals a few steps
+    // ahead are prefetched.
     constexpr std::size_t ahead = 16;
-    for (std::size_t k = 0; k < count_; ++k) {
-      if (k + ahead < count_) {
-        const std::size_t q = order_[k + ahead];
+    const std::size_t open_count = open_candidates();
+    for (std::size_t k = 0; k < open_count; ++k) {
+      if (k + ahead < open_count) {
+        const std::size_t q = open_list_[k + ahead];
         __builtin_prefetch(&p_[q]);
         __builtin_prefetch(&n_[q]);
       }
-      const std::size_t i = order_[k];
-      if (!is_open_[i]) continue;
+      const std::size_t i = open_list_[k];
       const glm::vec3 x = p_[i], nx = n_[i];
       const bool blocked = seed_cells_.any_near(x, spacing_, [&](const glm::vec3& c, const glm::vec3& nc) {
         const glm::vec3 d = x - c;
@@ -1120,13 +1413,24 @@ class placement {
 
   // 4. New records in seed order with their own radius limits (split sphere, gradient limit,
   // clamp to [min_radius, max_radius]); invalid samples mark their point and, within their
-  // exclusion ball, the points on the same side of the same surface (presume_inside). Returns
+  // exclusion ball, the points on the same side of the same surface (presumed_by). Returns
   // the index of the first new record.
   std::size_t append_records(const std::vector<std::size_t>& seeds, const std::vector<cache_sample>& samples,
                              cache_round_stats& round) {
     const std::size_t first_new = records_.size();
     old_radius_.resize(first_new);
-    for (std::size_t j = 0; j < first_new; ++j) old_radius_[j] = records_[j].radius;
+    for (std::size_t j = 0; j < first_new; ++j) old_radius_[j] = radius_of(j);
+    // The records, and the points each invalid sample presumes inside, in parallel; then
+    // appended in seed order.
+    std::vector<cache_record> made(seeds.size());
+    std::vector<std::vector<std::uint32_t>> presumed(seeds.size());
+    parallel_for(seeds.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k)
+        if (samples[k].backface_fraction > o_.invalid_backface_fraction)
+          presumed[k] = presumed_by(seeds[k], samples[k].min_distance);
+        else
+          made[k] = make_record(seeds[k], samples[k]);
+    });
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
       const cache_sample& s = samples[k];
@@ -1134,10 +1438,20 @@ class placement {
         ++stats_.invalid_samples;
         ++round.invalid_samples;
         own_invalid_[i] = 1;
-        presume_inside(i, s.min_distance);
+        for (std::uint32_t j : presumed[k]) {
+          presumed_[j] = 1;
+          if (!dirty_[j]) {
+            dirty_[j] = 1;
+            dirty_list_.push_back(j);
+          }
+        }
         continue;
       }
-      records_.push_back(make_record(i, s));
+      records_.push_back(made[k]);
+      models_.push_back(linear_model(records_.back()));
+      record_cells_.insert(records_.back().position, static_cast<std::uint32_t>(records_.size() - 1));
+      lists_.add(records_.back());
+      record_point_.push_back(static_cast<std::uint32_t>(i));
       record_at_point_[i] = static_cast<std::int32_t>(records_.size() - 1);
     }
     round.records_added = records_.size() - first_new;
@@ -1175,105 +1489,173 @@ class placement {
   // (a wall meeting the floor, a slab's underside inside another slab) are never presumed: the
   // ball says nothing behind the sample. A valid record covering a presumed point contests it
   // (check_point).
-  void presume_inside(std::size_t i, float min_distance) {
-    if (!std::isfinite(min_distance) || !(min_distance > 0.0f)) return;
+  std::vector<std::uint32_t> presumed_by(std::size_t i, float min_distance) const {
+    std::vector<std::uint32_t> out;
+    if (!std::isfinite(min_distance) || !(min_distance > 0.0f)) return out;
     const float ball = 0.9f * min_distance;
     const glm::vec3 c = p_[i], nc = n_[i];
     grid_of_points_.for_each_in_sphere(c, ball, [&](std::uint32_t j) {
       if (presumed_[j] || glm::dot(n_[j], nc) <= 0.9f || glm::dot(p_[j] - c, nc) < -0.01f * ball) return;
-      presumed_[j] = 1;
-      dirty_[j] = 1;
+      out.push_back(j);
     });
+    return out;
   }
 
+
   // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
-  // over pairs (new record, any record) within reach (deterministic). Returns whether it built
-  // the record tree (then only radii changed since, and a refit suffices).
-  bool limit_radii(std::size_t first_new) {
-    if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return false;
+  // over pairs (new record, any record) within reach (deterministic); then the grid's keys take
+  // the new radii.
+  void limit_radii(std::size_t first_new) {
+    if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return;
     const float a = o_.error_threshold;
-    bvh_.build(records_, o_, threads_);
-    // The pairs of each new record i: records j whose coverage box holds x_i, with their distance
-    // and whether their first-order predictions of each other disagree by more than a (neither
-    // depends on the radii, so both are found first, in parallel; the tree is not rebuilt during
-    // the sequential pass below).
+    // The pairs of each new record i: records j whose coverage sphere (a R_j, the radii before
+    // this stage) holds x_i, in record order, with their distance and whether their first-order
+    // predictions of each other disagree by more than a (neither depends on the radii, so both
+    // are found first, in parallel).
     struct pair {
       std::uint32_t j;
       bool disagree;
       float d;
     };
     const bool shrink = o_.shrink_disagreeing;
+    bvh_.build(records_, o_, threads_);
     std::vector<std::vector<pair>> candidates(records_.size() - first_new);
+    // Queried in the point grid's cell order: records one after another visit the same nodes.
+    std::vector<std::uint32_t> by_cell(candidates.size());
+    std::iota(by_cell.begin(), by_cell.end(), 0u);
+    std::sort(by_cell.begin(), by_cell.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return cell_rank_[record_point_[first_new + x]] < cell_rank_[record_point_[first_new + y]];
+    });
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        std::vector<pair>& near = candidates[k];
+      std::vector<std::uint32_t> js;
+      for (std::size_t kk = b; kk < e; ++kk) {
+        const std::size_t k = by_cell[kk];
         const std::size_t i = first_new + k;
-        const cache_record& ri = records_[i];
-        bvh_.query(ri.position, [&](const record_bvh::key& key) {
-          if (std::size_t(key.index) != i)
-            near.push_back({key.index, shrink && glm::dot(ri.normal, key.normal) > 0.9f, glm::length(ri.position - key.position)});
+        // The neighbours' indices, sorted (a record lies in one leaf: no index twice), then
+        // their distances and disagreements from the compact keys and models.
+        js.clear();
+        bvh_.query(records_[i].position, [&](const record_bvh::key& key) {
+          if (std::size_t(key.index) != i) js.push_back(key.index);
         });
-        std::sort(near.begin(), near.end(), [](const pair& x, const pair& y) { return x.j < y.j; });
-        for (pair& q : near) {
-          // (disagree holds "similar normals" until here.)
-          if (q.disagree && q.d > 0.0f) {
-            const cache_record& rj = records_[q.j];
+        std::sort(js.begin(), js.end());
+        std::vector<pair>& near = candidates[k];
+        near.resize(js.size());
+        const linear_model& mi = models_[i];
+        for (std::size_t q = 0; q < js.size(); ++q) {
+          const linear_model& mj = models_[js[q]];
+          const float d = glm::length(mi.position - mj.position);
+          bool disagree = false;
+          // With neighbour clamping, a disagreement cannot change anything while R_i + d stays
+          // within the gap radius 0.4 d / a (then the clamp R_j <= R_i + d is the stronger limit
+          // on R_j, and R_i is already inside the gap); R_i only shrinks in the pass below, so
+          // that holds there too. (1% margin for float rounding.)
+          const bool moot = o_.neighbour_clamp && radius_of(i) + d <= 0.99f * (0.4f * d / a);
+          if (shrink && !moot && glm::dot(mi.normal, mj.normal) > 0.9f && d > 0.0f) {
             // Each record's first-order prediction of the other's irradiance (luminance).
-            const float ei = luminance(ri.irradiance), ej = luminance(rj.irradiance);
-            const float pij = luminance(extrapolate(ri, rj.position, rj.normal, 1));
-            const float pji = luminance(extrapolate(rj, ri.position, ri.normal, 1));
+            const float ei = luminance(mi.irradiance), ej = luminance(mj.irradiance);
+            const float pij = luminance(mi.predict(mj.position, mj.normal));
+            const float pji = luminance(mj.predict(mi.position, mi.normal));
             const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
-            q.disagree = err > a;
-          } else {
-            q.disagree = false;
+            disagree = err > a;
           }
+          near[q] = {js[q], disagree, d};
         }
       }
     });
+    // The sequential pass works on a compact copy of the radii.
+    radius_.resize(records_.size());
+    for (std::size_t j = 0; j < records_.size(); ++j) radius_[j] = records_[j].radius;
+    // At the finest spacing, new records do not shrink older ones (only each other): the points
+    // those cover stay covered, instead of opening again round after round.
+    const bool keep_older = !(spacing_ > finest_);
     for (std::size_t i = first_new; i < records_.size(); ++i) {
+      float& ri = radius_[i];
       for (const pair& q : candidates[i - first_new]) {
-        cache_record& ri = records_[i];
-        cache_record& rj = records_[q.j];
+        float unchanged = radius_[q.j];
+        float& rj = keep_older && q.j < first_new ? unchanged : radius_[q.j];
         const float d = q.d;
         if (o_.neighbour_clamp) {
-          ri.radius = std::max(o_.min_radius, std::min(ri.radius, rj.radius + d));
-          rj.radius = std::max(o_.min_radius, std::min(rj.radius, ri.radius + d));
+          ri = std::max(o_.min_radius, std::min(ri, rj + d));
+          rj = std::max(o_.min_radius, std::min(rj, ri + d));
         }
         if (q.disagree) {
           // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
           const float r_gap = std::max(o_.min_radius, 0.4f * d / a);
-          ri.radius = std::min(ri.radius, r_gap);
-          rj.radius = std::min(rj.radius, r_gap);
+          ri = std::min(ri, r_gap);
+          rj = std::min(rj, r_gap);
         }
       }
     }
-    return true;
+    for (std::size_t j = 0; j < records_.size(); ++j) records_[j].radius = radius_[j];
+    for (std::size_t j = 0; j < records_.size(); ++j)
+      if (records_[j].radius != lists_[j].radius) lists_.set_radius(j, records_[j].radius);
   }
 
-  // 6. Points whose coverage this round's records can have changed (a shrunk record's old
-  // sphere holds its new one) are re-checked in the next coverage pass.
+  // 6. Points whose coverage this round's records can have changed (in a new record's sphere, or
+  // in the old sphere of a shrunk one, which holds its new one, or within nearby_opinion's reach
+  // of a new record) are re-checked in the next coverage pass; the new records join the lists of
+  // the points their spheres hold (after the limits: their final radii).
   void mark_dirty(std::size_t first_new) {
     const float a = o_.error_threshold;
-    // Worker 0 marks dirty_ itself, the others their own arrays, OR-ed in after (only ones are
-    // written, so the result does not depend on which worker marked what).
-    dirty_extra_.resize(std::size_t(std::max(threads_ - 1, 0)));
-    for (std::vector<std::uint8_t>& v : dirty_extra_) v.assign(count_, 0);
+    // Each worker marks its own flags and lists what it marked; the marks are merged into
+    // dirty_list_ after (which points are dirty does not depend on which worker marked what).
+    // A new record's points (those in its sphere) are found in the point grid and kept with the
+    // record (members_), so that when it shrinks its old sphere's points are at hand.
+    marks_.resize(std::size_t(threads_));
+    for (worker_marks& m : marks_) m.flag.resize(count_, 0);
+    members_.resize(records_.size());
     parallel_for(records_.size(), threads_, 256, [&](int worker, std::size_t b, std::size_t e) {
-      std::uint8_t* dirty = worker == 0 ? dirty_.data() : dirty_extra_[std::size_t(worker - 1)].data();
+      worker_marks& m = marks_[std::size_t(worker)];
+      const auto mark = [&](std::uint32_t i) {
+        if (!m.flag[i]) {
+          m.flag[i] = 1;
+          m.list.push_back(i);
+        }
+      };
       for (std::size_t j = b; j < e; ++j) {
-        const bool added = j >= first_new;
-        if (!added && records_[j].radius == old_radius_[j]) continue;
-        const float r = coverage_radius(records_[j], o_);
-        const float reach = added ? r : std::max(r, a * old_radius_[j]);
+        const float radius = radius_of(j);
+        const glm::vec3 x = lists_[j].position;
         // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
-        grid_of_points_.for_each_in_sphere(records_[j].position, reach * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
-        // nearby_opinion consults the records placed within nearby_reach of a point.
-        if (added && o_.nearby_opinion > 0.0f)
-          grid_of_points_.for_each_in_sphere(records_[j].position, nearby_reach_ * 1.0001f, [&](std::uint32_t i) { dirty[i] = 1; });
+        const float reach = a * radius * 1.0001f, reach2 = reach * reach;
+        std::vector<std::uint32_t>& members = members_[j];
+        if (j >= first_new) {
+          const float marked = o_.nearby_opinion > 0.0f ? std::max(reach, nearby_reach_ * 1.0001f) : reach;
+          grid_of_points_.for_each_in_sphere(x, marked, [&](std::uint32_t i) {
+            mark(i);
+            const glm::vec3 d = p_[i] - x;
+            if (glm::dot(d, d) <= reach2) members.push_back(i);
+          });
+        } else if (radius != old_radius_[j]) {
+          // Every point of the old sphere is marked; those of the new one stay members.
+          std::size_t kept = 0;
+          for (std::uint32_t i : members) {
+            mark(i);
+            const glm::vec3 d = p_[i] - x;
+            if (glm::dot(d, d) <= reach2) members[kept++] = i;
+          }
+          members.resize(kept);
+        }
       }
     });
-    for (const std::vector<std::uint8_t>& v : dirty_extra_)
-      for (std::size_t i = 0; i < count_; ++i) dirty_[i] |= v[i];
+    for (worker_marks& m : marks_) {
+      for (std::uint32_t i : m.list) {
+        m.flag[i] = 0;
+        if (!dirty_[i]) {
+          dirty_[i] = 1;
+          dirty_list_.push_back(i);
+        }
+      }
+      m.list.clear();
+    }
+    // The new records join the lists of their points, each owner's points in parallel.
+    parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t owner = b; owner < e; ++owner) {
+        for (std::size_t j = first_new; j < records_.size(); ++j)
+          for (std::uint32_t i : members_[j])
+            if (lists_.owner(i) == owner) lists_.append(i, static_cast<std::uint32_t>(j));
+        lists_.lay_out(owner, grid_of_points_.cell_order());
+      }
+    });
   }
 
   // 7. Final interpolation (parallel) of every point that is not inside geometry.
@@ -1289,7 +1671,7 @@ class placement {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
-        if (!inside(i) && interpolate(records_, bvh_, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
+        if (!inside(i) && interpolate(records_, lists_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
                                       o_.directional ? &cone : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
@@ -1389,16 +1771,31 @@ class placement {
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;  // records seeing more back faces than this stand at a contact (check_point)
   std::vector<cache_record> records_;
-  record_bvh bvh_;
+  record_lists lists_;
+  record_bvh bvh_;  // limit_radii: the records' boxes
+  std::vector<float> radius_;  // limit_radii: the radii during its sequential pass
+  std::vector<linear_model> models_;
+  record_cells record_cells_;  // the records' positions (nearby_records_agree)  // per record: its first-order model, compact (limit_radii)
+  std::vector<std::uint32_t> record_point_;  // per record: the point it was placed at
   point_grid grid_of_points_;
   std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
   seed_grid seed_cells_;  // pick_seeds: the round's seeds so far
-  std::vector<std::uint8_t> is_open_;  // pick_seeds: open(i) of every point
   glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
   std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
-  std::vector<std::size_t> order_;             // the fixed pseudo-random order of the points
+  std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it
+  std::vector<std::uint32_t> rank_;            // per point: its place in the fixed pseudo-random order
+  std::vector<std::uint32_t> order_;           // the points in that order (order_[rank_[i]] = i)
+  std::vector<std::uint32_t> cell_rank_;       // per point: its place in grid_of_points_.cell_order()
+  std::vector<std::uint32_t> dirty_list_;      // the points with dirty_ set: the next coverage pass's
+  std::vector<std::uint32_t> open_list_;       // the open points, by rank_ (update_open_list)
+  std::vector<std::uint8_t> in_open_list_;
   std::vector<float> old_radius_;
-  std::vector<std::vector<std::uint8_t>> dirty_extra_;  // mark_dirty: workers 1, 2, ...' marks
+  struct worker_marks {
+    std::vector<std::uint8_t> flag;
+    std::vector<std::uint32_t> list;
+  };
+  std::vector<std::vector<std::uint32_t>> members_;  // per record: the points in its sphere (mark_dirty)
+  std::vector<worker_marks> marks_;  // mark_dirty: each worker's marks
   cache_stats stats_;
 };
 

@@ -24,7 +24,12 @@
 // It runs in rounds. Each round finds the points no record covers, picks among them, in a fixed
 // pseudo-random order, seeds at least `spacing` apart (spacing halves every round, from
 // a x max_radius down to a x min_radius), renders the seeds' hemicubes in parallel, and appends
-// the new records in seed order. A point counts as covered when a record's weight passes 1/a
+// the new records in seed order. While the spacing s is coarse only a uniform sample of the
+// points, about 9 per s x s of surface (the first ones in that order), are candidates; the others
+// are tested when a finer spacing makes them candidates (at the finest spacing every point is).
+// At the finest spacing new records do not shrink older ones (neighbour clamping and the
+// disagreement shrink then apply to the new records only, and among them). Interpolation sums the
+// covering records in record order, as interpolate_records does. A point counts as covered when a record's weight passes 1/a
 // and (refine_disagreement) the covering records' predictions agree within a, and
 // (second_opinion) a point covered by one record only is not extrapolated far from it, nor
 // (sole_record_reach) from the rim of its reach, and (nearby_opinion) records near such a point
@@ -212,9 +217,11 @@ struct cache_options {
 struct cache_round_stats {
   float spacing = 0.0f;                  ///< the round's seed spacing (scene units)
   std::size_t points_checked = 0;        ///< points whose coverage the round's coverage pass tested
-  std::size_t records_visited = 0;       ///< records the tested points' queries visited, summed
-  std::size_t max_records_visited = 0;   ///< the most records one query visited
-  std::size_t open_points = 0;           ///< points left open after the coverage pass
+  /// Records the tested points' queries weighed (those whose coverage sphere held the point
+  /// when they were added: the covering ones and those that shrank since), summed.
+  std::size_t records_visited = 0;
+  std::size_t max_records_visited = 0;   ///< the most records one query weighed
+  std::size_t open_points = 0;           ///< seed candidates left open after the coverage pass
   std::size_t seeds = 0;                 ///< hemicubes rendered in the round
   std::size_t records_added = 0;         ///< of them valid (records)
   std::size_t invalid_samples = 0;       ///< of them inside geometry
@@ -236,7 +243,7 @@ struct cache_stats {
   /// record updates, automatic radii, second-order fits): the three add up to `seconds`.
   double placement_seconds = 0.0, render_seconds = 0.0, interpolation_seconds = 0.0;
   float min_radius = 0.0f, max_radius = 0.0f;  ///< the radii used (after automatic defaults)
-  std::vector<cache_round_stats> round_details;  ///< per round, including the last (coverage only)
+  std::vector<cache_round_stats> round_details;  ///< per round, including those that rendered nothing (coverage only)
   /// Records visited per coverage query, over all rounds: bucket 0 counts queries that visited
   /// none, bucket k >= 1 those that visited [2^(k-1), 2^k) records, the last bucket everything above.
   static constexpr std::size_t histogram_buckets = 16;
