@@ -1,6 +1,6 @@
 // End-to-end bake time and accuracy of the built-in and reference scenes.
 //   usage: sweep_bake out.csv [sizes...]   (default sizes 256 512)
-//          sweep_bake --target out.csv [runs] [--scenes a,b] [--truth-cache DIR]
+//          sweep_bake --target out.csv [runs] [--scenes a,b] [--truth-cache DIR] [--bake-only]
 // Sweep: the hexagon room (tessellation 2, 496 triangles, lit by the sky through its window)
 // and the Cornell box (32 triangles), chart UVs from generate_lightmap_uvs (2 texels padding).
 // For each lightmap size, bounce count (1, 3) and thread count (1, 2): a bake with N = 64 and
@@ -25,7 +25,9 @@
 // every 4th of the valid texels within 8 texels (lightmap distance) of a texel the per-texel bake
 // calls invalid (inside geometry), where parts meet and contact shadows lie. wrongly_invalid counts
 // the per-texel-valid texels the cached bake calls invalid. --truth-cache DIR keeps the converged
-// values between runs (binary files named by scene, class, size and count).
+// values between runs (binary files named by scene, class, size and count). --bake-only: the cached
+// bakes alone (no SH + HL2 runs, no reference, empty error columns), for paired timing rounds of
+// two builds (benchmarks/paired_bake.sh).
 #include "hemilight/bake.hpp"
 #include "hemilight/cache.hpp"
 #include "hemilight/parallel.hpp"
@@ -204,7 +206,7 @@ struct target_scene {
   scene_mesh mesh;
 };
 
-int target(const char* path, int runs, const std::vector<std::string>& only, const std::string& truth_dir) {
+int target(const char* path, int runs, const std::vector<std::string>& only, const std::string& truth_dir, bool bake_only) {
   std::FILE* f = std::fopen(path, "w");
   std::string conv_path = path;
   const std::size_t dot = conv_path.rfind(".csv");
@@ -234,7 +236,7 @@ int target(const char* path, int runs, const std::vector<std::string>& only, con
     std::printf("%s: %zu triangles\n", ts.name.c_str(), ts.mesh.triangle_count());
     std::vector<bake_result> results;
     // The directional runs only for the hexagon room (the figure the docs have tracked).
-    const int directional_modes = ts.name == "hexagon_room_t3" ? 2 : 1;
+    const int directional_modes = ts.name == "hexagon_room_t3" && !bake_only ? 2 : 1;
     for (int directional = 0; directional < directional_modes; ++directional)
       for (int run = 0; run < runs; ++run) {
         o.output_sh_l1 = o.output_hl2 = directional == 1;
@@ -246,6 +248,17 @@ int target(const char* path, int runs, const std::vector<std::string>& only, con
         std::fflush(stdout);
         results.push_back(std::move(r));
       }
+    if (bake_only) {  // the cached bakes alone (paired timing rounds): no reference, no error columns
+      for (std::size_t i = 0; i < results.size(); ++i) {
+        const bake_result& r = results[i];
+        const cache_stats& cs = r.stats.passes.front();
+        std::fprintf(f, "%zu,%s,%zu,%d,0,%.4f,%.4f,%.4f,%zu,%zu,%.4f,%zu,,\n", i, ts.name.c_str(), ts.mesh.triangle_count(), size,
+                     r.stats.seconds, cs.placement_seconds, cs.render_seconds, r.stats.sampled_texels, r.stats.hemicubes,
+                     double(r.stats.hemicubes) / double(r.stats.sampled_texels), r.stats.invalid_texels);
+      }
+      std::fflush(f);
+      continue;
+    }
     o.output_sh_l1 = o.output_hl2 = false;
     o.use_cache = false;
     const bake_result ref = bake_lightmap(in, o);
@@ -282,6 +295,7 @@ int main(int argc, char** argv) {
     int runs = 3;
     std::vector<std::string> only;
     std::string truth_dir;
+    bool bake_only = false;
     for (int i = 3; i < argc; ++i) {
       const std::string a = argv[i];
       if (a == "--scenes" && i + 1 < argc) {
@@ -289,11 +303,13 @@ int main(int argc, char** argv) {
         for (std::string item; std::getline(list, item, ',');) only.push_back(item);
       } else if (a == "--truth-cache" && i + 1 < argc) {
         truth_dir = argv[++i];
+      } else if (a == "--bake-only") {
+        bake_only = true;
       } else {
         runs = std::max(1, std::atoi(argv[i]));
       }
     }
-    return target(argv[2], runs, only, truth_dir);
+    return target(argv[2], runs, only, truth_dir, bake_only);
   }
   if (argc < 2) {
     std::fprintf(stderr, "usage: sweep_bake out.csv [sizes...]\n");

@@ -1527,38 +1527,34 @@ class placement {
       return cell_rank_[record_point_[first_new + x]] < cell_rank_[record_point_[first_new + y]];
     });
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
-      std::vector<std::uint32_t> js;
       for (std::size_t kk = b; kk < e; ++kk) {
         const std::size_t k = by_cell[kk];
         const std::size_t i = first_new + k;
-        // The neighbours' indices, sorted (a record lies in one leaf: no index twice), then
-        // their distances and disagreements from the compact keys and models.
-        js.clear();
-        bvh_.query(records_[i].position, [&](const record_bvh::key& key) {
-          if (std::size_t(key.index) != i) js.push_back(key.index);
-        });
-        std::sort(js.begin(), js.end());
-        std::vector<pair>& near = candidates[k];
-        near.resize(js.size());
         const linear_model& mi = models_[i];
-        for (std::size_t q = 0; q < js.size(); ++q) {
-          const linear_model& mj = models_[js[q]];
-          const float d = glm::length(mi.position - mj.position);
-          bool disagree = false;
-          // With neighbour clamping, a disagreement cannot change anything while R_i + d stays
-          // within the gap radius 0.4 d / a (then the clamp R_j <= R_i + d is the stronger limit
-          // on R_j, and R_i is already inside the gap); R_i only shrinks in the pass below, so
-          // that holds there too. (1% margin for float rounding.)
-          const bool moot = o_.neighbour_clamp && radius_of(i) + d <= 0.99f * (0.4f * d / a);
-          if (shrink && !moot && glm::dot(mi.normal, mj.normal) > 0.9f && d > 0.0f) {
-            // Each record's first-order prediction of the other's irradiance (luminance).
-            const float ei = luminance(mi.irradiance), ej = luminance(mj.irradiance);
-            const float pij = luminance(mi.predict(mj.position, mj.normal));
-            const float pji = luminance(mj.predict(mi.position, mi.normal));
-            const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
-            disagree = err > a;
-          }
-          near[q] = {js[q], disagree, d};
+        const float ri = radius_of(i);
+        // The neighbours from the tree's keys (sorted after: a record lies in one leaf, so no
+        // index twice), with their distance and whether a disagreement could change anything:
+        // with neighbour clamping not while R_i + d stays within the gap radius 0.4 d / a (then
+        // the clamp R_j <= R_i + d is the stronger limit on R_j, and R_i is already inside the
+        // gap); R_i only shrinks in the pass below, so that holds there too (1% margin for float
+        // rounding). Only those pairs read the two records' models.
+        std::vector<pair>& near = candidates[k];
+        bvh_.query(mi.position, [&](const record_bvh::key& key) {
+          if (std::size_t(key.index) == i) return;
+          const float d = glm::length(mi.position - key.position);
+          const bool moot = o_.neighbour_clamp && ri + d <= 0.99f * (0.4f * d / a);
+          near.push_back({key.index, shrink && !moot && d > 0.0f && glm::dot(mi.normal, key.normal) > 0.9f, d});
+        });
+        std::sort(near.begin(), near.end(), [](const pair& x, const pair& y) { return x.j < y.j; });
+        for (pair& q : near) {
+          if (!q.disagree) continue;  // (holds "to be tested" until here)
+          const linear_model& mj = models_[q.j];
+          // Each record's first-order prediction of the other's irradiance (luminance).
+          const float ei = luminance(mi.irradiance), ej = luminance(mj.irradiance);
+          const float pij = luminance(mi.predict(mj.position, mj.normal));
+          const float pji = luminance(mj.predict(mi.position, mi.normal));
+          const float err = std::max(std::fabs(pij - ej) / std::max(ej, 1e-20f), std::fabs(pji - ei) / std::max(ei, 1e-20f));
+          q.disagree = err > a;
         }
       }
     });
