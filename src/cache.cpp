@@ -28,7 +28,12 @@ constexpr float max_weight = 1e12f;
 // placement::candidate_count: seed candidates per seed spacing along a surface (so about 9 per
 // spacing x spacing square); 3 keeps the seeds' spacing as with every point a candidate (the
 // records, hemicube counts and errors: docs/cache.md) while checking a third fewer points.
-constexpr double candidates_per_spacing = 3.0;  // caps Ward's 1/0 at a record's own position and normal
+constexpr double candidates_per_spacing = 3.0;
+// placement: records whose coverage sphere is at most this many finest seed spacings (about the
+// points' spacing) in radius are listed at the points they cover (record_lists: about 800 points
+// at most each, so the lists stay short: docs/cache.md measures the memory); larger ones go into a
+// tree of their own.
+constexpr float listed_reach_in_spacings = 16.0f;  // caps Ward's 1/0 at a record's own position and normal
 constexpr float behind_epsilon = 1e-6f;
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -116,6 +121,15 @@ glm::vec3 extrapolate(const cache_record& r, const glm::vec3& x, const glm::vec3
 // The order of the predictions that options ask for.
 int prediction_order(const cache_options& o) { return !o.use_gradients ? 0 : (o.second_order ? 2 : 1); }
 
+// What a query needs of a record to weigh it (32 bytes; the records themselves are ten times
+// larger): the weights and is_behind read only these, bit for bit the record's.
+struct record_key {
+  glm::vec3 position;
+  float radius;
+  glm::vec3 normal;
+  std::uint32_t index;  // the record's index
+};
+
 // A bounding-volume hierarchy over the records' coverage boxes (centre +- a R), rebuilt after
 // every round's new records are appended (limit_radii finds each new record's neighbours with it:
 // the records of every leaf whose box holds the new record's position). Median splits on the
@@ -124,28 +138,26 @@ int prediction_order(const cache_options& o) { return !o.use_gradients ? 0 : (o.
 class record_bvh {
  public:
   // What a query reports of a record (32 bytes; the records themselves are ten times larger).
-  struct key {
-    glm::vec3 position;
-    float radius;
-    glm::vec3 normal;
-    std::uint32_t index;  // the record's index
-  };
+  using key = record_key;
 
   // threads: how many cores the build may use (the two halves below the root are built in
   // parallel; the tree is the same for any count).
-  void build(const std::vector<cache_record>& records, const cache_options& o, int threads = 1) {
+  // `subset`: the indices of the records to hold, ascending, or nullptr for all of them.
+  void build(const std::vector<cache_record>& records, const cache_options& o, int threads = 1,
+             const std::vector<std::uint32_t>* subset = nullptr) {
     nodes_.clear();
-    items_.resize(records.size());
-    for (std::size_t i = 0; i < records.size(); ++i) {
+    const std::size_t n = subset ? subset->size() : records.size();
+    items_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t i = subset ? (*subset)[k] : static_cast<std::uint32_t>(k);
       const float r = coverage_radius(records[i], o);
-      items_[i] = {records[i].position, records[i].position - glm::vec3(r), records[i].position + glm::vec3(r),
-                   static_cast<std::uint32_t>(i)};
+      items_[k] = {records[i].position, records[i].position - glm::vec3(r), records[i].position + glm::vec3(r), i};
     }
-    if (records.empty()) {
+    if (n == 0) {
       keys_.clear();
       return;
     }
-    const auto count = static_cast<std::uint32_t>(records.size());
+    const auto count = static_cast<std::uint32_t>(n);
     nodes_.push_back({});
     const std::uint32_t mid = split(nodes_[0], 0, count);
     if (mid == 0) {  // the root is a leaf
@@ -255,8 +267,8 @@ class record_bvh {
   }
 
   void fill_keys(const std::vector<cache_record>& records) {
-    keys_.resize(records.size());
-    for (std::size_t k = 0; k < records.size(); ++k) {
+    keys_.resize(items_.size());
+    for (std::size_t k = 0; k < items_.size(); ++k) {
       const cache_record& r = records[items_[k].index];
       keys_[k] = {r.position, r.radius, r.normal, items_[k].index};
     }
@@ -279,12 +291,7 @@ class record_lists {
  public:
   // What a query needs of a record to weigh it (32 bytes; the records themselves are ten times
   // larger): the weights and is_behind read only these, bit for bit the record's.
-  struct key {
-    glm::vec3 position;
-    float radius;
-    glm::vec3 normal;
-    std::uint32_t index;  // the record's index
-  };
+  using key = record_key;
 
   // owners: how many workers may append at once (each to the points it owns, owner()).
   void reset(std::size_t points, int owners) {
@@ -311,16 +318,15 @@ class record_lists {
   // owners may run in parallel. Blocks of 64 points, so that owners do not share cache lines.
   std::size_t owner(std::size_t point) const { return (point >> 6) & (pools_.size() - 1); }
 
-  // Lays the overflow lists of owner w's points out again in the order of `points` (a
-  // permutation of all points), each with room for its records only, when its pool has grown to
-  // more than twice its size at the last layout: lists that queries read one after another lie
-  // one after another.
-  void lay_out(std::size_t w, const std::vector<std::uint32_t>& points) {
+  // Lays the overflow lists of owner w's points out again in point order, each with room for its
+  // records only, when its pool has grown to more than twice its size at the last layout (lists
+  // move to the end of the pool as they grow, and leave their old room behind).
+  void lay_out(std::size_t w) {
     std::vector<std::uint32_t>& pool = pools_[w];
     if (pool.size() <= 2 * compacted_size_[w] + 1024) return;
     std::vector<std::uint32_t> fresh;
     fresh.reserve(pool.size() / 2);
-    for (std::uint32_t point : points) {
+    for (std::uint32_t point = 0; point < size_.size(); ++point) {
       if (owner(point) != w) continue;
       if (size_[point] <= inline_room) {  // no overflow: no room kept in the new pool either
         begin_[point] = room_[point] = 0;
@@ -444,17 +450,10 @@ class point_grid {
     }
     for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
     points_.resize(count);
-    where_.resize(count);
     std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::uint32_t k = fill[cell_of[i]]++;
-      points_[k] = static_cast<std::uint32_t>(i);
-      where_[k] = p[i];  // positions in cell order: a query reads them in sequence
-    }
+    for (std::size_t i = 0; i < count; ++i) points_[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    p_ = p;
   }
-
-  // The points cell by cell (rows of cells in x, then y, then z): neighbours near each other.
-  const std::vector<std::uint32_t>& cell_order() const { return points_; }
 
   // Calls f(i) for every point i with |p_i - c| <= r.
   template <class F>
@@ -468,16 +467,16 @@ class point_grid {
         const std::size_t row = cells_.index({a.x, y, z});
         const std::uint32_t end = start_[row + std::size_t(b.x - a.x) + 1];
         for (std::uint32_t k = start_[row]; k < end; ++k) {
-          const glm::vec3 d = where_[k] - c;
+          const glm::vec3 d = p_[points_[k]] - c;
           if (glm::dot(d, d) <= r2) f(points_[k]);
         }
       }
   }
 
  private:
+  const glm::vec3* p_ = nullptr;
   grid_cells cells_;
   std::vector<std::uint32_t> start_, points_;
-  std::vector<glm::vec3> where_;
 };
 
 // Second-order terms (fit_record_hessians in cache.hpp). For record i, in its tangent frame
@@ -668,7 +667,7 @@ struct coverage_detail {
 // predict for the point, and `own` whether one of them sits at the point itself.
 // `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered),
 // `cone` the same of the HL2 cones, `detail` (optional) what coverage_detail describes.
-float interpolate(const std::vector<cache_record>& records, const record_lists& lists, std::size_t point, const glm::vec3& x,
+float interpolate(const std::vector<cache_record>& records, const record_lists& lists, const record_bvh& large, std::size_t point, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
                   coverage_detail* detail = nullptr) {
@@ -681,11 +680,13 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
   thread_local std::vector<covering> cover;
   cover.clear();
   std::size_t visited = 0;
-  lists.query(point, [&](const record_lists::key& key) {
+  const auto consider = [&](const record_key& key) {
     ++visited;
     const float w = weight_of(key, x, n, o);
     if (w > 0.0f && !is_behind(key, x, n)) cover.push_back({key.index, w});
-  });
+  };
+  lists.query(point, consider);  // the records of small reach, listed at the point
+  large.query(x, consider);      // the others (each record is in one of the two)
   std::sort(cover.begin(), cover.end(), [](const covering& p, const covering& q) { return p.index < q.index; });
   // 2. The weighted sums.
   glm::vec3 sum(0.0f);
@@ -1043,9 +1044,9 @@ namespace {
 // pseudo-random order is below the round's candidate_count.
 // Where the time goes and why each structure is there: docs/cache.md, "Placement".
 // The structures, each kept up to date as records are added:
-//   lists_      per point, the records whose sphere held it (coverage and final interpolation)
+//   lists_      per point, the records of small reach whose sphere held it, and
+//   large_      the records of large reach in a tree (both: coverage and final interpolation)
 //   bvh_        the records' boxes, rebuilt each round (limit_radii's neighbours)
-//   members_    per record, the points in its sphere (mark_dirty, when it shrinks)
 //   record_cells_  the records' positions (nearby_records_agree)
 //   models_     per record, its first-order model, compact (limit_radii, nearby_records_agree)
 class placement {
@@ -1153,6 +1154,9 @@ class placement {
 
   void set_up() {
     lists_.reset(count_, threads_);
+    large_records_.clear();
+    large_.build(records_, o_, 1, &large_records_);
+    largest_listed_reach_ = listed_reach_in_spacings * finest_;
     record_cells_.reset(lo_, hi_, std::max(nearby_reach_, finest_), count_);
     for (auto* v : {&covered_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
     dirty_.assign(count_, 1);  // the first coverage pass tests every point
@@ -1161,8 +1165,6 @@ class placement {
     in_open_list_.assign(count_, 0);
     open_list_.clear();
     record_at_point_.assign(count_, -1);
-    cell_rank_.resize(count_);
-    for (std::size_t k = 0; k < count_; ++k) cell_rank_[grid_of_points_.cell_order()[k]] = static_cast<std::uint32_t>(k);
     order_ = pseudo_random_order(count_);
     rank_.resize(count_);
     for (std::size_t k = 0; k < count_; ++k) rank_[order_[k]] = static_cast<std::uint32_t>(k);
@@ -1216,7 +1218,7 @@ class placement {
       std::array<std::size_t, cache_stats::histogram_buckets> histogram{};
     };
     std::vector<tally> tallies(static_cast<std::size_t>(threads_));
-    in_cell_order(dirty_list_, dirty_);  // neighbouring points one after another: the same records
+    in_index_order(dirty_list_, dirty_);  // neighbouring points (lightmap order) one after another
     parallel_for(dirty_list_.size(), threads_, 1024, [&](int worker, std::size_t b, std::size_t e) {
       tally& t = tallies[std::size_t(worker)];
       for (std::size_t k = b; k < e; ++k) {
@@ -1275,20 +1277,18 @@ class placement {
     }
   }
 
-  // Sorts `list`, the indices of the points whose flag is set, in the point grid's cell order (so
-  // that points one after another query the same records): a long list by a scan of the flags in
-  // that order, a short one by sorting.
-  void in_cell_order(std::vector<std::uint32_t>& list, const std::vector<std::uint8_t>& flag) const {
+  // Sorts `list`, the indices of the points whose flag is set, ascending: a long list by a scan of
+  // the flags, a short one by sorting.
+  void in_index_order(std::vector<std::uint32_t>& list, const std::vector<std::uint8_t>& flag) const {
     if (list.size() > count_ / 16) {
       list.clear();
-      for (std::uint32_t i : grid_of_points_.cell_order())
-        if (flag[i]) list.push_back(i);
+      for (std::size_t i = 0; i < count_; ++i)
+        if (flag[i]) list.push_back(static_cast<std::uint32_t>(i));
     } else {
-      for (std::uint32_t& i : list) i = cell_rank_[i];
       std::sort(list.begin(), list.end());
-      for (std::uint32_t& k : list) k = grid_of_points_.cell_order()[k];
     }
   }
+
 
   // The coverage test of one point (coverage_pass); `visited` counts the records the query saw.
   void check_point(std::size_t i, std::size_t& visited) {
@@ -1305,7 +1305,7 @@ class placement {
       const float reach = o_.error_threshold * key.radius;
       return glm::dot(dx, dx) <= 1.0002f * reach * reach;
     });
-    const float w = interpolate(records_, lists_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
+    const float w = interpolate(records_, lists_, large_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
     // Presumed inside: a valid record that covers the point contests the presumption (the point
@@ -1520,15 +1520,8 @@ class placement {
     const bool shrink = o_.shrink_disagreeing;
     bvh_.build(records_, o_, threads_);
     std::vector<std::vector<pair>> candidates(records_.size() - first_new);
-    // Queried in the point grid's cell order: records one after another visit the same nodes.
-    std::vector<std::uint32_t> by_cell(candidates.size());
-    std::iota(by_cell.begin(), by_cell.end(), 0u);
-    std::sort(by_cell.begin(), by_cell.end(), [&](std::uint32_t x, std::uint32_t y) {
-      return cell_rank_[record_point_[first_new + x]] < cell_rank_[record_point_[first_new + y]];
-    });
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t kk = b; kk < e; ++kk) {
-        const std::size_t k = by_cell[kk];
+      for (std::size_t k = b; k < e; ++k) {
         const std::size_t i = first_new + k;
         const linear_model& mi = models_[i];
         const float ri = radius_of(i);
@@ -1593,13 +1586,12 @@ class placement {
   // the points their spheres hold (after the limits: their final radii).
   void mark_dirty(std::size_t first_new) {
     const float a = o_.error_threshold;
-    // Each worker marks its own flags and lists what it marked; the marks are merged into
-    // dirty_list_ after (which points are dirty does not depend on which worker marked what).
-    // A new record's points (those in its sphere) are found in the point grid and kept with the
-    // record (members_), so that when it shrinks its old sphere's points are at hand.
+    // Each worker marks its own flags and lists what it marked, and the (new record, point) pairs
+    // it found; the marks are merged into dirty_list_ after (which points are dirty does not
+    // depend on which worker marked what), and each owner of points then appends the pairs of its
+    // points to their lists.
     marks_.resize(std::size_t(threads_));
     for (worker_marks& m : marks_) m.flag.resize(count_, 0);
-    members_.resize(records_.size());
     parallel_for(records_.size(), threads_, 256, [&](int worker, std::size_t b, std::size_t e) {
       worker_marks& m = marks_[std::size_t(worker)];
       const auto mark = [&](std::uint32_t i) {
@@ -1613,23 +1605,16 @@ class placement {
         const glm::vec3 x = lists_[j].position;
         // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
         const float reach = a * radius * 1.0001f, reach2 = reach * reach;
-        std::vector<std::uint32_t>& members = members_[j];
         if (j >= first_new) {
           const float marked = o_.nearby_opinion > 0.0f ? std::max(reach, nearby_reach_ * 1.0001f) : reach;
+          const bool listed = a * radius <= largest_listed_reach_;
           grid_of_points_.for_each_in_sphere(x, marked, [&](std::uint32_t i) {
             mark(i);
             const glm::vec3 d = p_[i] - x;
-            if (glm::dot(d, d) <= reach2) members.push_back(i);
+            if (listed && glm::dot(d, d) <= reach2) m.found.push_back({static_cast<std::uint32_t>(j), i});
           });
         } else if (radius != old_radius_[j]) {
-          // Every point of the old sphere is marked; those of the new one stay members.
-          std::size_t kept = 0;
-          for (std::uint32_t i : members) {
-            mark(i);
-            const glm::vec3 d = p_[i] - x;
-            if (glm::dot(d, d) <= reach2) members[kept++] = i;
-          }
-          members.resize(kept);
+          grid_of_points_.for_each_in_sphere(x, a * old_radius_[j] * 1.0001f, mark);  // the old sphere holds the new one
         }
       }
     });
@@ -1646,12 +1631,20 @@ class placement {
     // The new records join the lists of their points, each owner's points in parallel.
     parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t owner = b; owner < e; ++owner) {
-        for (std::size_t j = first_new; j < records_.size(); ++j)
-          for (std::uint32_t i : members_[j])
-            if (lists_.owner(i) == owner) lists_.append(i, static_cast<std::uint32_t>(j));
-        lists_.lay_out(owner, grid_of_points_.cell_order());
+        for (const worker_marks& m : marks_)
+          for (const auto& jp : m.found)
+            if (lists_.owner(jp.second) == owner) lists_.append(jp.second, jp.first);
+        lists_.lay_out(owner);
       }
     });
+    for (worker_marks& m : marks_) {
+      m.found.clear();
+      m.found.shrink_to_fit();
+    }
+    // The records of large reach are kept in a tree of their own (with the radii as they are now).
+    for (std::size_t j = first_new; j < records_.size(); ++j)
+      if (o_.error_threshold * radius_of(j) > largest_listed_reach_) large_records_.push_back(static_cast<std::uint32_t>(j));
+    large_.build(records_, o_, threads_, &large_records_);
   }
 
   // 7. Final interpolation (parallel) of every point that is not inside geometry.
@@ -1667,7 +1660,7 @@ class placement {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
-        if (!inside(i) && interpolate(records_, lists_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
+        if (!inside(i) && interpolate(records_, lists_, large_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
                                       o_.directional ? &cone : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
@@ -1767,7 +1760,10 @@ class placement {
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;  // records seeing more back faces than this stand at a contact (check_point)
   std::vector<cache_record> records_;
-  record_lists lists_;
+  record_lists lists_;     // the records of reach up to largest_listed_reach_, per point
+  record_bvh large_;       // the others (large_records_), rebuilt each round
+  std::vector<std::uint32_t> large_records_;
+  float largest_listed_reach_ = 0.0f;
   record_bvh bvh_;  // limit_radii: the records' boxes
   std::vector<float> radius_;  // limit_radii: the radii during its sequential pass
   std::vector<linear_model> models_;
@@ -1781,7 +1777,6 @@ class placement {
   std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it
   std::vector<std::uint32_t> rank_;            // per point: its place in the fixed pseudo-random order
   std::vector<std::uint32_t> order_;           // the points in that order (order_[rank_[i]] = i)
-  std::vector<std::uint32_t> cell_rank_;       // per point: its place in grid_of_points_.cell_order()
   std::vector<std::uint32_t> dirty_list_;      // the points with dirty_ set: the next coverage pass's
   std::vector<std::uint32_t> open_list_;       // the open points, by rank_ (update_open_list)
   std::vector<std::uint8_t> in_open_list_;
@@ -1789,8 +1784,8 @@ class placement {
   struct worker_marks {
     std::vector<std::uint8_t> flag;
     std::vector<std::uint32_t> list;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> found;  // (new record, point in its sphere)
   };
-  std::vector<std::vector<std::uint32_t>> members_;  // per record: the points in its sphere (mark_dirty)
   std::vector<worker_marks> marks_;  // mark_dirty: each worker's marks
   cache_stats stats_;
 };
