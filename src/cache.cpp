@@ -29,11 +29,12 @@ constexpr float max_weight = 1e12f;
 // spacing x spacing square); 3 keeps the seeds' spacing as with every point a candidate (the
 // records, hemicube counts and errors: docs/cache.md) while checking a third fewer points.
 constexpr double candidates_per_spacing = 3.0;
-// placement: records whose coverage sphere is at most this many finest seed spacings (about the
-// points' spacing) in radius are listed at the points they cover (record_lists: about 800 points
-// at most each, so the lists stay short: docs/cache.md measures the memory); larger ones go into a
-// tree of their own.
-constexpr float listed_reach_in_spacings = 16.0f;  // caps Ward's 1/0 at a record's own position and normal
+// placement: a record whose coverage sphere holds at most max_listed_points points is listed at
+// them (record_lists) while the lists hold fewer than list_entries_per_point entries per point in
+// all; the others go into a tree of their own. Lists make a coverage test cheap; the budget bounds
+// their memory (docs/cache.md: the time and memory of both).
+constexpr std::size_t max_listed_points = 1024;
+constexpr std::size_t list_entries_per_point = 8;
 constexpr float behind_epsilon = 1e-6f;
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -1044,8 +1045,8 @@ namespace {
 // pseudo-random order is below the round's candidate_count.
 // Where the time goes and why each structure is there: docs/cache.md, "Placement".
 // The structures, each kept up to date as records are added:
-//   lists_      per point, the records of small reach whose sphere held it, and
-//   large_      the records of large reach in a tree (both: coverage and final interpolation)
+//   lists_      per point, the records of few points whose sphere held it, and
+//   large_tree_ the other records in a tree (both: coverage and final interpolation)
 //   bvh_        the records' boxes, rebuilt each round (limit_radii's neighbours)
 //   record_cells_  the records' positions (nearby_records_agree)
 //   models_     per record, its first-order model, compact (limit_radii, nearby_records_agree)
@@ -1155,8 +1156,11 @@ class placement {
   void set_up() {
     lists_.reset(count_, threads_);
     large_records_.clear();
-    large_.build(records_, o_, 1, &large_records_);
-    largest_listed_reach_ = listed_reach_in_spacings * finest_;
+    large_.clear();
+    listed_points_.clear();
+    listed_entries_ = 0;
+    list_budget_ = list_entries_per_point * count_;
+    large_tree_.build(records_, o_, 1, &large_records_);
     record_cells_.reset(lo_, hi_, std::max(nearby_reach_, finest_), count_);
     for (auto* v : {&covered_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
     dirty_.assign(count_, 1);  // the first coverage pass tests every point
@@ -1305,7 +1309,7 @@ class placement {
       const float reach = o_.error_threshold * key.radius;
       return glm::dot(dx, dx) <= 1.0002f * reach * reach;
     });
-    const float w = interpolate(records_, lists_, large_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
+    const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
     // Presumed inside: a valid record that covers the point contests the presumption (the point
@@ -1586,12 +1590,15 @@ class placement {
   // the points their spheres hold (after the limits: their final radii).
   void mark_dirty(std::size_t first_new) {
     const float a = o_.error_threshold;
-    // Each worker marks its own flags and lists what it marked, and the (new record, point) pairs
-    // it found; the marks are merged into dirty_list_ after (which points are dirty does not
-    // depend on which worker marked what), and each owner of points then appends the pairs of its
-    // points to their lists.
+    // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
+    const auto reach_of = [&](std::size_t j) { return a * radius_of(j) * 1.0001f; };
+    // a. Each worker marks its own flags and lists what it marked (merged into dirty_list_ after:
+    // which points are dirty does not depend on which worker marked what), and counts each new
+    // record's points.
     marks_.resize(std::size_t(threads_));
     for (worker_marks& m : marks_) m.flag.resize(count_, 0);
+    large_.resize(records_.size(), 0);
+    listed_points_.resize(records_.size(), 0);
     parallel_for(records_.size(), threads_, 256, [&](int worker, std::size_t b, std::size_t e) {
       worker_marks& m = marks_[std::size_t(worker)];
       const auto mark = [&](std::uint32_t i) {
@@ -1601,19 +1608,18 @@ class placement {
         }
       };
       for (std::size_t j = b; j < e; ++j) {
-        const float radius = radius_of(j);
         const glm::vec3 x = lists_[j].position;
-        // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
-        const float reach = a * radius * 1.0001f, reach2 = reach * reach;
+        const float reach = reach_of(j), reach2 = reach * reach;
         if (j >= first_new) {
           const float marked = o_.nearby_opinion > 0.0f ? std::max(reach, nearby_reach_ * 1.0001f) : reach;
-          const bool listed = a * radius <= largest_listed_reach_;
+          std::uint32_t points = 0;
           grid_of_points_.for_each_in_sphere(x, marked, [&](std::uint32_t i) {
             mark(i);
             const glm::vec3 d = p_[i] - x;
-            if (listed && glm::dot(d, d) <= reach2) m.found.push_back({static_cast<std::uint32_t>(j), i});
+            points += glm::dot(d, d) <= reach2 ? 1u : 0u;
           });
-        } else if (radius != old_radius_[j]) {
+          listed_points_[j] = points;
+        } else if (radius_of(j) != old_radius_[j]) {
           grid_of_points_.for_each_in_sphere(x, a * old_radius_[j] * 1.0001f, mark);  // the old sphere holds the new one
         }
       }
@@ -1628,23 +1634,50 @@ class placement {
       }
       m.list.clear();
     }
-    // The new records join the lists of their points, each owner's points in parallel.
-    parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t owner = b; owner < e; ++owner) {
-        for (const worker_marks& m : marks_)
-          for (const auto& jp : m.found)
-            if (lists_.owner(jp.second) == owner) lists_.append(jp.second, jp.first);
-        lists_.lay_out(owner);
+    // b. Which new records are listed, in record order (deterministic): those of at most
+    // max_listed_points points while the lists' entries stay within the budget; the others are
+    // large and kept in a tree of their own (with the radii as they are now).
+    std::vector<std::uint32_t> listed;
+    for (std::size_t j = first_new; j < records_.size(); ++j) {
+      const bool is_listed = listed_points_[j] <= max_listed_points && listed_entries_ + listed_points_[j] <= list_budget_;
+      large_[j] = is_listed ? 0 : 1;
+      if (is_listed) {
+        listed_entries_ += listed_points_[j];
+        listed.push_back(static_cast<std::uint32_t>(j));
+      } else {
+        large_records_.push_back(static_cast<std::uint32_t>(j));
       }
+    }
+    large_tree_.build(records_, o_, threads_, &large_records_);
+    // c. The listed records join the lists of their points: their (record, point) pairs found in
+    // parallel, then appended by the owner of each point (owners in parallel); in batches of at
+    // most about one pair per point, so the pairs in flight take no more memory than that.
+    for (std::size_t first = 0; first < listed.size();) {
+      std::size_t last = first, pairs = 0;
+      while (last < listed.size() && (last == first || pairs + listed_points_[listed[last]] <= count_)) pairs += listed_points_[listed[last++]];
+      parallel_for(last - first, threads_, 64, [&](int worker, std::size_t b, std::size_t e) {
+        worker_marks& m = marks_[std::size_t(worker)];
+        for (std::size_t k = first + b; k < first + e; ++k) {
+          const std::uint32_t j = listed[k];
+          grid_of_points_.for_each_in_sphere(lists_[j].position, reach_of(j), [&](std::uint32_t i) { m.found.push_back({j, i}); });
+        }
+      });
+      parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
+        for (std::size_t owner = b; owner < e; ++owner)
+          for (const worker_marks& m : marks_)
+            for (const auto& jp : m.found)
+              if (lists_.owner(jp.second) == owner) lists_.append(jp.second, jp.first);
+      });
+      for (worker_marks& m : marks_) m.found.clear();
+      first = last;
+    }
+    parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t owner = b; owner < e; ++owner) lists_.lay_out(owner);
     });
     for (worker_marks& m : marks_) {
       m.found.clear();
       m.found.shrink_to_fit();
     }
-    // The records of large reach are kept in a tree of their own (with the radii as they are now).
-    for (std::size_t j = first_new; j < records_.size(); ++j)
-      if (o_.error_threshold * radius_of(j) > largest_listed_reach_) large_records_.push_back(static_cast<std::uint32_t>(j));
-    large_.build(records_, o_, threads_, &large_records_);
   }
 
   // 7. Final interpolation (parallel) of every point that is not inside geometry.
@@ -1660,7 +1693,7 @@ class placement {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
-        if (!inside(i) && interpolate(records_, lists_, large_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
+        if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
                                       o_.directional ? &cone : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
@@ -1760,10 +1793,12 @@ class placement {
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;  // records seeing more back faces than this stand at a contact (check_point)
   std::vector<cache_record> records_;
-  record_lists lists_;     // the records of reach up to largest_listed_reach_, per point
-  record_bvh large_;       // the others (large_records_), rebuilt each round
+  record_lists lists_;     // the records of up to max_listed_points points, per point
+  record_bvh large_tree_;  // the others (large_records_), rebuilt each round
   std::vector<std::uint32_t> large_records_;
-  float largest_listed_reach_ = 0.0f;
+  std::vector<std::uint8_t> large_;  // per record: 1 if it is in large_tree_, not in the lists
+  std::vector<std::uint32_t> listed_points_;  // per new record: the points in its sphere (mark_dirty)
+  std::size_t listed_entries_ = 0, list_budget_ = 0;  // list entries written, and at most
   record_bvh bvh_;  // limit_radii: the records' boxes
   std::vector<float> radius_;  // limit_radii: the radii during its sequential pass
   std::vector<linear_model> models_;
