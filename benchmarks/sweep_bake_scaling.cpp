@@ -2,8 +2,8 @@
 // count, the lightmap size and the thread count.
 //   usage: sweep_bake_scaling out.csv [--quick]
 //          sweep_bake_scaling --one SCENE T SIZE THREADS   (internal: one bake, one CSV row on stdout)
-// The full run is meant for a quiet machine (the 4096^2 bake and the million-triangle bake take
-// minutes and about 2 GB); --quick runs the reduced set below for testing.
+// The full run takes about 4 minutes on two cores and peaks at about 3.5 GiB (the 4096^2 bake);
+// --quick runs the reduced set below.
 //
 // Every configuration is baked in a child process (the program re-executes itself in --one mode
 // with fork + exec and reads the row through a pipe), because peak memory is read from VmHWM in
@@ -42,21 +42,7 @@
 //   memory ~ O(texels) (the per-texel arrays of the samples, the cache points and the outputs;
 //     bake.hpp says about 100 bytes per texel) + O(T) (the mesh here, and the scene the bake
 //     builds: about 140 bytes per triangle, scene.hpp).
-// Measured so far: only --quick, once, on the 2-core machine while other work shared it (load
-// 1.3-2.2; the same 1024^2 bake took 11.4 s and 13.4 s), so the times are rough; the full sweep is
-// for a quiet machine, and docs/bench/bake_scaling.png prints the measured log-log slopes.
-//   triangles (512^2, 2 threads): T = 968 / 10^4 / 10^5: 2.3 / 4.9 / 35.4 s with 28.2k / 25.0k /
-//     20.2k hemicubes, i.e. 164 / 392 / 3506 thread-us per hemicube: per-hemicube cost grew about
-//     like T^0.4 then T^0.95, not like log T: on this open heightfield nearly every triangle is
-//     visible from every texel, so the per-visible-triangle set-up dominates, not the culling.
-//     Peak memory 66 / 67 / 87 MiB: texel-bound at 512^2, ~230 B per triangle beyond (the mesh
-//     here ~50 B, the bake's scene and BVH the rest).
-//   size (10^4 triangles, 2 threads): 256^2 / 512^2 / 1024^2: 5.1 / 5.7 / 11.4 s with 17.5k /
-//     25.0k / 35.5k hemicubes (hemicubes ~ texels^0.26 on this smooth surface, 26.7% -> 3.4% of
-//     the texels; the coverage step ~ texels^0.9). Peak memory 37 / 67 / 194 MiB: ~170 B per
-//     texel at the margin (bake.hpp's estimate says about 100).
-//   threads (10^4 triangles, 1024^2): 19.7 s on 1 thread, 13.4 s on 2 (1.48x, shared machine);
-//     peak memory 189 / 195 MiB.
+// Measured figures and the chart: docs/bake.md, "Scaling with triangles, lightmap size and threads".
 #include "hemilight/bake.hpp"
 #include "hemilight/reference_scenes.hpp"
 

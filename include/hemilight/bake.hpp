@@ -81,8 +81,10 @@
 
 namespace hemilight {
 
-/// Largest lightmap width or height bake_lightmap accepts. Memory is about 100 bytes per texel
-/// (8192^2: 6.7 GB), so larger maps are refused with error(invalid_argument).
+/// Largest lightmap width or height bake_lightmap accepts. Peak memory is about 210 bytes per
+/// sampled texel (measured at 2048^2 and 4096^2 with every texel sampled, one bounce: 0.9 and
+/// 3.5 GiB; docs/bake.md, "Scaling"), so 8192^2 needs about 14 GiB; larger maps are refused with
+/// error(invalid_argument).
 inline constexpr int max_lightmap_size = 8192;
 
 /// Options of bake_lightmap.
