@@ -403,7 +403,7 @@ class record_lists {
 };
 
 // The cells of a uniform grid over a box: cubes of side >= `cell`, grown by 1.25x until there are
-// at most 4 count + 64 of them (at most 1024 per axis). point_grid and seed_grid share them.
+// at most 4 count + 64 of them (at most 1024 per axis). point_grid and incremental_grid share them.
 struct grid_cells {
   glm::vec3 lo{0.0f};
   float inv_cell = 1.0f;
@@ -480,63 +480,12 @@ class point_grid {
   std::vector<std::uint32_t> start_, points_;
 };
 
-// Second-order terms (fit_record_hessians in cache.hpp). For record i, in its tangent frame
-// (t, b): the symmetric H2 = [[h11, h12], [h12, h22]] that best maps the neighbours' offsets
-// (dt, db) to their gradient differences (per channel), two equations per neighbour:
-//     h11 dt + h12 db = dg.t,   h12 dt + h22 db = dg.b.
-// The normal matrix depends only on the offsets, so the three channels share it.
-// Points with normals added one at a time into a uniform grid of cells at least `cell` wide
-// over a box (a linked list per cell; positions and normals stored in insertion order): is there
-// one near a point? At most about 4 count + 64 cells.
-class seed_grid {
- public:
-  void reset(const glm::vec3& lo, const glm::vec3& hi, float cell, std::size_t count) {
-    const glm::vec3 ext = glm::max(hi - lo, glm::vec3(0.0f));
-    cells_.fit(lo, ext, std::max({cell, 1e-6f * std::max({ext.x, ext.y, ext.z}), 1e-30f}), count);
-    head_.assign(cells_.size(), none);
-    next_.clear();
-    position_.clear();
-    normal_.clear();
-  }
-  void insert(const glm::vec3& x, const glm::vec3& n) {
-    const std::size_t c = cells_.index(cells_.cell_of(x));
-    next_.push_back(head_[c]);
-    position_.push_back(x);
-    normal_.push_back(n);
-    head_[c] = static_cast<std::uint32_t>(next_.size() - 1);
-  }
-  // Whether pred(position, normal) holds for an item in the cells that the box x +- r touches
-  // (a superset of the items within r of x); stops at the first that does.
-  template <class F>
-  bool any_near(const glm::vec3& x, float r, F&& pred) const {
-    // x's own cell first: the item that answers is most often there.
-    const glm::ivec3 own = cells_.cell_of(x);
-    const std::size_t own_index = cells_.index(own);
-    for (std::uint32_t k = head_[own_index]; k != none; k = next_[k])
-      if (pred(position_[k], normal_[k])) return true;
-    const glm::ivec3 a = cells_.cell_of(x - glm::vec3(r)), b = cells_.cell_of(x + glm::vec3(r));
-    for (int z = a.z; z <= b.z; ++z)
-      for (int y = a.y; y <= b.y; ++y)
-        for (int xx = a.x; xx <= b.x; ++xx) {
-          const std::size_t c = cells_.index({xx, y, z});
-          if (c == own_index) continue;
-          for (std::uint32_t k = head_[c]; k != none; k = next_[k])
-            if (pred(position_[k], normal_[k])) return true;
-        }
-    return false;
-  }
-
- private:
-  static constexpr std::uint32_t none = 0xffffffffu;
-  grid_cells cells_;
-  std::vector<std::uint32_t> head_, next_;
-  std::vector<glm::vec3> position_, normal_;
-};
-
-// Record indices at positions, added one at a time into a uniform grid of cells at least `cell`
-// wide over a box (a linked list per cell): which records lie near a point. At most about
-// 4 count + 64 cells.
-class record_cells {
+// Items at positions, added one at a time into a uniform grid of cells at least `cell` wide over
+// a box (a linked list per cell, items stored in insertion order): is there one near a point? At
+// most about 4 count + 64 cells. pick_seeds keeps the round's seeds in one (item: position and
+// normal), nearby_records_agree the records (item: the record's index).
+template <class Item>
+class incremental_grid {
  public:
   void reset(const glm::vec3& lo, const glm::vec3& hi, float cell, std::size_t count) {
     const glm::vec3 ext = glm::max(hi - lo, glm::vec3(0.0f));
@@ -545,31 +494,49 @@ class record_cells {
     next_.clear();
     item_.clear();
   }
-  void insert(const glm::vec3& x, std::uint32_t item) {
+  void insert(const glm::vec3& x, const Item& item) {
     const std::size_t c = cells_.index(cells_.cell_of(x));
     next_.push_back(head_[c]);
     item_.push_back(item);
     head_[c] = static_cast<std::uint32_t>(next_.size() - 1);
   }
   // Whether pred(item) holds for an item in the cells that the box x +- r touches (a superset of
-  // the items within r of x); stops at the first that does.
+  // the items within r of x); stops at the first that does. x's own cell first: the item that
+  // answers is most often there.
   template <class F>
   bool any_near(const glm::vec3& x, float r, F&& pred) const {
+    const std::size_t own = cells_.index(cells_.cell_of(x));
+    for (std::uint32_t k = head_[own]; k != none; k = next_[k])
+      if (pred(item_[k])) return true;
     const glm::ivec3 a = cells_.cell_of(x - glm::vec3(r)), b = cells_.cell_of(x + glm::vec3(r));
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
-        for (int xx = a.x; xx <= b.x; ++xx)
-          for (std::uint32_t k = head_[cells_.index({xx, y, z})]; k != none; k = next_[k])
+        for (int xx = a.x; xx <= b.x; ++xx) {
+          const std::size_t c = cells_.index({xx, y, z});
+          if (c == own) continue;
+          for (std::uint32_t k = head_[c]; k != none; k = next_[k])
             if (pred(item_[k])) return true;
+        }
     return false;
   }
 
  private:
   static constexpr std::uint32_t none = 0xffffffffu;
   grid_cells cells_;
-  std::vector<std::uint32_t> head_, next_, item_;
+  std::vector<std::uint32_t> head_, next_;
+  std::vector<Item> item_;
 };
 
+// A seed of pick_seeds: where it is and its normal.
+struct seed {
+  glm::vec3 position, normal;
+};
+
+// Second-order terms (fit_record_hessians in cache.hpp). For record i, in its tangent frame
+// (t, b): the symmetric H2 = [[h11, h12], [h12, h22]] that best maps the neighbours' offsets
+// (dt, db) to their gradient differences (per channel), two equations per neighbour:
+//     h11 dt + h12 db = dg.t,   h12 dt + h22 db = dg.b.
+// The normal matrix depends only on the offsets, so the three channels share it.
 void fit_hessians(std::vector<cache_record>& records, const cache_options& o, int threads) {
   const std::size_t count = records.size();
   std::vector<glm::vec3> where(count);
@@ -1382,12 +1349,12 @@ class placement {
       }
       const std::size_t i = open_list_[k];
       const glm::vec3 x = p_[i], nx = n_[i];
-      const bool blocked = seed_cells_.any_near(x, spacing_, [&](const glm::vec3& c, const glm::vec3& nc) {
-        const glm::vec3 d = x - c;
-        return glm::dot(d, d) <= r2 && glm::length(x - c) < spacing_ && glm::dot(nx, nc) > 0.9f;
+      const bool blocked = seed_cells_.any_near(x, spacing_, [&](const seed& c) {
+        const glm::vec3 d = x - c.position;
+        return glm::dot(d, d) <= r2 && glm::length(d) < spacing_ && glm::dot(nx, c.normal) > 0.9f;
       });
       if (blocked) continue;
-      seed_cells_.insert(x, nx);
+      seed_cells_.insert(x, {x, nx});
       seeds.push_back(i);
     }
     return seeds;
@@ -1789,24 +1756,24 @@ class placement {
   cache_options coverage_options_;
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
-  float contact_backface_ = 0.0f;
+  float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (check_point)
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
-  bool floor_set_ = false;  // records seeing more back faces than this stand at a contact (check_point)
+  bool floor_set_ = false;
   std::vector<cache_record> records_;
   record_lists lists_;     // the records of up to max_listed_points points, per point
   record_bvh large_tree_;  // the others (large_records_), rebuilt each round
   std::vector<std::uint32_t> large_records_;
   std::vector<std::uint8_t> large_;  // per record: 1 if it is in large_tree_, not in the lists
   std::vector<std::uint32_t> listed_points_;  // per new record: the points in its sphere (mark_dirty)
-  std::size_t listed_entries_ = 0, list_budget_ = 0;  // list entries written, and at most
+  std::size_t listed_entries_ = 0, list_budget_ = 0;  // list entries written so far, and the most allowed
   record_bvh bvh_;  // limit_radii: the records' boxes
   std::vector<float> radius_;  // limit_radii: the radii during its sequential pass
-  std::vector<linear_model> models_;
-  record_cells record_cells_;  // the records' positions (nearby_records_agree)  // per record: its first-order model, compact (limit_radii)
+  std::vector<linear_model> models_;  // per record: its first-order model, compact (limit_radii, nearby_records_agree)
+  incremental_grid<std::uint32_t> record_cells_;  // the records' positions (nearby_records_agree)
   std::vector<std::uint32_t> record_point_;  // per record: the point it was placed at
   point_grid grid_of_points_;
   std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
-  seed_grid seed_cells_;  // pick_seeds: the round's seeds so far
+  incremental_grid<seed> seed_cells_;  // pick_seeds: the round's seeds so far
   glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
   std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
   std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it
