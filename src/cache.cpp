@@ -1525,18 +1525,18 @@ class placement {
     // The sequential pass works on a compact copy of the radii.
     radius_.resize(records_.size());
     for (std::size_t j = 0; j < records_.size(); ++j) radius_[j] = records_[j].radius;
-    // At the finest spacing, new records do not shrink older ones (only each other): the points
-    // those cover stay covered, instead of opening again round after round.
-    const bool keep_older = !(spacing_ > finest_);
+    // At the finest spacing, neighbour clamping does not shrink older records (only the new ones,
+    // by each other and by the older ones): the points those cover stay covered, instead of
+    // opening again round after round. A disagreement still shrinks both.
+    const bool clamp_older = spacing_ > finest_;
     for (std::size_t i = first_new; i < records_.size(); ++i) {
       float& ri = radius_[i];
       for (const pair& q : candidates[i - first_new]) {
-        float unchanged = radius_[q.j];
-        float& rj = keep_older && q.j < first_new ? unchanged : radius_[q.j];
+        float& rj = radius_[q.j];
         const float d = q.d;
         if (o_.neighbour_clamp) {
           ri = std::max(o_.min_radius, std::min(ri, rj + d));
-          rj = std::max(o_.min_radius, std::min(rj, ri + d));
+          if (clamp_older || q.j >= first_new) rj = std::max(o_.min_radius, std::min(rj, ri + d));
         }
         if (q.disagree) {
           // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.

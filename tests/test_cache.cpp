@@ -745,7 +745,8 @@ TEST_CASE("cache: second opinion - the Cornell box wall just below the emitter's
   // of a record one row lower does not see how fast. Reference: a hemicube at every point with the
   // same sampler (the cache's interpolation error), green channel, relative to max(E, 5% of the
   // mean) as in benchmarks/sweep_cache. Measured (2,048 points, N = 64, a = 0.3): second opinion
-  // off: 727 hemicubes, RMS 10.7%, max 242%; on (0.25): 1,052 hemicubes, RMS 5.8%, max 61%.
+  // off: 903 hemicubes, RMS 6.9%, max 82%; on (0.25): 1,153 hemicubes, RMS 4.9%, max 67%. (Before
+  // the placement of 0.11.0 tested every point at every spacing, "off" measured 14.5%, max 567%.)
   const scene_mesh mesh = cornell_box();
   const float H = 0.5488f, D = 0.5592f;
   const int k = 128, rows = 16;
@@ -788,10 +789,10 @@ TEST_CASE("cache: second opinion - the Cornell box wall just below the emitter's
   CHECK(b_rms < 0.07);
   CHECK(b_max < 1.5);
   CHECK(b.stats.hemicubes < p.size() * 7 / 10);
-  CHECK(a_rms > 1.5 * b_rms);  // what the rule buys here (measured 1.8x)
-  CHECK(a_max > 2.0 * b_max);
-  // All defaults (second opinion, nearby opinion, sole record reach): measured 5.8% RMS, max 61%,
-  // 1,069 hemicubes.
+  CHECK(a_rms > 1.25 * b_rms);  // what the rule buys here (measured 1.4x)
+  CHECK(a_max > b_max);
+  // All defaults (second opinion, nearby opinion, sole record reach): measured 5.0% RMS, max 67%,
+  // 1,160 hemicubes.
   cache_options defaults;
   defaults.error_threshold = 0.3f;
   const cache_result c = cache_irradiance(p.data(), n.data(), p.size(), sampler, defaults);
