@@ -27,8 +27,8 @@
 // the new records in seed order. While the spacing s is coarse only a uniform sample of the
 // points, about 9 per s x s of surface (the first ones in that order), are candidates; the others
 // are tested when a finer spacing makes them candidates (at the finest spacing every point is).
-// At the finest spacing new records do not shrink older ones (neighbour clamping and the
-// disagreement shrink then apply to the new records only, and among them). Interpolation sums the
+// At the finest spacing neighbour clamping does not shrink older records (it limits the new
+// ones, by each other and by the older ones); a disagreement shrinks both. Interpolation sums the
 // covering records in record order, as interpolate_records does. A point counts as covered when a record's weight passes 1/a
 // and (refine_disagreement) the covering records' predictions agree within a, and
 // (second_opinion) a point covered by one record only is not extrapolated far from it, nor
