@@ -24,7 +24,7 @@ namespace hemilight {
 
 namespace {
 
-constexpr float max_weight = 1e12f;
+constexpr float max_weight = 1e12f;  // caps Ward's 1/0 at a record's own position and normal
 // placement::candidate_count: seed candidates per seed spacing along a surface (so about 9 per
 // spacing x spacing square); 3 keeps the seeds' spacing as with every point a candidate (the
 // records, hemicube counts and errors: docs/cache.md) while checking a third fewer points.
@@ -284,14 +284,14 @@ class record_bvh {
 // held it when they were added. Radii only shrink after a record is added (cache.hpp: limits),
 // so the records that cover a point now are among them, and a query at a point reads one short
 // list instead of searching a structure. A record whose sphere shrank past the point stays in the
-// list; the weight test drops it. Every query in placement and in the final interpolation is at
-// one of the points. Lists live in one pool: a full list moves to the end of the pool with twice
-// the room. Queries are read-only and may run in parallel; add, append and set_radius may not run
-// during them.
+// list until compact() drops it; the weight test ignores it meanwhile. Every query in placement
+// and in the final interpolation is at one of the points. A list's first inline_room entries are
+// kept inline; the rest lie in the pool of the point's owner, and a full one moves to the end of
+// that pool with twice the room. Also holds every record's key (with its current radius).
+// Queries are read-only and may run in parallel; add, append and set_radius may not run during
+// them, appends to points of different owners may.
 class record_lists {
  public:
-  // What a query needs of a record to weigh it (32 bytes; the records themselves are ten times
-  // larger): the weights and is_behind read only these, bit for bit the record's.
   using key = record_key;
 
   // owners: how many workers may append at once (each to the points it owns, owner()).
@@ -640,7 +640,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
                   coverage_detail* detail = nullptr) {
   // 1. The covering records and their weights, then in record order: the sums below do not
-  // depend on how the grid lists records (the same order as interpolate_records).
+  // depend on how the lists and the tree report records (the same order as interpolate_records).
   struct covering {
     std::uint32_t index;
     float w;
@@ -653,7 +653,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
     const float w = weight_of(key, x, n, o);
     if (w > 0.0f && !is_behind(key, x, n)) cover.push_back({key.index, w});
   };
-  lists.query(point, consider);  // the records of small reach, listed at the point
+  lists.query(point, consider);  // the records of few points, listed at the point
   large.query(x, consider);      // the others (each record is in one of the two)
   std::sort(cover.begin(), cover.end(), [](const covering& p, const covering& q) { return p.index < q.index; });
   // 2. The weighted sums.
@@ -1123,7 +1123,6 @@ class placement {
   void set_up() {
     lists_.reset(count_, threads_);
     large_records_.clear();
-    large_.clear();
     listed_points_.clear();
     listed_entries_ = 0;
     list_budget_ = list_entries_per_point * count_;
@@ -1135,7 +1134,6 @@ class placement {
     std::iota(dirty_list_.begin(), dirty_list_.end(), std::uint32_t(0));
     in_open_list_.assign(count_, 0);
     open_list_.clear();
-    record_at_point_.assign(count_, -1);
     order_ = pseudo_random_order(count_);
     rank_.resize(count_);
     for (std::size_t k = 0; k < count_; ++k) rank_[order_[k]] = static_cast<std::uint32_t>(k);
@@ -1259,7 +1257,6 @@ class placement {
       std::sort(list.begin(), list.end());
     }
   }
-
 
   // The coverage test of one point (coverage_pass); `visited` counts the records the query saw.
   void check_point(std::size_t i, std::size_t& visited) {
@@ -1423,7 +1420,6 @@ class placement {
       record_cells_.insert(records_.back().position, static_cast<std::uint32_t>(records_.size() - 1));
       lists_.add(records_.back());
       record_point_.push_back(static_cast<std::uint32_t>(i));
-      record_at_point_[i] = static_cast<std::int32_t>(records_.size() - 1);
     }
     round.records_added = records_.size() - first_new;
     return first_new;
@@ -1472,17 +1468,16 @@ class placement {
     return out;
   }
 
-
   // 5. Neighbour clamping and shrinking of disagreeing neighbours, sequential in record order
-  // over pairs (new record, any record) within reach (deterministic); then the grid's keys take
+  // over pairs (new record, neighbour) (deterministic); then the records and the lists' keys take
   // the new radii.
   void limit_radii(std::size_t first_new) {
     if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return;
     const float a = o_.error_threshold;
-    // The pairs of each new record i: records j whose coverage sphere (a R_j, the radii before
-    // this stage) holds x_i, in record order, with their distance and whether their first-order
-    // predictions of each other disagree by more than a (neither depends on the radii, so both
-    // are found first, in parallel).
+    // The pairs of each new record i: the records j of every leaf of bvh_ (built over all records
+    // with the radii before this stage) whose box holds x_i, in record order, with their distance
+    // and whether their first-order predictions of each other disagree by more than a (neither
+    // depends on the radii, so both are found first, in parallel).
     struct pair {
       std::uint32_t j;
       bool disagree;
@@ -1522,9 +1517,9 @@ class placement {
         }
       }
     });
-    // The sequential pass works on a compact copy of the radii.
+    // The sequential pass works on a compact copy of the radii (the lists' keys hold them).
     radius_.resize(records_.size());
-    for (std::size_t j = 0; j < records_.size(); ++j) radius_[j] = records_[j].radius;
+    for (std::size_t j = 0; j < records_.size(); ++j) radius_[j] = radius_of(j);
     // At the finest spacing, neighbour clamping does not shrink older records (only the new ones,
     // by each other and by the older ones): the points those cover stay covered, instead of
     // opening again round after round. A disagreement still shrinks both.
@@ -1546,9 +1541,11 @@ class placement {
         }
       }
     }
-    for (std::size_t j = 0; j < records_.size(); ++j) records_[j].radius = radius_[j];
     for (std::size_t j = 0; j < records_.size(); ++j)
-      if (records_[j].radius != lists_[j].radius) lists_.set_radius(j, records_[j].radius);
+      if (radius_[j] != radius_of(j)) {
+        records_[j].radius = radius_[j];
+        lists_.set_radius(j, radius_[j]);
+      }
   }
 
   // 6. Points whose coverage this round's records can have changed (in a new record's sphere, or
@@ -1564,7 +1561,6 @@ class placement {
     // record's points.
     marks_.resize(std::size_t(threads_));
     for (worker_marks& m : marks_) m.flag.resize(count_, 0);
-    large_.resize(records_.size(), 0);
     listed_points_.resize(records_.size(), 0);
     parallel_for(records_.size(), threads_, 256, [&](int worker, std::size_t b, std::size_t e) {
       worker_marks& m = marks_[std::size_t(worker)];
@@ -1607,7 +1603,6 @@ class placement {
     std::vector<std::uint32_t> listed;
     for (std::size_t j = first_new; j < records_.size(); ++j) {
       const bool is_listed = listed_points_[j] <= max_listed_points && listed_entries_ + listed_points_[j] <= list_budget_;
-      large_[j] = is_listed ? 0 : 1;
       if (is_listed) {
         listed_entries_ += listed_points_[j];
         listed.push_back(static_cast<std::uint32_t>(j));
@@ -1641,10 +1636,7 @@ class placement {
     parallel_for(lists_.owners(), threads_, 1, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t owner = b; owner < e; ++owner) lists_.lay_out(owner);
     });
-    for (worker_marks& m : marks_) {
-      m.found.clear();
-      m.found.shrink_to_fit();
-    }
+    for (worker_marks& m : marks_) m.found.shrink_to_fit();  // (emptied by the last batch)
   }
 
   // 7. Final interpolation (parallel) of every point that is not inside geometry.
@@ -1763,7 +1755,6 @@ class placement {
   record_lists lists_;     // the records of up to max_listed_points points, per point
   record_bvh large_tree_;  // the others (large_records_), rebuilt each round
   std::vector<std::uint32_t> large_records_;
-  std::vector<std::uint8_t> large_;  // per record: 1 if it is in large_tree_, not in the lists
   std::vector<std::uint32_t> listed_points_;  // per new record: the points in its sphere (mark_dirty)
   std::size_t listed_entries_ = 0, list_budget_ = 0;  // list entries written so far, and the most allowed
   record_bvh bvh_;  // limit_radii: the records' boxes
@@ -1775,7 +1766,6 @@ class placement {
   std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
   incremental_grid<seed> seed_cells_;  // pick_seeds: the round's seeds so far
   glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
-  std::vector<std::int32_t> record_at_point_;  // per point: the record placed there, or -1
   std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it
   std::vector<std::uint32_t> rank_;            // per point: its place in the fixed pseudo-random order
   std::vector<std::uint32_t> order_;           // the points in that order (order_[rank_[i]] = i)
