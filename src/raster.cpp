@@ -698,11 +698,30 @@ float default_near_distance(const scene& s) noexcept {
 // hemicube_rasterizer
 // ---------------------------------------------------------------------------------------------
 
-hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options) : scene_(std::move(s)) {
-  if (!scene_) throw_invalid_argument("hemicube_rasterizer: scene is null");
+hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options) {
+  bind(std::move(s), options);
+}
+
+void hemicube_rasterizer::unbind() noexcept {
+  scene_.reset();
+  sky_.reset();
+}
+
+void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_options& options) {
+  // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
+  if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
   if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
     throw_invalid_argument("hemicube_rasterizer: near_distance is " + std::to_string(options.near_distance) +
                            "; it must be finite and >= 0 (0 = default)");
+  if (options.sky) {
+    // A cheap structural check; the values were checked when the map was built (from_image).
+    const cubemap& m = *options.sky;
+    if (m.level_count() < 1 || m.levels[0].size < 1 || (m.channels() != 3 && m.channels() != 4) ||
+        m.levels[0].pixels.size() != 6u * std::size_t(m.size()) * std::size_t(m.size()) * std::size_t(m.channels()))
+      throw_invalid_argument("hemicube_rasterizer: the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
+  }
+  // Step 2: the scene, the options, and the shades (the direction tables and scratch stay).
+  scene_ = std::move(s);
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
   simd_ = options.simd;
 #if HEMILIGHT_RASTER_AVX2
@@ -710,15 +729,9 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
   avx512_ = avx2_ && options.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
 #endif
-  if (options.sky) {
-    // A cheap structural check; the values were checked when the map was built (from_image).
-    const cubemap& m = *options.sky;
-    if (m.level_count() < 1 || m.levels[0].size < 1 || (m.channels() != 3 && m.channels() != 4) ||
-        m.levels[0].pixels.size() != 6u * std::size_t(m.size()) * std::size_t(m.size()) * std::size_t(m.channels()))
-      throw_invalid_argument("hemicube_rasterizer: the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
-    sky_ = options.sky;
-  }
+  sky_ = options.sky;
   const glm::vec3 sky = scene_->sky_radiance();
+  shades_.clear();
   shades_.reserve(2 + scene_->emissions().size());
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
@@ -736,6 +749,7 @@ hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
                                           int resolution) const {
   const std::string w(who);
+  if (!scene_) throw_invalid_argument(w + ": no scene (unbind() was called; bind() one first)");
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(position[c]))
       throw_invalid_argument(w + ": position." + "xyz"[c] + " is " + std::to_string(position[c]) + "; it must be finite");

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <cstring>
 #include <set>
@@ -651,6 +652,44 @@ TEST_CASE("raster: rasterizers on several threads share one scene and agree with
     CHECK(serial[i].distance == threaded[i].distance);
     CHECK(serial[i].flags == threaded[i].flags);
   }
+}
+
+TEST_CASE("raster: bind() to another scene renders bitwise as a new rasterizer; unbind() drops the scene", "[raster]") {
+  const auto room = scene::create(hexagon_room(2).desc());
+  const auto box = scene::create(cornell_box().desc());
+  const glm::vec3 p_room{0.3f, 1.2f, -0.4f}, p_box{0.28f, 0.1f, 0.25f};
+  std::mt19937 rng(5);
+  const frame f = random_frame(rng);
+  hemicube_buffer fresh_room, fresh_box, reused;
+  hemicube_rasterizer(room).render(p_room, f, 32, fresh_room);
+  hemicube_rasterizer(box).render(p_box, f, 32, fresh_box);
+  // Renders at another N in between, so the reused one's tables and scratch have been resized.
+  hemicube_rasterizer r(room);
+  r.render(p_room, f, 16, reused);
+  r.bind(box);
+  r.render(p_box, f, 32, reused);
+  CHECK(reused.radiance == fresh_box.radiance);
+  CHECK(reused.distance == fresh_box.distance);
+  CHECK(reused.flags == fresh_box.flags);
+  r.bind(room);
+  r.render(p_room, f, 32, reused);
+  CHECK(reused.radiance == fresh_room.radiance);
+  CHECK(reused.flags == fresh_room.flags);
+  // The scene is no longer held after unbind(); render() then fails with a clear error.
+  std::weak_ptr<const scene> held = box;
+  {
+    hemicube_rasterizer only(scene::create(cornell_box().desc()));
+    held = only.scene_ptr();
+    only.unbind();
+    CHECK(held.expired());
+    CHECK_THROWS_WITH(only.render(p_box, f, 16, reused), Catch::Contains("no scene"));
+  }
+  // A failed bind changes nothing.
+  CHECK_THROWS_WITH(r.bind(nullptr), Catch::Contains("scene is null"));
+  CHECK_THROWS_WITH(r.bind(box, raster_options{-1.0f}), Catch::Contains("near_distance is -1"));
+  CHECK(r.scene_ptr() == room);
+  r.render(p_room, f, 32, reused);
+  CHECK(reused.radiance == fresh_room.radiance);
 }
 
 TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round-trip", "[raster]") {

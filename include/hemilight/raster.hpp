@@ -161,6 +161,18 @@ class alignas(64) hemicube_rasterizer {
   /// Throws error(invalid_argument) for a null scene or a negative or non-finite near distance.
   explicit hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options = {});
 
+  /// Renders another scene (or the same with other options) from now on, keeping the direction
+  /// tables and scratch memory: what constructing a new rasterizer would give, without paying
+  /// for the tables again (they cost about as much as a few renders at N = 64). Renders are
+  /// bitwise those of a new rasterizer. Errors as the constructor; on error nothing changes.
+  /// Cost: O(distinct emissions of the scene).
+  void bind(std::shared_ptr<const scene> s, const raster_options& options = {});
+
+  /// Drops the references to the scene and the sky (a cached rasterizer then keeps no released
+  /// scene alive), keeping the tables and scratch memory. render() and render_coverage() throw
+  /// error(invalid_argument) until bind() is called.
+  void unbind() noexcept;
+
   /// Renders the hemicube at `position` (world) with frame `basis` (world; basis.n is the normal,
   /// local +z) at resolution N into `out` (resized to N; position and basis are stored in it).
   /// `texture` (optional): the radiance texture sampled at the perspective-correct lightmap UV of
