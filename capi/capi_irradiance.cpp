@@ -1,4 +1,4 @@
-// The C ABI's irradiance entry points: one hemicube at a point, and the irradiance cache.
+// The C ABI's irradiance cache (one hemicube at a point: capi_sampler.cpp).
 #include "capi_internal.hpp"
 
 #include "hemilight/cache.hpp"
@@ -19,63 +19,9 @@ using hemilight::capi::all_finite;
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
 
-std::string triple(const float* v) {
-  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
-}
-
 }  // namespace
 
 extern "C" {
-
-hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3], const float normal[3],
-                                             int resolution, hemilight_irradiance* out) {
-  const char* fn = "hemilight_sample_irradiance";
-  return guarded(fn, [&] {
-    if (!scene) return invalid(fn, "scene is NULL");
-    if (!position) return invalid(fn, "position is NULL");
-    if (!normal) return invalid(fn, "normal is NULL");
-    if (!out) return invalid(fn, "out is NULL");
-    if (!all_finite(position, 3)) return invalid(fn, "position " + triple(position) + " is not finite");
-    if (!all_finite(normal, 3)) return invalid(fn, "normal " + triple(normal) + " is not finite");
-    const glm::vec3 n(normal[0], normal[1], normal[2]);
-    const float len = glm::length(n);
-    if (!(len > 0.0f) || !std::isfinite(len)) return invalid(fn, "normal " + triple(normal) + " has no direction (zero length)");
-    if (!hemilight::is_valid_hemicube_resolution(resolution))
-      return invalid(fn, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
-    // The integrator (weight tables) and the buffer are kept per thread between calls; the
-    // rasterizer is made per call, so no thread keeps a released scene alive.
-    struct context {
-      std::unique_ptr<hemilight::hemicube_integrator> integrator;
-      hemilight::hemicube_buffer buffer;
-    };
-    thread_local context c;
-    if (!c.integrator || c.integrator->resolution() != resolution)
-      c.integrator = std::make_unique<hemilight::hemicube_integrator>(resolution);
-    const glm::vec3 x(position[0], position[1], position[2]);
-    hemilight::raster_options ro;
-    ro.sky = scene->sky;
-    hemilight::hemicube_rasterizer raster(scene->scene, ro);
-    raster.render(x, hemilight::make_frame(n / len), resolution, c.buffer);
-    const hemilight::irradiance_sample s = c.integrator->integrate(c.buffer);
-    hemilight_irradiance r;
-    for (int ch = 0; ch < 3; ++ch) {
-      r.irradiance[ch] = s.irradiance[ch];
-      for (int k = 0; k < 3; ++k) {
-        r.rotation_gradient[ch][k] = s.rotation_gradient[std::size_t(ch)][k];
-        r.translation_gradient[ch][k] = s.translation_gradient[std::size_t(ch)][k];
-      }
-    }
-    if (scene->lights) {
-      const glm::vec3 e = hemilight::direct_irradiance(*scene->scene, *scene->lights, x, n / len);
-      for (int ch = 0; ch < 3; ++ch) r.irradiance[ch] += e[ch];
-    }
-    r.harmonic_mean_distance = s.harmonic_mean_distance;
-    r.min_distance = s.min_distance;
-    r.backface_fraction = s.backface_fraction;
-    *out = r;
-    return HEMILIGHT_OK;
-  });
-}
 
 void hemilight_cache_options_init(hemilight_cache_options* options) {
   if (!options) return;

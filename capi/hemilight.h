@@ -230,11 +230,91 @@ typedef struct hemilight_irradiance {
  * itself does not see the surface it lies on; offset it from the surface if that surface is not in
  * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
  * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
- * normal, a zero normal, N odd or outside [2, 4096]. Cost: one hemicube (Cornell box, N = 64: tens
- * of microseconds); the first call for a new N builds its weight tables (~5 ms at N = 64). */
+ * normal, a zero normal, N odd or outside [2, 4096].
+ * Cost: one hemicube (Cornell box, N = 64: about 45 us on one core, docs/capi.md). Each thread
+ * keeps the tables of the last N it used up to N = 512 (about 40 bytes per hemicube texel, 3 N^2:
+ * 0.5 MB at N = 64, 31 MB at N = 512) between calls, but no reference to the scene; the first call
+ * on a thread for a new N builds them (~5 ms at N = 64). Above N = 512 every call builds its own.
+ * For many points use hemilight_sampler_irradiance (one per thread) or the batch below. */
 HEMILIGHT_API hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3],
                                                            const float normal[3], int resolution,
                                                            hemilight_irradiance* out);
+
+/* A sampler: one thread's reusable context for hemilight_sampler_irradiance, bound to a scene and a
+ * hemicube resolution. It keeps the scene alive: the scene handle may be released while samplers
+ * made from it live. A sampler serves one thread at a time; a call made while another thread's call
+ * on the same sampler runs is refused (INVALID_ARGUMENT, "in use by another thread") rather than
+ * racing. Different samplers of one scene may be used by different threads at once. */
+typedef struct hemilight_sampler hemilight_sampler;
+
+/* Creates a sampler for `scene` (its triangles, sky or environment, and lights) at hemicube
+ * resolution N. On success *out receives it; release it with hemilight_sampler_release.
+ * Errors (nothing written to *out): INVALID_ARGUMENT for NULL scene/out, N odd or outside
+ * [2, 4096]; OUT_OF_MEMORY. Cost: the tables for N (~5 ms and 0.5 MB at N = 64; about 40 bytes
+ * per hemicube texel, 3 N^2). */
+HEMILIGHT_API hemilight_status hemilight_sampler_create(const hemilight_scene* scene, int resolution,
+                                                        hemilight_sampler** out);
+
+/* hemilight_sample_irradiance at the sampler's scene and N: bitwise the same result for the same
+ * point. Errors (out untouched): as hemilight_sample_irradiance, plus a sampler in use by another
+ * thread. Cost: one hemicube, nothing else (Cornell box, N = 64: about 45 us on one core). */
+HEMILIGHT_API hemilight_status hemilight_sampler_irradiance(hemilight_sampler* sampler, const float position[3],
+                                                            const float normal[3], hemilight_irradiance* out);
+
+/* Releases a sampler (NULL is fine); the scene goes when its last handle or sampler goes. */
+HEMILIGHT_API void hemilight_sampler_release(hemilight_sampler* sampler);
+
+/* hemilight_sample_irradiance at `count` points on `thread_count` threads (0 = all cores):
+ * positions and normals are 3 * count floats, out receives count results, each bitwise what
+ * hemilight_sample_irradiance gives for that point, for any thread count. count = 0 does nothing.
+ * Errors (nothing written to out): INVALID_ARGUMENT for a NULL scene, or NULL arrays with count > 0,
+ * count over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0, and any bad point, named by
+ * its index ("point 17: normal (0, 0, 0) has no direction"); OUT_OF_MEMORY. Cost: count hemicubes
+ * over the threads, plus the tables per thread; about 100 bytes per point of temporary memory. */
+HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene, const float* positions,
+                                                                 const float* normals, size_t count, int resolution,
+                                                                 int thread_count, hemilight_irradiance* out);
+
+/* ---- light probes -------------------------------------------------------------------------------- */
+
+/* Light probes: the radiance arriving at points in free space, projected on real spherical
+ * harmonics up to band 2 (SH9), for lighting moving objects. Per probe i, 27 floats:
+ * sh9_rgb[27 i + 3 k + c], channel c = R, G, B, coefficient k in the order (l, m) = (0,0),
+ * (1,-1), (1,0), (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) of the basis
+ *   0.282095, 0.488603 y, 0.488603 z, 0.488603 x, 1.092548 xy, 1.092548 yz,
+ *   0.315392 (3z^2 - 1), 1.092548 xz, 0.546274 (x^2 - y^2)
+ * (world axes, unit direction (x, y, z)); coefficient = integral over the whole sphere of
+ * L Y_k d omega: a uniform sky of radiance L gives c_0 = 2 sqrt(pi) L = 3.5449 L and the rest 0.
+ * Made from two hemicubes of resolution N per probe (up +z and down -z: the six faces of a cube)
+ * with each basis function integrated over each texel, plus the scene's lights (each a point
+ * source from the direction of its visible light, shadows included: exact for hard point, spot and
+ * sun lights). docs/probes.md has the figures.
+ * A probe inside closed geometry sees back faces; hemilight_sample_probes_with_backfaces reports
+ * the solid-angle fraction of its sphere that does (near 1 inside; drop probes above ~0.1).
+ * Errors (nothing written): INVALID_ARGUMENT for a NULL scene, NULL arrays with count > 0, count
+ * over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0 and a non-finite position, named by
+ * its index ("point 7: position (0, nan, 1) is not finite"); OUT_OF_MEMORY.
+ * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
+ * Cost: 2 hemicubes per probe plus the lights' shadow rays (Cornell box, N = 64: ~15k probes/s on
+ * two cores; docs/probes.md); tables of 36 N^2 floats per N, kept up to N = 512. */
+HEMILIGHT_API hemilight_status hemilight_sample_probes(const hemilight_scene* scene, const float* positions, size_t count,
+                                                       int resolution, int thread_count, float* sh9_rgb);
+
+/* hemilight_sample_probes, also writing backface_fraction[i] in [0, 1] per probe (count floats):
+ * the fraction of the sphere's solid angle that sees back faces of one-sided triangles. Errors as
+ * hemilight_sample_probes, plus a NULL backface_fraction with count > 0. */
+HEMILIGHT_API hemilight_status hemilight_sample_probes_with_backfaces(const hemilight_scene* scene, const float* positions,
+                                                                      size_t count, int resolution, int thread_count,
+                                                                      float* sh9_rgb, float* backface_fraction);
+
+/* Irradiance (W/m^2, RGB) for a surface normal from one probe's 27 coefficients: the
+ * clamped-cosine convolution E(n) = sum_k A_l c_k Y_k(n), A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4.
+ * The normal need not be unit length. The band limit rings around small bright sources: for a
+ * 5-degree source whose exact irradiance facing it is 1, SH9 gives 1.062 facing it, 0.462 at
+ * 60 degrees (exact 0.5), 0.095 at 90 and 0.062 opposite (exact 0); results may be slightly
+ * negative. Errors (irradiance untouched): INVALID_ARGUMENT for NULL arguments, non-finite
+ * coefficients or normal, a zero normal, or a result that overflows float. Cost: ~30 flops. */
+HEMILIGHT_API hemilight_status hemilight_sh9_irradiance(const float sh9_rgb[27], const float normal[3], float irradiance[3]);
 
 /* ---- irradiance cache ---------------------------------------------------------------------------- */
 

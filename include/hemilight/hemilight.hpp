@@ -15,6 +15,7 @@
 //   cache.hpp     the irradiance cache: records, radii, deterministic placement, interpolation
 //   bake.hpp      the lightmap baker: UV coverage, samples, bounces, dilation
 //   cubemap.hpp   environment cube maps: mappings, sampling, lookup fixup, filtering, SH
+//   probes.hpp    light probes: SH9 of the radiance at points (two hemicubes and the lights)
 #pragma once
 
 #include "hemilight/bake.hpp"
@@ -27,6 +28,7 @@
 #include "hemilight/integrate.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/probes.hpp"
 #include "hemilight/raster.hpp"
 #include "hemilight/rays.hpp"
 #include "hemilight/reference_scenes.hpp"

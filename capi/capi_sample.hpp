@@ -1,0 +1,39 @@
+// One hemicube at a point through the C ABI, shared by hemilight_sample_irradiance, the samplers
+// and the batch (not installed): the checks of a point and the sample itself, so that every entry
+// gives bitwise the same result for the same point.
+#pragma once
+
+#include "capi_internal.hpp"
+
+#include "hemilight/hemicube.hpp"
+#include "hemilight/integrate.hpp"
+#include "hemilight/raster.hpp"
+
+#include <memory>
+#include <string>
+
+namespace hemilight::capi {
+
+/// What one thread needs to sample points of one scene at one resolution: the rasterizer (its
+/// direction tables and scratch), the integrator (its weight tables) and the buffer.
+struct point_sampler {
+  std::unique_ptr<hemicube_rasterizer> raster;
+  std::unique_ptr<hemicube_integrator> integrator;
+  hemicube_buffer buffer;
+
+  /// Binds the scene (its sky) and makes the tables for `resolution` if they are not there.
+  void prepare(const hemilight_scene& scene, int resolution);
+  /// One point, checked before (check_point): render, integrate, the lights' direct irradiance.
+  void sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
+              hemilight_irradiance& out);
+};
+
+/// Checks a point for `function`: position and normal non-NULL and finite, the normal nonzero.
+/// `where` prefixes the message's subject ("" or e.g. "point 7: "). On a bad point sets the error
+/// and returns INVALID_ARGUMENT, else HEMILIGHT_OK.
+hemilight_status check_point(const char* function, const std::string& where, const float* position, const float* normal);
+
+/// Checks a hemicube resolution for `function` (even, in [2, 4096]); as check_point.
+hemilight_status check_resolution(const char* function, int resolution);
+
+}  // namespace hemilight::capi

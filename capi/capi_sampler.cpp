@@ -1,0 +1,196 @@
+// The C ABI's point samplers: hemilight_sample_irradiance (one point, a per-thread cached
+// context), hemilight_sampler_* (a context the caller keeps) and hemilight_sample_irradiance_batch
+// (many points on several threads). All three go through point_sampler::sample.
+#include "capi_sample.hpp"
+
+#include "hemilight/geometry.hpp"
+#include "hemilight/lights.hpp"
+#include "hemilight/parallel.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <memory>
+#include <cmath>
+#include <string>
+#include <vector>
+
+/// The C ABI's sampler handle: the scene's parts (shared: the handle keeps them alive) and one
+/// thread's context.
+struct hemilight_sampler {
+  hemilight_scene scene;
+  int resolution = 0;
+  hemilight::capi::point_sampler context;
+  std::atomic<bool> busy{false};  // set while a call runs: a second thread's call is refused
+};
+
+namespace hemilight::capi {
+
+namespace {
+
+std::string triple(const float* v) {
+  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+}  // namespace
+
+hemilight_status check_point(const char* function, const std::string& where, const float* position, const float* normal) {
+  if (!position) return invalid(function, where + "position is NULL");
+  if (!normal) return invalid(function, where + "normal is NULL");
+  if (!all_finite(position, 3)) return invalid(function, where + "position " + triple(position) + " is not finite");
+  if (!all_finite(normal, 3)) return invalid(function, where + "normal " + triple(normal) + " is not finite");
+  const float len = glm::length(glm::vec3(normal[0], normal[1], normal[2]));
+  if (!(len > 0.0f) || !std::isfinite(len)) return invalid(function, where + "normal " + triple(normal) + " has no direction (zero length)");
+  return HEMILIGHT_OK;
+}
+
+hemilight_status check_resolution(const char* function, int resolution) {
+  if (!is_valid_hemicube_resolution(resolution))
+    return invalid(function, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
+  return HEMILIGHT_OK;
+}
+
+void point_sampler::prepare(const hemilight_scene& scene, int resolution) {
+  raster_options ro;
+  ro.sky = scene.sky;
+  if (!raster)
+    raster = std::make_unique<hemicube_rasterizer>(scene.scene, ro);
+  else
+    raster->bind(scene.scene, ro);
+  if (!integrator || integrator->resolution() != resolution) integrator = std::make_unique<hemicube_integrator>(resolution);
+}
+
+void point_sampler::sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
+                           hemilight_irradiance& out) {
+  const glm::vec3 n(normal[0], normal[1], normal[2]);
+  const float len = glm::length(n);
+  const glm::vec3 x(position[0], position[1], position[2]);
+  raster->render(x, make_frame(n / len), resolution, buffer);
+  const irradiance_sample s = integrator->integrate(buffer);
+  hemilight_irradiance r;
+  for (int ch = 0; ch < 3; ++ch) {
+    r.irradiance[ch] = s.irradiance[ch];
+    for (int k = 0; k < 3; ++k) {
+      r.rotation_gradient[ch][k] = s.rotation_gradient[std::size_t(ch)][k];
+      r.translation_gradient[ch][k] = s.translation_gradient[std::size_t(ch)][k];
+    }
+  }
+  if (scene.lights) {
+    const glm::vec3 e = direct_irradiance(*scene.scene, *scene.lights, x, n / len);
+    for (int ch = 0; ch < 3; ++ch) r.irradiance[ch] += e[ch];
+  }
+  r.harmonic_mean_distance = s.harmonic_mean_distance;
+  r.min_distance = s.min_distance;
+  r.backface_fraction = s.backface_fraction;
+  out = r;
+}
+
+}  // namespace hemilight::capi
+
+namespace {
+
+using hemilight::capi::check_point;
+using hemilight::capi::check_resolution;
+using hemilight::capi::guarded;
+using hemilight::capi::invalid;
+
+}  // namespace
+
+extern "C" {
+
+hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3], const float normal[3],
+                                             int resolution, hemilight_irradiance* out) {
+  const char* fn = "hemilight_sample_irradiance";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (const hemilight_status st = check_point(fn, "", position, normal)) return st;
+    if (const hemilight_status st = check_resolution(fn, resolution)) return st;
+    // The context is kept per thread between calls (tables, scratch) up to cached_resolution,
+    // bound to the call's scene for the call only: no thread keeps a released scene alive.
+    // Above it, a context for this call alone (its tables are then a small part of the render).
+    constexpr int cached_resolution = 512;
+    thread_local hemilight::capi::point_sampler cached;
+    hemilight::capi::point_sampler own;
+    hemilight::capi::point_sampler& context = resolution <= cached_resolution ? cached : own;
+    struct unbind_after {
+      hemilight::capi::point_sampler& c;
+      ~unbind_after() {
+        if (c.raster) c.raster->unbind();
+      }
+    } guard{context};
+    context.prepare(*scene, resolution);
+    context.sample(*scene, resolution, position, normal, *out);
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_sampler_create(const hemilight_scene* scene, int resolution, hemilight_sampler** out) {
+  const char* fn = "hemilight_sampler_create";
+  return guarded(fn, [&] {
+    if (!out) return invalid(fn, "out is NULL");
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (const hemilight_status st = check_resolution(fn, resolution)) return st;
+    auto s = std::make_unique<hemilight_sampler>();
+    s->scene = *scene;
+    s->resolution = resolution;
+    s->context.prepare(s->scene, resolution);
+    *out = s.release();
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_sampler_irradiance(hemilight_sampler* sampler, const float position[3], const float normal[3],
+                                              hemilight_irradiance* out) {
+  const char* fn = "hemilight_sampler_irradiance";
+  return guarded(fn, [&] {
+    if (!sampler) return invalid(fn, "sampler is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (const hemilight_status st = check_point(fn, "", position, normal)) return st;
+    if (sampler->busy.exchange(true, std::memory_order_acquire))
+      return invalid(fn, "the sampler is in use by another thread (a sampler serves one thread at a time: make one per thread)");
+    struct release_after {
+      std::atomic<bool>& busy;
+      ~release_after() { busy.store(false, std::memory_order_release); }
+    } guard{sampler->busy};
+    sampler->context.sample(sampler->scene, sampler->resolution, position, normal, *out);
+    return HEMILIGHT_OK;
+  });
+}
+
+void hemilight_sampler_release(hemilight_sampler* sampler) { delete sampler; }
+
+hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene, const float* positions, const float* normals,
+                                                   size_t count, int resolution, int thread_count, hemilight_irradiance* out) {
+  const char* fn = "hemilight_sample_irradiance_batch";
+  return guarded(fn, [&] {
+    // Step 1: the arguments and every point, before anything is rendered.
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (count == 0) return HEMILIGHT_OK;
+    if (!positions) return invalid(fn, "positions is NULL");
+    if (!normals) return invalid(fn, "normals is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (count > hemilight::max_scene_elements)
+      return invalid(fn, "count " + std::to_string(count) + " is over the limit of " + std::to_string(hemilight::max_scene_elements) +
+                             " points per call");
+    if (const hemilight_status st = check_resolution(fn, resolution)) return st;
+    if (thread_count < 0) return invalid(fn, "thread_count is " + std::to_string(thread_count) + "; it must be >= 0 (0 = all cores)");
+    for (std::size_t i = 0; i < count; ++i)
+      if (const hemilight_status st = check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i))
+        return st;
+    // Step 2: the points on the workers, one context each, into a buffer of our own (each
+    // point's result depends on that point alone: the same for any thread count).
+    const int workers = hemilight::resolve_thread_count(thread_count);
+    std::vector<hemilight::capi::point_sampler> contexts(static_cast<std::size_t>(workers));
+    std::vector<hemilight_irradiance> results(count);
+    hemilight::parallel_for(count, workers, 16, [&](int worker, std::size_t b, std::size_t e) {
+      hemilight::capi::point_sampler& c = contexts[std::size_t(worker)];
+      if (!c.raster) c.prepare(*scene, resolution);
+      for (std::size_t i = b; i < e; ++i) c.sample(*scene, resolution, positions + 3 * i, normals + 3 * i, results[i]);
+    });
+    // Step 3: the results out, only now that all succeeded.
+    std::copy(results.begin(), results.end(), out);
+    return HEMILIGHT_OK;
+  });
+}
+
+}  // extern "C"

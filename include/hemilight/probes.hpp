@@ -1,0 +1,99 @@
+// hemilight/probes.hpp — light probes: the radiance arriving at points in free space from all
+// directions, projected on real spherical harmonics up to band 2 (SH9, 9 coefficients per colour
+// channel), for lighting moving objects; and the irradiance for a normal from them.
+//
+// The SH basis (real, orthonormal on the sphere, world axes), in coefficient order k:
+//   k = 0 (l, m) = (0, 0)   0.282095
+//   k = 1        (1, -1)    0.488603 y
+//   k = 2        (1, 0)     0.488603 z
+//   k = 3        (1, 1)     0.488603 x
+//   k = 4        (2, -2)    1.092548 x y
+//   k = 5        (2, -1)    1.092548 y z
+//   k = 6        (2, 0)     0.315392 (3 z^2 - 1)
+//   k = 7        (2, 1)     1.092548 x z
+//   k = 8        (2, 2)     0.546274 (x^2 - y^2)
+// Coefficient k of a probe = integral over the whole sphere of L(w) Y_k(w) d omega (radiance in
+// W m^-2 sr^-1, so a uniform sky of radiance L gives c_0 = 2 sqrt(pi) L and the rest 0).
+//
+// How a probe is made: two hemicubes of the same resolution N at the point, one looking up the
+// world +z axis (frame t = +x, b = +y) and one down -z (t = +x, b = -y): together the six faces
+// of a cube, every direction once. Each texel's radiance is taken as constant over the texel, and
+// each basis function is integrated exactly over each texel (4 x 4 Gauss-Legendre points per
+// texel on the face plane, per eighth of a face for N < 16, in double; the tests check the
+// basis' integrals over the sphere), so the only error is the texel's constant radiance (edges
+// inside texels). Lights (lights.hpp) add their direct part at the point: each
+// light as a point source from the direction of its visible vector irradiance, with the
+// irradiance a surface facing that direction would get, shadows included (exact for hard point,
+// spot and directional lights; for soft lights and rects the error is second order in the
+// light's angular size).
+//
+// A probe inside closed geometry sees the back faces of one-sided triangles: probe_result's
+// backface_fraction (the solid-angle fraction of the sphere that sees back faces) is near 1 for
+// it. Its coefficients are then what it sees (mostly black); callers drop such probes (e.g. above
+// 0.1, the cache's invalid_backface_fraction) and fill them from neighbours.
+#pragma once
+
+#include "hemilight/cubemap.hpp"
+#include "hemilight/lights.hpp"
+#include "hemilight/raster.hpp"
+#include "hemilight/scene.hpp"
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace hemilight {
+
+/// Coefficients of one probe: sh9_rgb[k] is coefficient k (order above) of R, G and B.
+using sh9_rgb = std::array<glm::vec3, 9>;
+
+/// The 9 basis functions at a unit direction w (world axes), in coefficient order. Precondition:
+/// |w| = 1 (not checked; the result scales with |w|^l). Cost: a dozen flops.
+std::array<float, 9> sh9_basis(const glm::vec3& w) noexcept;
+
+/// Irradiance E(n) = integral of L(w) max(0, n.w) d omega of the band-limited radiance: the
+/// clamped-cosine convolution, E(n) = sum_k A_l c_k Y_k(n) with A_0 = pi, A_1 = 2 pi / 3,
+/// A_2 = pi / 4 (Ramamoorthi and Hanrahan 2001). `normal` need not be unit length (it is
+/// normalised); a zero or non-finite normal gives 0. Negative results (ringing of a small bright
+/// source) are returned as they are. Error of the band limit for a small bright source (a cap of
+/// half-angle 5 deg whose exact irradiance facing it is 1; exact E = cos(theta) up to 85 deg):
+///   theta  0       30      60      90      120      180
+///   SH9    1.062   0.878   0.462   0.095   -0.038   0.062   (exact: 1, 0.866, 0.5, ~0, 0, 0)
+/// i.e. up to +6% of the facing value where the light is, ringing of -4% .. +10% of it elsewhere
+/// (a delta source: 1.0625 facing it). Smooth lighting (sky, bounces) loses far less.
+/// Cost: ~30 flops.
+glm::vec3 sh9_irradiance(const sh9_rgb& coefficients, const glm::vec3& normal) noexcept;
+
+/// Options of sample_probes.
+struct probe_options {
+  int resolution = 64;                    ///< hemicube N (even, 2..4096) of each of the two hemicubes
+  int thread_count = 0;                   ///< 0 = all cores; results do not depend on it
+  std::shared_ptr<const cubemap> sky;     ///< environment sky (null: the scene's constant sky)
+  std::shared_ptr<const light_set> lights;///< lights (null: none)
+  /// Radiance of the surfaces over the scene's lightmap UVs (null: the triangles' emission), e.g.
+  /// bake_radiance_texture of a bake (bake.hpp): then the probes see the baked bounce light.
+  /// Needs a scene with lightmap UVs; must outlive the call.
+  const radiance_texture* texture = nullptr;
+  direct_options direct;                  ///< the lights' shadow sampling
+};
+
+/// Probes at points.
+struct probe_result {
+  std::vector<sh9_rgb> probes;            ///< one per point
+  std::vector<float> backface_fraction;   ///< per point, in [0, 1]: near 1 inside closed geometry
+};
+
+/// Renders two hemicubes at each of `count` points (world) and projects what they see, plus the
+/// lights' direct light, on SH9 (the top of this header). Deterministic: each probe depends only
+/// on its point, bitwise, whatever the thread count.
+/// Errors (error(invalid_argument), naming what): a null scene or positions with count > 0, a
+/// non-finite position ("positions[7].y is nan"), an invalid resolution, a negative
+/// thread_count, bad direct options, an invalid texture or one on a scene without lightmap UVs.
+/// Cost: 2 hemicubes per point (Cornell box, N = 64: about
+/// 2 x 30 us on one core) plus the lights' shadow rays; tables of 36 N^2 floats per N (cached
+/// up to N = 512).
+probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* positions, std::size_t count,
+                           const probe_options& options = {});
+
+}  // namespace hemilight
