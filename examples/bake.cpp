@@ -12,6 +12,13 @@
 // NAME_hl2_{0..2}.exr (Half-Life 2 basis in the lightmap tangent frame; bake.hpp). Shows a
 // progress bar with the time left and prints the bake's statistics.
 // --environment FILE.exr: an ENVMAP_CUBE EXR as the sky (built-in scenes and models).
+// --probes GRID|FILE: also NAME_probes.json, SH9 light probes (probes.hpp) rendered after the bake
+// so that they see the baked surfaces (emission + albedo E / pi: bake_radiance_texture), the sky
+// and the lights. The file: {"format": "hemilight_probes", "version": 1, "basis": "...",
+// "resolution": N, "grid": [A, B, C] or null, "bounds": {"min", "max"} (grids only), "probes":
+// [{"position": [x, y, z], "backface_fraction": f, "sh9_rgb": [27 numbers: 3 k + c]}, ...]};
+// grid probes are at the cell centres, x fastest, then y, then z. Drop probes whose
+// backface_fraction is above ~0.1 (inside geometry).
 //
 // Models: read with assimp (triangulated, node transforms applied, normals generated when
 // missing). Lightmap UVs are the mesh's UV channel 1 if it has one, else channel 0; they must lie
@@ -36,6 +43,7 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/probes.hpp"
 #include "hemilight/reference_scenes.hpp"
 
 #include <assimp/Importer.hpp>
@@ -82,6 +90,9 @@ const char* usage =
     "                     radius in radians (default 0.00465, the sun's; 0 = hard)\n"
     "  --point X,Y,Z,I[,R]   a point light (repeatable): position, intensity (W/sr), radius (default 0)\n"
     "  --shadow-mask      also write NAME_shadow_mask.exr: the visibility of the first four lights\n"
+    "  --probes P         also write NAME_probes.json: SH9 light probes (probes.hpp) that see the\n"
+    "                     baked surfaces, at the centres of an AxBxC grid over the scene's bounds\n"
+    "                     (P like 8x4x8) or at the points of a text file (x y z per line, # comments)\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -99,6 +110,7 @@ struct settings {
   bake_options options;
   glm::vec3 sky{1.0f};
   bool quiet = false, shadow_mask = false;
+  std::string probes;  // --probes: "AxBxC" or a file of points; empty: none
 };
 
 // "a,b,c,d[,e]": 4 or 5 finite numbers.
@@ -200,6 +212,8 @@ settings parse(int argc, char** argv) {
       s.options.lights.push_back(l);
     } else if (a == "--shadow-mask") {
       s.shadow_mask = true;
+    } else if (a == "--probes") {
+      s.probes = value();
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -210,7 +224,71 @@ settings parse(int argc, char** argv) {
       fail("more than one model given: " + s.model + " and " + a, 2);
     }
   }
+  if (!s.probes.empty() && s.options.indirect_only)
+    fail("--probes cannot be used with --indirect-only: the probes see the surfaces' whole baked light", 2);
   return s;
+}
+
+// --probes: the probe positions, from "AxBxC" (cell centres of that grid over [lo, hi]) or a file.
+std::vector<glm::vec3> probe_positions(const std::string& spec, const glm::vec3& lo, const glm::vec3& hi, int (&grid)[3]) {
+  std::vector<glm::vec3> p;
+  int a = 0, b = 0, c = 0;
+  char tail;
+  if (std::sscanf(spec.c_str(), "%dx%dx%d%c", &a, &b, &c, &tail) == 3) {
+    if (a < 1 || b < 1 || c < 1 || double(a) * b * c > 1e7)
+      fail("--probes " + spec + " is invalid: each count must be >= 1 and the grid at most 10^7 probes", 2);
+    grid[0] = a, grid[1] = b, grid[2] = c;
+    for (int k = 0; k < c; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < a; ++i)
+          p.push_back(lo + (hi - lo) * glm::vec3((float(i) + 0.5f) / float(a), (float(j) + 0.5f) / float(b), (float(k) + 0.5f) / float(c)));
+    return p;
+  }
+  std::FILE* f = std::fopen(spec.c_str(), "r");
+  if (!f) fail("--probes " + spec + ": not a grid like 8x4x8, and the file cannot be read: " + std::strerror(errno), 2);
+  char line[1024];
+  int number = 0;
+  while (std::fgets(line, sizeof line, f)) {
+    ++number;
+    const char* t = line + std::strspn(line, " \t\r\n");
+    if (*t == '#' || *t == '\0') continue;
+    float x, y, z;
+    char extra;
+    if (std::sscanf(t, "%f %f %f %c", &x, &y, &z, &extra) != 3 || !std::isfinite(x + y + z)) {
+      std::fclose(f);
+      fail("--probes " + spec + ": line " + std::to_string(number) + " is not three finite numbers x y z", 2);
+    }
+    p.push_back({x, y, z});
+  }
+  std::fclose(f);
+  if (p.empty()) fail("--probes " + spec + ": the file holds no points", 2);
+  return p;
+}
+
+// NAME_probes.json: the probes (probes.hpp's basis and order), see the usage text.
+void write_probes_json(const std::string& path, const std::vector<glm::vec3>& p, const probe_result& r, int resolution,
+                       const int (&grid)[3], const glm::vec3& lo, const glm::vec3& hi) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) fail("cannot write '" + path + "': " + std::strerror(errno));
+  std::fprintf(f, "{\n  \"format\": \"hemilight_probes\",\n  \"version\": 1,\n");
+  std::fprintf(f, "  \"basis\": \"real SH, bands 0-2, world axes; sh9_rgb[3 k + c], k: (l,m) = (0,0) (1,-1) (1,0) (1,1) (2,-2) "
+                  "(2,-1) (2,0) (2,1) (2,2); coefficient = integral of L Y_k d omega\",\n");
+  std::fprintf(f, "  \"resolution\": %d,\n", resolution);
+  if (grid[0] > 0)
+    std::fprintf(f, "  \"grid\": [%d, %d, %d],\n  \"bounds\": {\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]},\n", grid[0],
+                 grid[1], grid[2], double(lo.x), double(lo.y), double(lo.z), double(hi.x), double(hi.y), double(hi.z));
+  else
+    std::fprintf(f, "  \"grid\": null,\n");
+  std::fprintf(f, "  \"probes\": [\n");
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    std::fprintf(f, "    {\"position\": [%.9g, %.9g, %.9g], \"backface_fraction\": %.6g, \"sh9_rgb\": [", double(p[i].x), double(p[i].y),
+                 double(p[i].z), double(r.backface_fraction[i]));
+    for (std::size_t k = 0; k < 9; ++k)
+      for (int c = 0; c < 3; ++c) std::fprintf(f, "%s%.9g", k + std::size_t(c) ? ", " : "", double(r.probes[i][k][c]));
+    std::fprintf(f, "]}%s\n", i + 1 < p.size() ? "," : "");
+  }
+  std::fprintf(f, "  ]\n}\n");
+  if (std::fclose(f) != 0) fail("cannot write '" + path + "'");
 }
 
 // A model as the baker needs it (arrays owned here).
@@ -399,6 +477,26 @@ void bake_and_write(const std::string& name, const bake_input& in, const setting
     std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
   std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}\n", st.seconds, st.coverage_seconds, base.c_str(),
               suffixes.c_str());
+  if (s.probes.empty()) return;
+  // Probes that see the baked surfaces (emission + albedo E / pi), the sky and the lights.
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::shared_ptr<const scene> sc = scene::create(in.scene);
+  int grid[3] = {0, 0, 0};
+  const std::vector<glm::vec3> points = probe_positions(s.probes, sc->bounds_lo(), sc->bounds_hi(), grid);
+  const image texture = bake_radiance_texture(in, o, r);
+  const radiance_texture view(texture);
+  probe_options po;
+  po.resolution = o.resolution;
+  po.thread_count = o.thread_count;
+  po.sky = o.environment;
+  po.texture = &view;
+  if (!o.lights.empty()) po.lights = std::make_shared<const light_set>(o.lights.data(), o.lights.size());
+  const probe_result pr = sample_probes(sc, points.data(), points.size(), po);
+  write_probes_json(base + "_probes.json", points, pr, o.resolution, grid, sc->bounds_lo(), sc->bounds_hi());
+  std::size_t inside = 0;
+  for (float b : pr.backface_fraction) inside += b > 0.1f ? 1 : 0;
+  std::printf("  %zu probes (%zu inside geometry: back-face fraction > 0.1), %.2f s; wrote %s_probes.json\n", points.size(), inside,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), base.c_str());
 }
 
 void run_scenes(const settings& s);

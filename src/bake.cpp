@@ -506,6 +506,31 @@ image pass_radiance_texture(const lightmap_samples& s, const scene& sc, const sa
   return texture;
 }
 
+}  // namespace
+
+image bake_radiance_texture(const bake_input& input, const bake_options& o, const bake_result& r) {
+  if (o.indirect_only)
+    throw_invalid_argument("bake_radiance_texture: the bake is indirect_only: its irradiance lacks the first bounce");
+  if (r.irradiance.width != o.width || r.irradiance.height != o.height || r.sampled.size() != std::size_t(o.width) * std::size_t(o.height))
+    throw_invalid_argument("bake_radiance_texture: the result's size does not match options (" + std::to_string(o.width) + " x " +
+                           std::to_string(o.height) + ")");
+  const lightmap_samples s = compute_lightmap_samples(input, o.width, o.height);
+  image texture = image::make(o.width, o.height, 3);
+  std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
+  for (std::size_t k = 0; k < filled.size(); ++k) {
+    if (!r.sampled[k] || s.owner[k] == lightmap_samples::no_triangle) continue;
+    const material m = input.scene.materials ? input.scene.materials[s.owner[k]] : material{};
+    const glm::vec3 e(r.irradiance.pixels[3 * k], r.irradiance.pixels[3 * k + 1], r.irradiance.pixels[3 * k + 2]);
+    const glm::vec3 l = m.emission + m.albedo * e / pi_f;
+    std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
+    filled[k] = 1;
+  }
+  dilate(texture, filled, o.dilation < 0 ? -1 : std::max(o.dilation, 2));
+  return texture;
+}
+
+namespace {
+
 // One pass through the cache (bake_options::use_cache).
 pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, cache_options co, bool directional,
                         const std::function<bool(float)>& progress, bake_stats& stats) {

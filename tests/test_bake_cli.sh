@@ -62,6 +62,32 @@ expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --sun 0.3,-1
 grep -q "2 lights: direct light" ok.log || { echo "FAIL: expected 2 lights:"; cat ok.log; fails=$((fails + 1)); }
 [ -s lit/quad_shadow_mask.exr ] || { echo "FAIL: lit/quad_shadow_mask.exr not written"; fails=$((fails + 1)); }
 
+# Probes: a grid and a file of points; the JSON's fields, and a probe 0.5 above the floor's centre
+# under the uniform sky (radiance 1): c_0 lies between Y00 (4 pi - Omega) (a black floor) and
+# Y00 4 pi (a white one), Omega = 4 asin(1/2) = 2 pi / 3 the floor's solid angle from there.
+printf '# x y z\n0.5 0.5 0.5\n\n0.2 1 0.8\n' > probes.txt
+expect_ok quad.obj --size 8 --resolution 16 --bounces 2 --probes probes.txt --out probes
+expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --probes 2x1x3 --out grid
+python3 - <<'PY' || fails=$((fails + 1))
+import json, math
+d = json.load(open('probes/quad_probes.json'))
+assert d['format'] == 'hemilight_probes' and d['version'] == 1 and d['grid'] is None and d['resolution'] == 16, d
+assert len(d['probes']) == 2 and d['probes'][0]['position'] == [0.5, 0.5, 0.5], d['probes'][0]
+y00 = 0.5 / math.sqrt(math.pi)
+for p in d['probes']:
+    assert len(p['sh9_rgb']) == 27 and p['backface_fraction'] == 0.0, p
+c0 = d['probes'][0]['sh9_rgb'][0]
+assert y00 * (4 * math.pi - 2 * math.pi / 3) - 1e-4 <= c0 <= y00 * 4 * math.pi + 1e-4, c0
+g = json.load(open('grid/quad_probes.json'))
+assert g['grid'] == [2, 1, 3] and len(g['probes']) == 6 and g['bounds']['max'] == [1, 0, 1], g['grid']
+assert all(abs(a - b) < 1e-6 for a, b in zip(g['probes'][1]['position'], [0.75, 0, 1 / 6])), g['probes'][1]['position']
+PY
+expect_fail "--probes 0x1x1" "grid at most" -- quad.obj --probes 0x1x1
+expect_fail "--probes nofile.txt" "cannot be read" -- quad.obj --probes nofile.txt
+printf '0.5 0.5\n' > short.txt
+expect_fail "short.txt: line 1" -- quad.obj --probes short.txt
+expect_fail "--indirect-only" -- quad.obj --probes 1x1x1 --indirect-only
+
 # A glTF 2.0 quad (the same floor) with a KHR_lights_punctual point light on a node at
 # (0.5, 1, 0.5): the model's own light is baked.
 python3 - <<'PY'

@@ -244,6 +244,15 @@ struct texel_clip {
 };
 texel_clip clip_triangle_to_texel(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c, int x, int y) noexcept;
 
+/// What the baked surfaces send out, as a radiance texture over the lightmap (W x H RGB): per
+/// sampled texel emission + albedo E / pi of the material of the triangle that owns it, E the
+/// result's irradiance; dilated as bounce passes dilate theirs (at least 2 rings). What light
+/// probes (probes.hpp: probe_options::texture) or later hemicubes should see of a baked scene.
+/// `input` and `options` must be those of the bake (its size and materials). Meaningless for an
+/// indirect_only bake (its E lacks the first bounce): throws error(invalid_argument) then, and
+/// when the result's size does not match options. Cost: compute_lightmap_samples plus O(texels).
+image bake_radiance_texture(const bake_input& input, const bake_options& options, const bake_result& result);
+
 /// Grows the filled texels of `img` into the empty ones, `rings` times (-1: until every texel
 /// is filled or nothing changes): an empty texel with at least one filled 8-neighbour gets the
 /// mean of them and becomes filled. `filled` (width x height, 0/1) is updated. Returns the number
