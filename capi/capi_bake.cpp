@@ -1,6 +1,7 @@
 // The C ABI of the lightmap baker: meshes concatenated into one scene, bake_lightmap, outputs
 // copied into the caller's buffers only after everything succeeded.
 #include "capi_internal.hpp"
+#include "capi_options.hpp"
 
 #include "hemilight/bake.hpp"
 
@@ -31,26 +32,6 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
 
 extern "C" {
 
-void hemilight_bake_options_init(hemilight_bake_options* options) {
-  if (!options) return;
-  *options = hemilight_bake_options{};
-  options->width = options->height = 256;
-  options->resolution = 64;
-  options->bounces = 1;
-  options->indirect_only = 0;
-  options->error_threshold = 0.2f;
-  options->min_coverage = 0.01f;
-  options->dilation = 16;
-  options->use_cache = 1;
-  options->thread_count = 0;
-  options->progress = nullptr;
-  options->progress_user = nullptr;
-  options->environment_rgb = nullptr;
-  options->environment_size = 0;
-  options->lights = nullptr;
-  options->light_count = 0;
-}
-
 hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
                                          const hemilight_bake_options* options, float* irradiance_rgb,
                                          size_t irradiance_capacity, uint8_t* valid, size_t valid_capacity,
@@ -78,10 +59,14 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
                       size_t hl2_capacity, hemilight_bake_stats* stats) {
   return guarded(fn, [&] {
     if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
+    hemilight_bake_options full = hemilight::capi::default_bake_options();
+    if (const std::string problem = hemilight::capi::read_sized(options, full); !problem.empty()) return invalid(fn, problem);
+    if (stats)
+      if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
     if (mesh_count == 0) return invalid(fn, "mesh_count is 0: there is nothing to bake");
     if (!meshes) return invalid(fn, "meshes is NULL");
     if (!irradiance_rgb) return invalid(fn, "irradiance_rgb is NULL");
-    const hemilight_bake_options& o = *options;
+    const hemilight_bake_options& o = full;
     if (o.width < 1 || o.width > hemilight::max_lightmap_size || o.height < 1 || o.height > hemilight::max_lightmap_size)
       return invalid(fn, "options->width x height = " + std::to_string(o.width) + " x " + std::to_string(o.height) +
                              " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
@@ -173,26 +158,8 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     in.scene.lightmap_uvs = uvs.data();
     in.scene.sky_radiance = glm::vec3(o.sky_radiance[0], o.sky_radiance[1], o.sky_radiance[2]);
     in.normals = any_normals ? normals.data() : nullptr;
-    hemilight::bake_options bo;
-    bo.width = o.width;
-    bo.height = o.height;
-    bo.resolution = o.resolution;
-    bo.bounces = o.bounces;
-    bo.indirect_only = o.indirect_only == 1;
-    bo.cache.error_threshold = o.error_threshold;
-    bo.min_coverage = o.min_coverage;
-    bo.dilation = o.dilation;
-    bo.use_cache = o.use_cache == 1;
-    bo.thread_count = o.thread_count;
-    bo.environment = environment;
-    bo.lights = std::move(lights);
-    bo.output_sh_l1 = sh_l1_rgb != nullptr;
-    bo.output_hl2 = hl2_rgb != nullptr;
-    if (o.progress) {
-      const hemilight_progress_fn progress = o.progress;
-      void* user = o.progress_user;
-      bo.progress = [progress, user](float f) { return progress(user, f) != 0; };
-    }
+    const hemilight::bake_options bo =
+        hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), sh_l1_rgb != nullptr, hl2_rgb != nullptr);
     hemilight::bake_result r;
     try {
       r = hemilight::bake_lightmap(in, bo);
@@ -206,13 +173,16 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     if (hl2_rgb)
       for (std::size_t k = 0; k < 3; ++k) std::copy(r.hl2[k].pixels.begin(), r.hl2[k].pixels.end(), hl2_rgb + 3 * texels * k);
     if (stats) {
-      stats->sampled_texels = r.stats.sampled_texels;
-      stats->invalid_texels = r.stats.invalid_texels;
-      stats->dilated_texels = r.stats.dilated_texels;
-      stats->overlapping_texels = r.stats.overlapping_texels;
-      stats->hemicubes = r.stats.hemicubes;
-      stats->records = r.stats.records;
-      stats->seconds = r.stats.seconds;
+      hemilight_bake_stats st;
+      st.struct_size = sizeof st;
+      st.sampled_texels = r.stats.sampled_texels;
+      st.invalid_texels = r.stats.invalid_texels;
+      st.dilated_texels = r.stats.dilated_texels;
+      st.overlapping_texels = r.stats.overlapping_texels;
+      st.hemicubes = r.stats.hemicubes;
+      st.records = r.stats.records;
+      st.seconds = r.stats.seconds;
+      hemilight::capi::write_sized(st, stats);
     }
     return HEMILIGHT_OK;
   });

@@ -1,5 +1,6 @@
 // The C ABI's irradiance cache (one hemicube at a point: capi_sampler.cpp).
 #include "capi_internal.hpp"
+#include "capi_options.hpp"
 
 #include "hemilight/cache.hpp"
 #include "hemilight/integrate.hpp"
@@ -23,30 +24,6 @@ using hemilight::capi::invalid;
 
 extern "C" {
 
-void hemilight_cache_options_init(hemilight_cache_options* options) {
-  if (!options) return;
-  options->resolution = 64;
-  options->error_threshold = 0.2f;
-  options->min_radius = 0.0f;
-  options->max_radius = 0.0f;
-  options->use_gradients = 1;
-  options->thread_count = 0;
-  options->progress = nullptr;
-  options->progress_user = nullptr;
-  const hemilight::cache_options d;
-  options->weight = HEMILIGHT_CACHE_WEIGHT_WARD;
-  options->gradient_radius_limit = d.gradient_radius_limit ? 1 : 0;
-  options->neighbour_clamp = d.neighbour_clamp ? 1 : 0;
-  options->shrink_disagreeing = d.shrink_disagreeing ? 1 : 0;
-  options->refine_disagreement = d.refine_disagreement ? 1 : 0;
-  options->second_opinion = d.second_opinion;
-  options->nearby_opinion = d.nearby_opinion;
-  options->sole_record_reach = d.sole_record_reach;
-  options->invalid_backface_fraction = d.invalid_backface_fraction;
-  options->extrapolate_wall_depth = hemilight::integrate_options{}.extrapolate_wall_depth ? 1 : 0;
-  options->second_order = d.second_order ? 1 : 0;
-}
-
 hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions, const float* normals,
                                             size_t count, const hemilight_cache_options* options, float* irradiance_rgb,
                                             hemilight_cache_stats* stats) {
@@ -54,62 +31,42 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
   return guarded(fn, [&] {
     if (!scene) return invalid(fn, "scene is NULL");
     if (!options) return invalid(fn, "options is NULL (use hemilight_cache_options_init)");
+    hemilight_cache_options full = hemilight::capi::default_cache_options();
+    if (const std::string problem = hemilight::capi::read_sized(options, full); !problem.empty()) return invalid(fn, problem);
+    if (stats)
+      if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
+    const hemilight_cache_options* const opts = &full;
     if (!irradiance_rgb) return invalid(fn, "irradiance_rgb is NULL");
     if (!positions) return invalid(fn, "positions is NULL");
     if (!normals) return invalid(fn, "normals is NULL");
     if (count == 0) return invalid(fn, "count is 0: there are no points");
-    if (!hemilight::is_valid_hemicube_resolution(options->resolution))
-      return invalid(fn, "options->resolution " + std::to_string(options->resolution) +
+    if (!hemilight::is_valid_hemicube_resolution(opts->resolution))
+      return invalid(fn, "options->resolution " + std::to_string(opts->resolution) +
                              " is invalid: it must be even and in [2, 4096]");
-    if (options->thread_count < 0)
-      return invalid(fn, "options->thread_count is " + std::to_string(options->thread_count) + "; it must be >= 0");
-    const std::pair<const char*, int> switches[] = {{"use_gradients", options->use_gradients},
-                                                    {"gradient_radius_limit", options->gradient_radius_limit},
-                                                    {"neighbour_clamp", options->neighbour_clamp},
-                                                    {"shrink_disagreeing", options->shrink_disagreeing},
-                                                    {"refine_disagreement", options->refine_disagreement},
-                                                    {"extrapolate_wall_depth", options->extrapolate_wall_depth},
-                                                    {"second_order", options->second_order}};
+    if (opts->thread_count < 0)
+      return invalid(fn, "options->thread_count is " + std::to_string(opts->thread_count) + "; it must be >= 0");
+    const std::pair<const char*, int> switches[] = {{"use_gradients", opts->use_gradients},
+                                                    {"gradient_radius_limit", opts->gradient_radius_limit},
+                                                    {"neighbour_clamp", opts->neighbour_clamp},
+                                                    {"shrink_disagreeing", opts->shrink_disagreeing},
+                                                    {"refine_disagreement", opts->refine_disagreement},
+                                                    {"extrapolate_wall_depth", opts->extrapolate_wall_depth},
+                                                    {"second_order", opts->second_order}};
     for (const auto& sw : switches)
       if (sw.second != 0 && sw.second != 1)
         return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
     // Read as an int: a C caller may store any int in an enum field (a C++ load of such a value is
     // undefined behaviour).
-    const int weight = hemilight::capi::enum_value(options->weight);
+    const int weight = hemilight::capi::enum_value(opts->weight);
     if (weight != HEMILIGHT_CACHE_WEIGHT_WARD && weight != HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE &&
         weight != HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS)
       return invalid(fn, "options->weight is " + std::to_string(weight) +
                              "; it must be HEMILIGHT_CACHE_WEIGHT_WARD (0), HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE (1) "
                              "or HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS (2)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
-    hemilight::cache_options o;
-    o.error_threshold = options->error_threshold;
-    o.min_radius = options->min_radius;
-    o.max_radius = options->max_radius;
-    o.use_gradients = options->use_gradients == 1;
-    o.thread_count = options->thread_count;
-    o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD                   ? hemilight::cache_weight::ward
-               : weight == HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE ? hemilight::cache_weight::tabellion_lamorlette
-                                                                       : hemilight::cache_weight::ward_continuous;
-    o.gradient_radius_limit = options->gradient_radius_limit == 1;
-    o.neighbour_clamp = options->neighbour_clamp == 1;
-    o.shrink_disagreeing = options->shrink_disagreeing == 1;
-    o.refine_disagreement = options->refine_disagreement == 1;
-    o.second_order = options->second_order == 1;
-    // Range-checked (with the field named) by cache_irradiance.
-    o.second_opinion = options->second_opinion;
-    o.nearby_opinion = options->nearby_opinion;
-    o.sole_record_reach = options->sole_record_reach;
-    o.invalid_backface_fraction = options->invalid_backface_fraction;
-    if (options->progress) {
-      const hemilight_progress_fn progress = options->progress;
-      void* user = options->progress_user;
-      o.progress = [progress, user](float f) { return progress(user, f) != 0; };
-    }
-    hemilight::hemicube_sampler_options so;
-    so.resolution = options->resolution;
+    const hemilight::cache_options o = hemilight::capi::to_cpp(full);
+    hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
     so.raster.sky = scene->sky;
-    so.integrate.extrapolate_wall_depth = options->extrapolate_wall_depth == 1;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
     hemilight::cache_result r;
@@ -134,10 +91,13 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     for (size_t i = 0; i < count; ++i)
       for (int c = 0; c < 3; ++c) irradiance_rgb[3 * i + size_t(c)] = r.irradiance[i][c];
     if (stats) {
-      stats->hemicubes = r.stats.hemicubes;
-      stats->records = r.stats.records;
-      stats->seconds = r.stats.seconds;
-      stats->invalid_samples = r.stats.invalid_samples;
+      hemilight_cache_stats st;
+      st.struct_size = sizeof st;
+      st.hemicubes = r.stats.hemicubes;
+      st.records = r.stats.records;
+      st.seconds = r.stats.seconds;
+      st.invalid_samples = r.stats.invalid_samples;
+      hemilight::capi::write_sized(st, stats);
     }
     return HEMILIGHT_OK;
   });

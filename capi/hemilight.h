@@ -17,6 +17,22 @@
  *     x along the GL s coordinate and y along t.
  *   - Thread safety: every function may be called from any thread; objects are immutable after
  *     creation unless a function says otherwise.
+ *
+ * Structs that grow (what stays compatible)
+ *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options and
+ *     hemilight_bake_stats begin with size_t struct_size. Their _init functions are inline (below)
+ *     and record the sizeof the program was compiled with; call one before use.
+ *   - A later minor version only appends fields to them, each new field starting at or after the
+ *     previous version's sizeof. The library reads the fields that lie within the caller's
+ *     struct_size and takes the documented defaults for the others, and writes statistics only
+ *     within it. So a program built against this header runs against every later library with the
+ *     same SOVERSION (libhemilight_c.so.1) without a rebuild.
+ *   - A struct_size below sizeof(size_t) (not initialised) or above what the library knows (a
+ *     program built against a newer header than the library) is refused with INVALID_ARGUMENT.
+ *   - Structs passed in arrays (hemilight_bake_mesh, hemilight_bake_material, hemilight_light,
+ *     hemilight_irradiance) and every function signature stay as they are for an SOVERSION; new
+ *     data would come through new functions or arrays. The SOVERSION changes only when that
+ *     promise is broken.
  */
 #ifndef HEMILIGHT_H
 #define HEMILIGHT_H
@@ -42,7 +58,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 11
+#define HEMILIGHT_VERSION_MINOR 12
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {
@@ -334,6 +350,8 @@ typedef enum hemilight_cache_weight {
 } hemilight_cache_weight;
 
 typedef struct hemilight_cache_options {
+  size_t struct_size;     /* sizeof(hemilight_cache_options) as the caller was built: set by
+                             hemilight_cache_options_init (see "Structs that grow" at the top) */
   int resolution;         /* hemicube N, even, 2..4096 (default 64) */
   float error_threshold;  /* Ward's a, (0, 1]: larger = fewer hemicubes, more error (default 0.2) */
   float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
@@ -366,15 +384,29 @@ typedef struct hemilight_cache_options {
                                      records and hemicubes, lower error (docs/cache.md) (default 1) */
 } hemilight_cache_options;
 
-/* Fills options with the defaults above. NULL is ignored. */
-HEMILIGHT_API void hemilight_cache_options_init(hemilight_cache_options* options);
+/* Fills the first struct_size bytes of options with the defaults above and sets
+ * options->struct_size = struct_size (fields past it are not touched). NULL, or a struct_size below
+ * sizeof(size_t), is ignored. Call it through hemilight_cache_options_init. */
+HEMILIGHT_API void hemilight_cache_options_init_sized(hemilight_cache_options* options, size_t struct_size);
+/* Fills options with the defaults above (inline: records the caller's sizeof). NULL is ignored. */
+static inline void hemilight_cache_options_init(hemilight_cache_options* options) {
+  hemilight_cache_options_init_sized(options, sizeof *options);
+}
 
 typedef struct hemilight_cache_stats {
+  size_t struct_size;     /* sizeof as the caller was built: set by hemilight_cache_stats_init */
   size_t hemicubes;       /* hemicubes rendered */
   size_t records;         /* cache records kept */
   double seconds;         /* wall time */
   size_t invalid_samples; /* hemicubes rejected because they saw > 10% back faces (inside geometry) */
 } hemilight_cache_stats;
+
+/* Zeroes stats and sets stats->struct_size (call before passing stats to a function that fills
+ * it; the library writes only the fields that fit in struct_size). NULL is ignored. */
+HEMILIGHT_API void hemilight_cache_stats_init_sized(hemilight_cache_stats* stats, size_t struct_size);
+static inline void hemilight_cache_stats_init(hemilight_cache_stats* stats) {
+  hemilight_cache_stats_init_sized(stats, sizeof *stats);
+}
 
 /* Irradiance (RGB) at `count` points (positions and normals: 3 * count floats each; normals unit
  * length within 1e-3) through the irradiance cache: hemicubes are rendered at few points, the
@@ -417,6 +449,8 @@ typedef struct hemilight_bake_mesh {
 
 /* Bake options; fill with hemilight_bake_options_init, then change what you need. */
 typedef struct hemilight_bake_options {
+  size_t struct_size;      /* sizeof(hemilight_bake_options) as the caller was built: set by
+                              hemilight_bake_options_init (see "Structs that grow" at the top) */
   int width, height;       /* lightmap size in texels, each 1..8192 (default 256 x 256) */
   int resolution;          /* hemicube N, even, 2..4096 (default 64) */
   int bounces;             /* 1 = direct light only, up to 64 (default 1) */
@@ -445,10 +479,15 @@ typedef struct hemilight_bake_options {
   size_t light_count;
 } hemilight_bake_options;
 
-/* Fills options with the defaults above. NULL is ignored. */
-HEMILIGHT_API void hemilight_bake_options_init(hemilight_bake_options* options);
+/* As hemilight_cache_options_init_sized, for bake options. */
+HEMILIGHT_API void hemilight_bake_options_init_sized(hemilight_bake_options* options, size_t struct_size);
+/* Fills options with the defaults above (inline: records the caller's sizeof). NULL is ignored. */
+static inline void hemilight_bake_options_init(hemilight_bake_options* options) {
+  hemilight_bake_options_init_sized(options, sizeof *options);
+}
 
 typedef struct hemilight_bake_stats {
+  size_t struct_size;        /* sizeof as the caller was built: set by hemilight_bake_stats_init */
   size_t sampled_texels;     /* texels that got a sample (coverage >= min_coverage) */
   size_t invalid_texels;     /* sampled texels inside geometry, filled from valid neighbours */
   size_t dilated_texels;     /* empty texels filled by dilation */
@@ -457,6 +496,12 @@ typedef struct hemilight_bake_stats {
   size_t records;            /* irradiance cache records, all bounces */
   double seconds;            /* wall time */
 } hemilight_bake_stats;
+
+/* As hemilight_cache_stats_init, for bake statistics. */
+HEMILIGHT_API void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_size);
+static inline void hemilight_bake_stats_init(hemilight_bake_stats* stats) {
+  hemilight_bake_stats_init_sized(stats, sizeof *stats);
+}
 
 /* Bakes the irradiance lightmap (RGB float E = integral of L cos(theta) d omega) of the meshes:
  * exact UV coverage per texel, a sample at the centroid of the covered part offset along the

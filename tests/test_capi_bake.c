@@ -74,6 +74,7 @@ int main(void) {
 
   /* Good call: E = pi everywhere (the quads see only the sky: nothing bounces onto them). */
   fill_sentinel();
+  hemilight_bake_stats_init(&stats);
   CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, &stats) == HEMILIGHT_OK);
   for (i = 0; i < 3 * W * H; ++i)
     if (fabs(out[i] - 3.14159265) > 1e-4) ok = 0; /* float sums of exact weights */

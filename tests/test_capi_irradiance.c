@@ -135,6 +135,7 @@ static void test_cache(void) {
   hemilight_cache_options_init(NULL); /* ignored */
   o.resolution = 16;
   CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &empty) == HEMILIGHT_OK);
+  hemilight_cache_stats_init(&stats);
   CHECK(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, &stats) == HEMILIGHT_OK);
   for (i = 0; i < count; ++i) ok = ok && fabs(out[3 * i + 2] / (pi * sky[2]) - 1.0) < 1e-5;
   CHECK(ok);
@@ -176,6 +177,8 @@ static void check_interpolation_only(const hemilight_scene* scene, const float* 
   hemilight_cache_stats sa, sb;
   size_t i;
   int differs = 0;
+  hemilight_cache_stats_init(&sa);
+  hemilight_cache_stats_init(&sb);
   CHECK(hemilight_cache_irradiance(scene, pos, nrm, count, a, out, &sa) == HEMILIGHT_OK);
   CHECK(hemilight_cache_irradiance(scene, pos, nrm, count, b, out2, &sb) == HEMILIGHT_OK);
   CHECK(sa.hemicubes == sb.hemicubes && sa.records == sb.records);
@@ -204,6 +207,8 @@ static void test_cache_rules(void) {
         o.invalid_backface_fraction == 0.1f && o.extrapolate_wall_depth == 0 && o.second_order == 1);
   o.resolution = 32;
   CHECK(hemilight_scene_create(quad_pos, 4, quad_idx, 2, black, sky, &shadow) == HEMILIGHT_OK);
+  hemilight_cache_stats_init(&with_rules);
+  hemilight_cache_stats_init(&without_rules);
   CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, &with_rules) == HEMILIGHT_OK);
   o.refine_disagreement = 0;
   o.second_opinion = 0.0f;
@@ -222,6 +227,7 @@ static void test_cache_rules(void) {
     if (out2) {
       CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out, NULL) == HEMILIGHT_OK);
       o.extrapolate_wall_depth = 1;
+      hemilight_cache_stats_init(&extrapolated);
       CHECK(hemilight_cache_irradiance(shadow, pos, nrm, count, &o, out2, &extrapolated) == HEMILIGHT_OK);
       for (i = 0; i < 3 * count; ++i) differs = differs || out[i] != out2[i];
       CHECK(differs);

@@ -1,0 +1,251 @@
+// Growable C structs and the C-to-C++ options mappings (capi_options.hpp).
+#include "capi_options.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstring>
+
+namespace hemilight::capi {
+
+namespace {
+
+// Where a field lies in its struct.
+struct span {
+  std::size_t offset, size;
+};
+#define HEMILIGHT_SPAN(T, f) span { offsetof(T, f), sizeof(static_cast<T*>(nullptr)->f) }
+
+// Fields of each growable struct, in order. A later version appends fields that start at or
+// after the previous version's sizeof (so they never lie in an older caller's tail padding):
+// when a struct grows, add its old size to the static_asserts below.
+const span cache_options_fields[] = {
+    HEMILIGHT_SPAN(hemilight_cache_options, struct_size), HEMILIGHT_SPAN(hemilight_cache_options, resolution),
+    HEMILIGHT_SPAN(hemilight_cache_options, error_threshold), HEMILIGHT_SPAN(hemilight_cache_options, min_radius),
+    HEMILIGHT_SPAN(hemilight_cache_options, max_radius), HEMILIGHT_SPAN(hemilight_cache_options, use_gradients),
+    HEMILIGHT_SPAN(hemilight_cache_options, thread_count), HEMILIGHT_SPAN(hemilight_cache_options, progress),
+    HEMILIGHT_SPAN(hemilight_cache_options, progress_user), HEMILIGHT_SPAN(hemilight_cache_options, weight),
+    HEMILIGHT_SPAN(hemilight_cache_options, gradient_radius_limit), HEMILIGHT_SPAN(hemilight_cache_options, neighbour_clamp),
+    HEMILIGHT_SPAN(hemilight_cache_options, shrink_disagreeing), HEMILIGHT_SPAN(hemilight_cache_options, refine_disagreement),
+    HEMILIGHT_SPAN(hemilight_cache_options, second_opinion), HEMILIGHT_SPAN(hemilight_cache_options, nearby_opinion),
+    HEMILIGHT_SPAN(hemilight_cache_options, sole_record_reach), HEMILIGHT_SPAN(hemilight_cache_options, invalid_backface_fraction),
+    HEMILIGHT_SPAN(hemilight_cache_options, extrapolate_wall_depth), HEMILIGHT_SPAN(hemilight_cache_options, second_order)};
+const span bake_options_fields[] = {
+    HEMILIGHT_SPAN(hemilight_bake_options, struct_size), HEMILIGHT_SPAN(hemilight_bake_options, width),
+    HEMILIGHT_SPAN(hemilight_bake_options, height), HEMILIGHT_SPAN(hemilight_bake_options, resolution),
+    HEMILIGHT_SPAN(hemilight_bake_options, bounces), HEMILIGHT_SPAN(hemilight_bake_options, indirect_only),
+    HEMILIGHT_SPAN(hemilight_bake_options, error_threshold), HEMILIGHT_SPAN(hemilight_bake_options, min_coverage),
+    HEMILIGHT_SPAN(hemilight_bake_options, dilation), HEMILIGHT_SPAN(hemilight_bake_options, use_cache),
+    HEMILIGHT_SPAN(hemilight_bake_options, thread_count), HEMILIGHT_SPAN(hemilight_bake_options, sky_radiance),
+    HEMILIGHT_SPAN(hemilight_bake_options, progress), HEMILIGHT_SPAN(hemilight_bake_options, progress_user),
+    HEMILIGHT_SPAN(hemilight_bake_options, environment_rgb), HEMILIGHT_SPAN(hemilight_bake_options, environment_size),
+    HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count)};
+const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
+                                   HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
+                                   HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
+const span bake_stats_fields[] = {
+    HEMILIGHT_SPAN(hemilight_bake_stats, struct_size), HEMILIGHT_SPAN(hemilight_bake_stats, sampled_texels),
+    HEMILIGHT_SPAN(hemilight_bake_stats, invalid_texels), HEMILIGHT_SPAN(hemilight_bake_stats, dilated_texels),
+    HEMILIGHT_SPAN(hemilight_bake_stats, overlapping_texels), HEMILIGHT_SPAN(hemilight_bake_stats, hemicubes),
+    HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds)};
+#undef HEMILIGHT_SPAN
+
+// The sizes of this ABI's first layouts (x86-64 and every LP64 ABI). A struct that grows keeps
+// its old size here and its new fields start at or after it.
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 96, "hemilight_cache_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 112, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
+
+template <std::size_t K>
+void copy_fields(const span (&fields)[K], const void* from, void* to, std::size_t size) {
+  for (const span& f : fields)
+    if (f.offset + f.size <= size)
+      std::memcpy(static_cast<char*>(to) + f.offset, static_cast<const char*>(from) + f.offset, f.size);
+}
+
+std::string size_problem(const char* what, const char* init, std::size_t size, std::size_t known) {
+  if (size < sizeof(std::size_t))
+    return std::string(what) + "->struct_size is " + std::to_string(size) + ": fill the struct with " + init + " first";
+  if (size > known)
+    return std::string(what) + "->struct_size is " + std::to_string(size) + " but this library knows " + std::to_string(known) +
+           " bytes: the program was built against a newer hemilight.h than this libhemilight_c (link it with that version)";
+  return {};
+}
+
+template <class T, std::size_t K>
+std::string read(const T* in, T& out, const span (&fields)[K], const char* init) {
+  const std::string problem = size_problem("options", init, in->struct_size, sizeof(T));
+  if (!problem.empty()) return problem;
+  copy_fields(fields, in, &out, in->struct_size);
+  return {};
+}
+
+}  // namespace
+
+hemilight_cache_options default_cache_options() {
+  hemilight_cache_options o;
+  std::memset(&o, 0, sizeof o);
+  o.struct_size = sizeof o;
+  o.resolution = 64;
+  o.error_threshold = 0.2f;
+  o.min_radius = 0.0f;
+  o.max_radius = 0.0f;
+  o.use_gradients = 1;
+  o.thread_count = 0;
+  o.progress = nullptr;
+  o.progress_user = nullptr;
+  const cache_options d;
+  o.weight = HEMILIGHT_CACHE_WEIGHT_WARD;
+  o.gradient_radius_limit = d.gradient_radius_limit ? 1 : 0;
+  o.neighbour_clamp = d.neighbour_clamp ? 1 : 0;
+  o.shrink_disagreeing = d.shrink_disagreeing ? 1 : 0;
+  o.refine_disagreement = d.refine_disagreement ? 1 : 0;
+  o.second_opinion = d.second_opinion;
+  o.nearby_opinion = d.nearby_opinion;
+  o.sole_record_reach = d.sole_record_reach;
+  o.invalid_backface_fraction = d.invalid_backface_fraction;
+  o.extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth ? 1 : 0;
+  o.second_order = d.second_order ? 1 : 0;
+  return o;
+}
+
+hemilight_bake_options default_bake_options() {
+  hemilight_bake_options o;
+  std::memset(&o, 0, sizeof o);
+  o.struct_size = sizeof o;
+  o.width = o.height = 256;
+  o.resolution = 64;
+  o.bounces = 1;
+  o.indirect_only = 0;
+  o.error_threshold = 0.2f;
+  o.min_coverage = 0.01f;
+  o.dilation = 16;
+  o.use_cache = 1;
+  o.thread_count = 0;
+  o.progress = nullptr;
+  o.progress_user = nullptr;
+  o.environment_rgb = nullptr;
+  o.environment_size = 0;
+  o.lights = nullptr;
+  o.light_count = 0;
+  return o;
+}
+
+std::string read_sized(const hemilight_cache_options* in, hemilight_cache_options& out) {
+  return read(in, out, cache_options_fields, "hemilight_cache_options_init");
+}
+std::string read_sized(const hemilight_bake_options* in, hemilight_bake_options& out) {
+  return read(in, out, bake_options_fields, "hemilight_bake_options_init");
+}
+
+std::string check_sized(const hemilight_cache_stats* stats) {
+  return size_problem("stats", "hemilight_cache_stats_init", stats->struct_size, sizeof *stats);
+}
+std::string check_sized(const hemilight_bake_stats* stats) {
+  return size_problem("stats", "hemilight_bake_stats_init", stats->struct_size, sizeof *stats);
+}
+
+void write_sized(const hemilight_cache_stats& from, hemilight_cache_stats* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(cache_stats_fields, &from, out, size);
+  out->struct_size = size;
+}
+void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(bake_stats_fields, &from, out, size);
+  out->struct_size = size;
+}
+
+cache_options to_cpp(const hemilight_cache_options& c) {
+  cache_options o;
+  o.error_threshold = c.error_threshold;
+  o.min_radius = c.min_radius;
+  o.max_radius = c.max_radius;
+  o.use_gradients = c.use_gradients == 1;
+  o.thread_count = c.thread_count;
+  int weight = 0;
+  std::memcpy(&weight, &c.weight, sizeof weight);  // any int a C caller stored (checked before)
+  o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD                   ? cache_weight::ward
+             : weight == HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE ? cache_weight::tabellion_lamorlette
+                                                                     : cache_weight::ward_continuous;
+  o.gradient_radius_limit = c.gradient_radius_limit == 1;
+  o.neighbour_clamp = c.neighbour_clamp == 1;
+  o.shrink_disagreeing = c.shrink_disagreeing == 1;
+  o.refine_disagreement = c.refine_disagreement == 1;
+  o.second_order = c.second_order == 1;
+  // Range-checked (with the field named) by cache_irradiance.
+  o.second_opinion = c.second_opinion;
+  o.nearby_opinion = c.nearby_opinion;
+  o.sole_record_reach = c.sole_record_reach;
+  o.invalid_backface_fraction = c.invalid_backface_fraction;
+  if (c.progress) {
+    const hemilight_progress_fn progress = c.progress;
+    void* user = c.progress_user;
+    o.progress = [progress, user](float f) { return progress(user, f) != 0; };
+  }
+  return o;
+}
+
+hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_options& c) {
+  hemicube_sampler_options so;
+  so.resolution = c.resolution;
+  so.integrate.extrapolate_wall_depth = c.extrapolate_wall_depth == 1;
+  return so;
+}
+
+bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubemap> environment, std::vector<light> lights,
+                    bool output_sh_l1, bool output_hl2) {
+  bake_options o;
+  o.width = c.width;
+  o.height = c.height;
+  o.resolution = c.resolution;
+  o.bounces = c.bounces;
+  o.indirect_only = c.indirect_only == 1;
+  o.cache.error_threshold = c.error_threshold;
+  o.min_coverage = c.min_coverage;
+  o.dilation = c.dilation;
+  o.use_cache = c.use_cache == 1;
+  o.thread_count = c.thread_count;
+  o.environment = std::move(environment);
+  o.lights = std::move(lights);
+  o.output_sh_l1 = output_sh_l1;
+  o.output_hl2 = output_hl2;
+  if (c.progress) {
+    const hemilight_progress_fn progress = c.progress;
+    void* user = c.progress_user;
+    o.progress = [progress, user](float f) { return progress(user, f) != 0; };
+  }
+  return o;
+}
+
+}  // namespace hemilight::capi
+
+extern "C" {
+
+void hemilight_cache_options_init_sized(hemilight_cache_options* options, size_t struct_size) {
+  if (!options || struct_size < sizeof(size_t)) return;
+  const hemilight_cache_options d = hemilight::capi::default_cache_options();
+  hemilight::capi::copy_fields(hemilight::capi::cache_options_fields, &d, options, std::min(struct_size, sizeof d));
+  options->struct_size = struct_size;
+}
+
+void hemilight_bake_options_init_sized(hemilight_bake_options* options, size_t struct_size) {
+  if (!options || struct_size < sizeof(size_t)) return;
+  const hemilight_bake_options d = hemilight::capi::default_bake_options();
+  hemilight::capi::copy_fields(hemilight::capi::bake_options_fields, &d, options, std::min(struct_size, sizeof d));
+  options->struct_size = struct_size;
+}
+
+void hemilight_cache_stats_init_sized(hemilight_cache_stats* stats, size_t struct_size) {
+  if (!stats || struct_size < sizeof(size_t)) return;
+  std::memset(stats, 0, std::min(struct_size, sizeof *stats));
+  stats->struct_size = struct_size;
+}
+
+void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_size) {
+  if (!stats || struct_size < sizeof(size_t)) return;
+  std::memset(stats, 0, std::min(struct_size, sizeof *stats));
+  stats->struct_size = struct_size;
+}
+
+}  // extern "C"

@@ -1,0 +1,45 @@
+// The C ABI's growable structs (hemilight.h, "Structs that grow") and the one place where each C
+// options struct is mapped to its C++ options (not installed). Free of the C ABI's error state, so
+// that tests/test_capi_options.cpp can check every field's mapping directly.
+#pragma once
+
+#include "hemilight.h"
+
+#include "hemilight/bake.hpp"
+#include "hemilight/cache.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hemilight::capi {
+
+/// Copies the caller's options into `out` (which holds the defaults): every field that lies
+/// within in->struct_size, the defaults for the others. Returns "" or what is wrong with
+/// struct_size ("options->struct_size is 0: ...").
+std::string read_sized(const hemilight_cache_options* in, hemilight_cache_options& out);
+std::string read_sized(const hemilight_bake_options* in, hemilight_bake_options& out);
+
+/// The defaults, for the whole struct the library knows (struct_size = its sizeof).
+hemilight_cache_options default_cache_options();
+hemilight_bake_options default_bake_options();
+
+/// Checks stats->struct_size; returns "" or what is wrong.
+std::string check_sized(const hemilight_cache_stats* stats);
+std::string check_sized(const hemilight_bake_stats* stats);
+/// Writes the fields of `from` that lie within out->struct_size (checked before).
+void write_sized(const hemilight_cache_stats& from, hemilight_cache_stats* out);
+void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out);
+
+/// The C++ options of checked C options (switches already 0 or 1, the weight a known value).
+/// Every field of the C struct but resolution and extrapolate_wall_depth (which belong to the
+/// hemicube sampler: hemicube_sampler_options_of) lands here.
+cache_options to_cpp(const hemilight_cache_options& c);
+hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_options& c);
+
+/// The C++ bake options of checked C options, with the environment map and the lights already
+/// converted (they need checks that name their elements) and the directional outputs asked for.
+bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubemap> environment, std::vector<light> lights,
+                    bool output_sh_l1, bool output_hl2);
+
+}  // namespace hemilight::capi

@@ -1,0 +1,188 @@
+// The C ABI's options structs against the C++ options: every C field reaches its C++ field (each
+// set to a value other than its default, so a missing or swapped mapping fails), the C defaults are
+// the C++ defaults, and a struct_size of an older, shorter layout reads the fields it holds and
+// takes the defaults for the rest (capi/capi_options.cpp, compiled into this test).
+#include "capi_options.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstddef>
+#include <cstring>
+
+using namespace hemilight;
+
+namespace {
+
+int progress_calls = 0;
+int count_progress(void* user, float) {
+  ++*static_cast<int*>(user);
+  return 1;
+}
+
+}  // namespace
+
+TEST_CASE("C ABI options: every cache option reaches the C++ side", "[capi]") {
+  hemilight_cache_options c = capi::default_cache_options();
+  c.resolution = 48;
+  c.error_threshold = 0.37f;
+  c.min_radius = 0.011f;
+  c.max_radius = 2.5f;
+  c.use_gradients = 0;
+  c.thread_count = 3;
+  c.progress = count_progress;
+  c.progress_user = &progress_calls;
+  c.weight = HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE;
+  c.gradient_radius_limit = 0;
+  c.neighbour_clamp = 0;
+  c.shrink_disagreeing = 0;
+  c.refine_disagreement = 0;
+  c.second_opinion = 0.4f;
+  c.nearby_opinion = 3.0f;
+  c.sole_record_reach = 0.5f;
+  c.invalid_backface_fraction = 0.3f;
+  c.extrapolate_wall_depth = 1;
+  c.second_order = 0;
+  const cache_options o = capi::to_cpp(c);
+  const hemicube_sampler_options so = capi::hemicube_sampler_options_of(c);
+  CHECK(so.resolution == 48);
+  CHECK(so.integrate.extrapolate_wall_depth);
+  CHECK(o.error_threshold == 0.37f);
+  CHECK(o.min_radius == 0.011f);
+  CHECK(o.max_radius == 2.5f);
+  CHECK(!o.use_gradients);
+  CHECK(o.thread_count == 3);
+  CHECK(o.weight == cache_weight::tabellion_lamorlette);
+  CHECK(!o.gradient_radius_limit);
+  CHECK(!o.neighbour_clamp);
+  CHECK(!o.shrink_disagreeing);
+  CHECK(!o.refine_disagreement);
+  CHECK(o.second_opinion == 0.4f);
+  CHECK(o.nearby_opinion == 3.0f);
+  CHECK(o.sole_record_reach == 0.5f);
+  CHECK(o.invalid_backface_fraction == 0.3f);
+  CHECK(!o.second_order);
+  REQUIRE(o.progress);
+  progress_calls = 0;
+  CHECK(o.progress(0.5f));
+  CHECK(progress_calls == 1);
+  c.weight = HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS;
+  CHECK(capi::to_cpp(c).weight == cache_weight::ward_continuous);
+  c.weight = HEMILIGHT_CACHE_WEIGHT_WARD;
+  CHECK(capi::to_cpp(c).weight == cache_weight::ward);
+}
+
+TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
+  const cache_options d;
+  const cache_options o = capi::to_cpp(capi::default_cache_options());
+  CHECK(o.error_threshold == d.error_threshold);
+  CHECK(o.min_radius == d.min_radius);
+  CHECK(o.max_radius == d.max_radius);
+  CHECK(o.use_gradients == d.use_gradients);
+  CHECK(o.thread_count == d.thread_count);
+  CHECK(o.weight == d.weight);
+  CHECK(o.gradient_radius_limit == d.gradient_radius_limit);
+  CHECK(o.neighbour_clamp == d.neighbour_clamp);
+  CHECK(o.shrink_disagreeing == d.shrink_disagreeing);
+  CHECK(o.refine_disagreement == d.refine_disagreement);
+  CHECK(o.second_opinion == d.second_opinion);
+  CHECK(o.nearby_opinion == d.nearby_opinion);
+  CHECK(o.sole_record_reach == d.sole_record_reach);
+  CHECK(o.invalid_backface_fraction == d.invalid_backface_fraction);
+  CHECK(o.second_order == d.second_order);
+  CHECK(!o.progress);
+  CHECK(capi::hemicube_sampler_options_of(capi::default_cache_options()).resolution == hemicube_sampler_options{}.resolution);
+  const bake_options bd;
+  const bake_options b = capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false);
+  CHECK(b.resolution == bd.resolution);
+  CHECK(b.bounces == bd.bounces);
+  CHECK(b.indirect_only == bd.indirect_only);
+  CHECK(b.cache.error_threshold == bd.cache.error_threshold);
+  CHECK(b.min_coverage == bd.min_coverage);
+  CHECK(b.dilation == bd.dilation);
+  CHECK(b.use_cache == bd.use_cache);
+  CHECK(b.thread_count == bd.thread_count);
+}
+
+TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
+  hemilight_bake_options c = capi::default_bake_options();
+  c.width = 300;
+  c.height = 200;
+  c.resolution = 32;
+  c.bounces = 4;
+  c.indirect_only = 1;
+  c.error_threshold = 0.3f;
+  c.min_coverage = 0.05f;
+  c.dilation = 3;
+  c.use_cache = 0;
+  c.thread_count = 2;
+  c.progress = count_progress;
+  c.progress_user = &progress_calls;
+  light l;
+  l.position = {1, 2, 3};
+  const auto env = std::make_shared<const cubemap>();
+  const bake_options o = capi::to_cpp(c, env, {l}, true, false);
+  CHECK(o.width == 300);
+  CHECK(o.height == 200);
+  CHECK(o.resolution == 32);
+  CHECK(o.bounces == 4);
+  CHECK(o.indirect_only);
+  CHECK(o.cache.error_threshold == 0.3f);
+  CHECK(o.min_coverage == 0.05f);
+  CHECK(o.dilation == 3);
+  CHECK(!o.use_cache);
+  CHECK(o.thread_count == 2);
+  CHECK(o.environment == env);
+  REQUIRE(o.lights.size() == 1);
+  CHECK(o.lights[0].position.z == 3.0f);
+  CHECK(o.output_sh_l1);
+  CHECK(!o.output_hl2);
+  REQUIRE(o.progress);
+  progress_calls = 0;
+  CHECK(o.progress(0.25f));
+  CHECK(progress_calls == 1);
+  // (sky_radiance and environment_rgb / light_count are converted by the bake entry itself, which
+  // the C99 tests cover: test_capi_bake.c.)
+}
+
+TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for the fields it lacks", "[capi]") {
+  // An older layout: everything up to extrapolate_wall_depth (no second_order).
+  hemilight_cache_options older = capi::default_cache_options();
+  older.second_order = 0;  // would be read if the size covered it
+  older.resolution = 32;
+  older.struct_size = offsetof(hemilight_cache_options, second_order);
+  hemilight_cache_options full = capi::default_cache_options();
+  REQUIRE(capi::read_sized(&older, full).empty());
+  CHECK(full.resolution == 32);
+  CHECK(full.second_order == 1);  // the default, not the 0 beyond the caller's struct
+  CHECK(full.struct_size == older.struct_size);
+  older.struct_size = 0;
+  CHECK_THAT(capi::read_sized(&older, full), Catch::Contains("struct_size is 0: fill the struct with hemilight_cache_options_init"));
+  older.struct_size = sizeof(hemilight_cache_options) + 8;
+  CHECK_THAT(capi::read_sized(&older, full), Catch::Contains("built against a newer hemilight.h"));
+  hemilight_bake_options bo = capi::default_bake_options();
+  bo.light_count = 5;
+  bo.width = 17;
+  bo.struct_size = offsetof(hemilight_bake_options, lights);
+  hemilight_bake_options bfull = capi::default_bake_options();
+  REQUIRE(capi::read_sized(&bo, bfull).empty());
+  CHECK(bfull.width == 17);
+  CHECK(bfull.light_count == 0);
+  CHECK(bfull.lights == nullptr);
+  // Statistics: only the fields within struct_size are written.
+  hemilight_cache_stats from{};
+  from.struct_size = sizeof from;
+  from.hemicubes = 7;
+  from.records = 5;
+  from.seconds = 1.5;
+  from.invalid_samples = 2;
+  hemilight_cache_stats to;
+  std::memset(&to, 0x5a, sizeof to);
+  to.struct_size = offsetof(hemilight_cache_stats, seconds);
+  capi::write_sized(from, &to);
+  CHECK(to.hemicubes == 7);
+  CHECK(to.records == 5);
+  hemilight_cache_stats untouched;
+  std::memset(&untouched, 0x5a, sizeof untouched);
+  CHECK(std::memcmp(&to.seconds, &untouched.seconds, sizeof to.seconds) == 0);
+  CHECK(std::memcmp(&to.invalid_samples, &untouched.invalid_samples, sizeof to.invalid_samples) == 0);
+}
