@@ -77,9 +77,9 @@ hemilight_status hemilight_sh9_irradiance(const float sh9_rgb[27], const float n
     if (!irradiance) return invalid(fn, "irradiance is NULL");
     if (!all_finite(sh9_rgb, 27)) return invalid(fn, "sh9_rgb holds a NaN or an infinity");
     if (!all_finite(normal, 3)) return invalid(fn, "normal is not finite");
-    const glm::vec3 n(normal[0], normal[1], normal[2]);
-    const float len = glm::length(n);
-    if (!(len > 0.0f) || !std::isfinite(len)) return invalid(fn, "normal has no direction (zero length)");
+    if (normal[0] == 0.0f && normal[1] == 0.0f && normal[2] == 0.0f) return invalid(fn, "normal has no direction (zero length)");
+    const glm::dvec3 nd(normal[0], normal[1], normal[2]);
+    const glm::vec3 n(nd / glm::length(nd));  // in double: tiny and huge normals work
     hemilight::sh9_rgb c;
     for (std::size_t k = 0; k < 9; ++k) c[k] = {sh9_rgb[3 * k], sh9_rgb[3 * k + 1], sh9_rgb[3 * k + 2]};
     const glm::vec3 e = hemilight::sh9_irradiance(c, n);

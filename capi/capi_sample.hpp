@@ -29,9 +29,13 @@ struct point_sampler {
 };
 
 /// Checks a point for `function`: position and normal non-NULL and finite, the normal nonzero.
+/// Any finite nonzero normal is accepted, however small or large (unit_normal).
 /// `where` prefixes the message's subject ("" or e.g. "point 7: "). On a bad point sets the error
 /// and returns INVALID_ARGUMENT, else HEMILIGHT_OK.
 hemilight_status check_point(const char* function, const std::string& where, const float* position, const float* normal);
+
+/// The unit vector of a finite nonzero normal, computed in double (tiny and huge normals work).
+glm::vec3 unit_normal(const float* normal);
 
 /// Checks a hemicube resolution for `function` (even, in [2, 4096]); as check_point.
 hemilight_status check_resolution(const char* function, int resolution);

@@ -33,13 +33,20 @@ std::string triple(const float* v) {
 
 }  // namespace
 
+glm::vec3 unit_normal(const float* normal) {
+  // In double: every finite nonzero float vector has a finite nonzero length there (squares of
+  // 1e-45 and of 3.4e38 are far inside double's range), so tiny and huge normals work.
+  const glm::dvec3 n(normal[0], normal[1], normal[2]);
+  return glm::vec3(n / glm::length(n));
+}
+
 hemilight_status check_point(const char* function, const std::string& where, const float* position, const float* normal) {
   if (!position) return invalid(function, where + "position is NULL");
   if (!normal) return invalid(function, where + "normal is NULL");
   if (!all_finite(position, 3)) return invalid(function, where + "position " + triple(position) + " is not finite");
   if (!all_finite(normal, 3)) return invalid(function, where + "normal " + triple(normal) + " is not finite");
-  const float len = glm::length(glm::vec3(normal[0], normal[1], normal[2]));
-  if (!(len > 0.0f) || !std::isfinite(len)) return invalid(function, where + "normal " + triple(normal) + " has no direction (zero length)");
+  if (normal[0] == 0.0f && normal[1] == 0.0f && normal[2] == 0.0f)
+    return invalid(function, where + "normal " + triple(normal) + " has no direction (zero length)");
   return HEMILIGHT_OK;
 }
 
@@ -61,10 +68,9 @@ void point_sampler::prepare(const hemilight_scene& scene, int resolution) {
 
 void point_sampler::sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
                            hemilight_irradiance& out) {
-  const glm::vec3 n(normal[0], normal[1], normal[2]);
-  const float len = glm::length(n);
+  const glm::vec3 unit = unit_normal(normal);
   const glm::vec3 x(position[0], position[1], position[2]);
-  raster->render(x, make_frame(n / len), resolution, buffer);
+  raster->render(x, make_frame(unit), resolution, buffer);
   const irradiance_sample s = integrator->integrate(buffer);
   hemilight_irradiance r;
   for (int ch = 0; ch < 3; ++ch) {
@@ -75,7 +81,7 @@ void point_sampler::sample(const hemilight_scene& scene, int resolution, const f
     }
   }
   if (scene.lights) {
-    const glm::vec3 e = direct_irradiance(*scene.scene, *scene.lights, x, n / len);
+    const glm::vec3 e = direct_irradiance(*scene.scene, *scene.lights, x, unit);
     for (int ch = 0; ch < 3; ++ch) r.irradiance[ch] += e[ch];
   }
   r.harmonic_mean_distance = s.harmonic_mean_distance;

@@ -108,6 +108,7 @@ static void test_sampler_matches(void) {
   float pos[3 * count], nrm[3 * count];
   hemilight_irradiance ref[count], r;
   hemilight_scene* room = make_room();
+  hemilight_scene* room_for_tiny = NULL;
   hemilight_sampler* s = NULL;
   hemilight_sampler* s16 = NULL;
   int i, same = 1;
@@ -133,6 +134,7 @@ static void test_sampler_matches(void) {
   CHECK(hemilight_sampler_create(room, 64, &s) == HEMILIGHT_OK);
   CHECK(hemilight_sampler_create(room, 16, &s16) == HEMILIGHT_OK);
   hemilight_scene_release(room);
+  room_for_tiny = make_room();
   same = 1;
   for (i = 0; i < count; ++i) {
     CHECK(hemilight_sampler_irradiance(s, pos + 3 * i, nrm + 3 * i, &r) == HEMILIGHT_OK);
@@ -140,11 +142,26 @@ static void test_sampler_matches(void) {
     CHECK(hemilight_sampler_irradiance(s16, pos + 3 * i, nrm + 3 * i, &r) == HEMILIGHT_OK);
   }
   CHECK(same);
+  /* Tiny and huge normals (their squares under- or overflow float) give the unit normal's result. */
+  {
+    const float p[3] = {0.1f, -0.2f, -0.999f}, up[3] = {0, 0, 1}, tiny[3] = {0, 0, 3e-23f}, huge[3] = {0, 0, 1e30f};
+    const float p2[3] = {-0.999f, 0.1f, 0.2f}, x_tiny[3] = {1e-22f, 0, 0}, x_unit[3] = {1, 0, 0};
+    hemilight_irradiance a, b;
+    CHECK(hemilight_sampler_irradiance(s, p, up, &a) == HEMILIGHT_OK);
+    CHECK(hemilight_sampler_irradiance(s, p, tiny, &b) == HEMILIGHT_OK);
+    CHECK(memcmp(&a, &b, sizeof a) == 0);
+    CHECK(hemilight_sampler_irradiance(s, p, huge, &b) == HEMILIGHT_OK);
+    CHECK(memcmp(&a, &b, sizeof a) == 0);
+    CHECK(hemilight_sampler_irradiance(s, p2, x_unit, &a) == HEMILIGHT_OK);
+    CHECK(hemilight_sample_irradiance(room_for_tiny, p2, x_tiny, 64, &b) == HEMILIGHT_OK);
+    CHECK(memcmp(&a, &b, sizeof a) == 0);
+  }
   /* Physically plausible: finite, positive (the emitter or lit walls are in view of every point). */
   for (i = 0; i < count; ++i) CHECK(isfinite(ref[i].irradiance[0]) && ref[i].irradiance[0] > 0.0f);
   hemilight_sampler_release(s);
   hemilight_sampler_release(s16);
   hemilight_sampler_release(NULL);
+  hemilight_scene_release(room_for_tiny);
 }
 
 static void test_sampler_closed_forms(void) {
