@@ -2,7 +2,7 @@
 (benchmarks/sweep_lights.cpp): the direct-light stage of the 654² hexagon-room bake against its
 1 s target (left), the penumbra error of each light against a 4096-sample reference (middle), and
 the cache's error on the Cornell box's indirect light against the fraction of texels given a
-hemicube, with its light as an emissive quad and as a RECT light (right)."""
+hemicube, with its light as an emissive quad and as a RECT light, per lightmap size (right)."""
 import statistics
 import sys
 
@@ -39,17 +39,24 @@ b.set_xlabel("error in penumbrae (% of the unoccluded E)")
 b.set_title("Soft shadows, default sampling vs 4096 samples")
 b.legend(fontsize=8)
 
+sizes = sorted({int(r["size"]) for r in cornell})
+styles = dict(zip(sizes, ("-", "--", "-.", ":")))
 for light, marker in (("emissive_quad", "o"), ("rect", "s")):
-    for n, color in ((64, "tab:blue"), (256, "tab:green")):
-        pts = sorted((r for r in cornell if r["light"] == light and int(r["resolution"]) == n), key=lambda r: r["hemicube_fraction"])
-        c.plot([100 * r["hemicube_fraction"] for r in pts], [100 * r["rms_error"] for r in pts], marker=marker, color=color,
-               linestyle="-" if light == "rect" else ":", label=f"{light.replace('_', ' ')}, N = {n}")
+    for size in sizes:
+        for n, color in ((64, "tab:blue"), (256, "tab:green")):
+            pts = sorted((r for r in cornell if r["light"] == light and int(r["resolution"]) == n and int(r["size"]) == size),
+                         key=lambda r: r["hemicube_fraction"])
+            if not pts:
+                continue
+            c.plot([100 * r["hemicube_fraction"] for r in pts], [100 * r["rms_error"] for r in pts], marker=marker, color=color,
+                   linestyle=styles[size] if light == "rect" else ":", alpha=1.0 if light == "rect" else 0.5,
+                   label=f"{light.replace('_', ' ')}, {size}², N = {n}")
 c.scatter([3, 10], [3, 1], marker="*", s=150, color="k", zorder=5, label="targets (3% at 3%, 1% at 10%)")
 c.set_xscale("log")
 c.set_yscale("log")
 c.set_xlabel("hemicubes per sampled texel and bounce (%)")
 c.set_ylabel("relative RMS of the indirect part (%)")
-c.set_title("Cornell box indirect (3 bounces) vs per texel N = 256")
+c.set_title("Cornell indirect (3 bounces) vs per texel N = 256")
 c.legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(f"{out}/lights.png", dpi=110)

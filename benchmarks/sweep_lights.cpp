@@ -1,9 +1,11 @@
 // Lights (lights.hpp) in bakes: cost, penumbra accuracy and the cache on the indirect part.
 //   usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K]
+//                       [--cornell-sizes 128,256,512]
 // Writes OUT_PREFIX_direct.csv, OUT_PREFIX_penumbra.csv and OUT_PREFIX_cornell.csv (a trailing
 // "_sweep.csv" or ".csv" is dropped from OUT_PREFIX: `bash benchmarks/run.sh lights` passes
 // docs/bench/lights_sweep.csv and gets docs/bench/lights_*.csv, drawn by plot_lights.py).
-// About 12 minutes on two cores (the Cornell references: a hemicube per texel at N = 256).
+// About 50 minutes on two cores (the Cornell references: a hemicube per texel at N = 256, up to
+// 512 x 512: 14 minutes alone).
 //
 // direct: the hexagon room at tessellation 3 (1062 triangles), 654 x 654, N = 64, one bounce, two
 //   threads, lit by the sky through its window and by seven lights: the soft sun of
@@ -19,7 +21,8 @@
 //   (0 < visibility < 1) and a deterministic tenth of the others. Per light: RMS and largest
 //   |E - E_ref| / E_unoccluded over the reference's penumbra points, and the points where the
 //   default's probes agreed (visibility 0 or 1) although the reference differs by over 1%.
-// cornell: the Cornell box, 128 x 128, 3 bounces, indirect only (what the cache interpolates),
+// cornell: the Cornell box at 128 x 128, 256 x 256 and 512 x 512 (--cornell-sizes; the emissive
+//   quad at 128 x 128 only), 3 bounces, indirect only (what the cache interpolates),
 //   with its light as the emissive quad (hemicubes see it) and as a RECT light (direct light per
 //   texel, the cache sees only the bounces): the cached bake at N = 64 and 256 for several
 //   error thresholds against a hemicube-per-texel bake at N = 256 of the same lighting: hemicube
@@ -38,6 +41,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -251,44 +255,51 @@ double relative_rms(const bake_result& a, const bake_result& ref) {
   return den > 0.0 ? std::sqrt(num / den) : 0.0;
 }
 
-void cornell(const std::string& path) {
+// The cache on indirect light at each lightmap size in `sizes`: the emissive quad (at 128 x 128
+// only: it is the slow half, and its trend is the RECT's) and the RECT light; the cached bakes at
+// N = 64 and 256 for each error threshold against a hemicube per texel at N = 256.
+void cornell(const std::string& path, const std::vector<int>& sizes) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
     std::fprintf(stderr, "cannot write %s\n", path.c_str());
     std::exit(1);
   }
-  std::fprintf(f, "light,resolution,error_threshold,sampled_texels,hemicubes,hemicube_fraction,seconds,rms_error,reference_seconds\n");
-  const int size = 128, bounces = 3;
-  for (const bool rect : {false, true}) {
-    lit_scene ls = rect ? cornell_box_rect_light() : lit_scene{cornell_box(), {}};
-    generate_lightmap_uvs(ls.mesh, size, 2);
-    bake_input in;
-    in.scene = ls.mesh.desc();
-    bake_options o;
-    o.width = o.height = size;
-    o.bounces = bounces;
-    o.indirect_only = true;
-    o.thread_count = 2;
-    o.lights = ls.lights;
-    o.use_cache = false;
-    o.resolution = 256;
-    const bake_result ref = bake_lightmap(in, o);
-    std::printf("cornell (%s): reference (hemicube per texel, N = 256): %.1f s\n", rect ? "rect light" : "emissive quad",
-                ref.stats.seconds);
-    o.use_cache = true;
-    for (const int n : {64, 256})
-      for (const float a : {0.1f, 0.2f, 0.35f, 0.5f, 0.7f, 1.0f}) {
-        o.resolution = n;
-        o.cache.error_threshold = a;
-        const bake_result r = bake_lightmap(in, o);
-        const double fraction = double(r.stats.hemicubes) / double(r.stats.sampled_texels * std::size_t(bounces));
-        const double rms = relative_rms(r, ref);
-        std::printf("  N = %d, a = %.2f: %.2f%% hemicubes, RMS %.4f, %.2f s\n", n, double(a), 100.0 * fraction, rms, r.stats.seconds);
-        std::fprintf(f, "%s,%d,%.2f,%zu,%zu,%.5f,%.3f,%.5f,%.2f\n", rect ? "rect" : "emissive_quad", n, double(a),
-                     r.stats.sampled_texels, r.stats.hemicubes, fraction, r.stats.seconds, rms, ref.stats.seconds);
-        std::fflush(f);
-      }
-  }
+  std::fprintf(f, "light,size,resolution,error_threshold,sampled_texels,hemicubes,hemicube_fraction,seconds,rms_error,reference_seconds\n");
+  const int bounces = 3;
+  for (const int size : sizes)
+    for (const bool rect : {false, true}) {
+      if (!rect && size != 128) continue;
+      lit_scene ls = rect ? cornell_box_rect_light() : lit_scene{cornell_box(), {}};
+      generate_lightmap_uvs(ls.mesh, size, 2);
+      bake_input in;
+      in.scene = ls.mesh.desc();
+      bake_options o;
+      o.width = o.height = size;
+      o.bounces = bounces;
+      o.indirect_only = true;
+      o.thread_count = 2;
+      o.lights = ls.lights;
+      o.use_cache = false;
+      o.resolution = 256;
+      const bake_result ref = bake_lightmap(in, o);
+      std::printf("cornell %d^2 (%s): reference (hemicube per texel, N = 256): %.1f s\n", size, rect ? "rect light" : "emissive quad",
+                  ref.stats.seconds);
+      std::fflush(stdout);
+      o.use_cache = true;
+      for (const int n : {64, 256})
+        for (const float a : {0.1f, 0.2f, 0.35f, 0.5f, 0.7f, 1.0f}) {
+          o.resolution = n;
+          o.cache.error_threshold = a;
+          const bake_result r = bake_lightmap(in, o);
+          const double fraction = double(r.stats.hemicubes) / double(r.stats.sampled_texels * std::size_t(bounces));
+          const double rms = relative_rms(r, ref);
+          std::printf("  N = %d, a = %.2f: %.2f%% hemicubes, RMS %.4f, %.2f s\n", n, double(a), 100.0 * fraction, rms, r.stats.seconds);
+          std::fflush(stdout);
+          std::fprintf(f, "%s,%d,%d,%.2f,%zu,%zu,%.5f,%.3f,%.5f,%.2f\n", rect ? "rect" : "emissive_quad", size, n, double(a),
+                       r.stats.sampled_texels, r.stats.hemicubes, fraction, r.stats.seconds, rms, ref.stats.seconds);
+          std::fflush(f);
+        }
+    }
   std::fclose(f);
 }
 
@@ -296,7 +307,7 @@ void cornell(const std::string& path) {
 
 int main(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K]\n");
+    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K] [--cornell-sizes 128,256,512]\n");
     return 2;
   }
   // run.sh passes docs/bench/lights_sweep.csv: the prefix is then docs/bench/lights.
@@ -309,11 +320,17 @@ int main(int argc, char** argv) {
   int runs = 3;
   std::string only = "direct,penumbra,cornell";
   direct_options tested;  // the defaults unless --penumbra-samples
+  std::vector<int> cornell_sizes = {128, 256, 512};
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--runs") runs = std::max(1, std::atoi(argv[i + 1]));
     else if (a == "--only") only = argv[i + 1];
     else if (a == "--penumbra-samples") tested.penumbra_samples = std::atoi(argv[i + 1]);
+    else if (a == "--cornell-sizes") {
+      cornell_sizes.clear();
+      std::stringstream list(argv[i + 1]);
+      for (std::string item; std::getline(list, item, ',');) cornell_sizes.push_back(std::max(16, std::atoi(item.c_str())));
+    }
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -323,7 +340,7 @@ int main(int argc, char** argv) {
   std::printf("load average before: %s\n", load_average().c_str());
   if (wants("direct")) direct_target(prefix + "_direct.csv", runs);
   if (wants("penumbra")) penumbra(prefix + "_penumbra.csv", tested);
-  if (wants("cornell")) cornell(prefix + "_cornell.csv");
+  if (wants("cornell")) cornell(prefix + "_cornell.csv", cornell_sizes);
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
 }

@@ -242,12 +242,13 @@ typedef struct hemilight_irradiance {
  * a scene that has lights (hemilight_scene_with_lights), irradiance also holds their direct
  * irradiance at the point (shadow rays from the point offset along the normal by 1e-4 x the
  * scene's size); the gradients, distances and backface_fraction are the hemicube's alone.
- * The normal need not be unit length (it is normalised) but must be finite and nonzero. The point
+ * The normal need not be unit length (it is normalised, in double: any finite nonzero vector works,
+ * 1e-30 or 1e30 long alike) but must be finite and nonzero. The point
  * itself does not see the surface it lies on; offset it from the surface if that surface is not in
  * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
  * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
  * normal, a zero normal, N odd or outside [2, 4096].
- * Cost: one hemicube (Cornell box, N = 64: about 45 us on one core, docs/capi.md). Each thread
+ * Cost: one hemicube (Cornell box, N = 64: about 25 us on one core, docs/capi.md). Each thread
  * keeps the tables of the last N it used up to N = 512 (about 40 bytes per hemicube texel, 3 N^2:
  * 0.5 MB at N = 64, 31 MB at N = 512) between calls, but no reference to the scene; the first call
  * on a thread for a new N builds them (~5 ms at N = 64). Above N = 512 every call builds its own.
@@ -273,7 +274,7 @@ HEMILIGHT_API hemilight_status hemilight_sampler_create(const hemilight_scene* s
 
 /* hemilight_sample_irradiance at the sampler's scene and N: bitwise the same result for the same
  * point. Errors (out untouched): as hemilight_sample_irradiance, plus a sampler in use by another
- * thread. Cost: one hemicube, nothing else (Cornell box, N = 64: about 45 us on one core). */
+ * thread. Cost: one hemicube, nothing else (Cornell box, N = 64: about 25 us on one core). */
 HEMILIGHT_API hemilight_status hemilight_sampler_irradiance(hemilight_sampler* sampler, const float position[3],
                                                             const float normal[3], hemilight_irradiance* out);
 
@@ -311,8 +312,9 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight
  * over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0 and a non-finite position, named by
  * its index ("point 7: position (0, nan, 1) is not finite"); OUT_OF_MEMORY.
  * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
- * Cost: 2 hemicubes per probe plus the lights' shadow rays (Cornell box, N = 64: ~15k probes/s on
- * two cores; docs/probes.md); tables of 36 N^2 floats per N, kept up to N = 512. */
+ * Cost: 2 hemicubes and their projections per probe plus the lights' shadow rays (Cornell box,
+ * N = 64: ~7k probes/s per core, 14k on two; docs/probes.md); tables of 36 N^2 floats per N,
+ * kept up to N = 512. */
 HEMILIGHT_API hemilight_status hemilight_sample_probes(const hemilight_scene* scene, const float* positions, size_t count,
                                                        int resolution, int thread_count, float* sh9_rgb);
 

@@ -90,9 +90,9 @@ struct probe_result {
 /// Errors (error(invalid_argument), naming what): a null scene or positions with count > 0, a
 /// non-finite position ("positions[7].y is nan"), an invalid resolution, a negative
 /// thread_count, bad direct options, an invalid texture or one on a scene without lightmap UVs.
-/// Cost: 2 hemicubes per point (Cornell box, N = 64: about
-/// 2 x 30 us on one core) plus the lights' shadow rays; tables of 36 N^2 floats per N (cached
-/// up to N = 512).
+/// Cost: 2 hemicubes and their projections per point (Cornell box, N = 64: ~140 us on one core,
+/// 7k probes/s; docs/probes.md) plus the lights' shadow rays; tables of 36 N^2 floats per N
+/// (cached up to N = 512).
 probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* positions, std::size_t count,
                            const probe_options& options = {});
 
