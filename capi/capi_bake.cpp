@@ -5,6 +5,7 @@
 
 #include "hemilight/bake.hpp"
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +15,45 @@ namespace {
 using hemilight::capi::all_finite;
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
+
+// What is wrong with one material, in the caller's terms ("meshes[1].materials[3].emission[2] = -1
+// ..."), or "".
+std::string check_material(const hemilight_bake_material& m, const std::string& name) {
+  for (int c = 0; c < 3; ++c) {
+    if (!(m.emission[c] >= 0.0f && m.emission[c] <= hemilight::max_radiance))
+      return name + ".emission[" + std::to_string(c) + "] = " + std::to_string(m.emission[c]) +
+             "; it must be finite, >= 0 and at most 1e30";
+    if (!(m.albedo[c] >= 0.0f && m.albedo[c] <= 1.0f))
+      return name + ".albedo[" + std::to_string(c) + "] = " + std::to_string(m.albedo[c]) + "; it must be in [0, 1]";
+  }
+  if (m.two_sided != 0 && m.two_sided != 1) return name + ".two_sided = " + std::to_string(m.two_sided) + "; it must be 0 or 1";
+  return {};
+}
+
+// What is wrong with one mesh's arrays, naming the mesh and the index within it, or "". (The
+// baker checks the concatenated scene again; these checks keep the messages in the caller's terms.)
+std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name) {
+  for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      return name + ".positions[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
+             std::to_string(mesh.positions[i]) + "; it must be finite";
+  for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i)
+    if (!(mesh.lightmap_uvs[i] >= 0.0f && mesh.lightmap_uvs[i] <= 1.0f))
+      return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
+             ") = " + std::to_string(mesh.lightmap_uvs[i]) + "; it must be in [0, 1]";
+  if (mesh.normals)
+    for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
+      if (!std::isfinite(mesh.normals[i]))
+        return name + ".normals[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
+               std::to_string(mesh.normals[i]) + "; it must be finite";
+  if (mesh.materials) {
+    for (std::size_t t = 0; t < mesh.triangle_count; ++t)
+      if (std::string p = check_material(mesh.materials[t], name + ".materials[" + std::to_string(t) + "]"); !p.empty()) return p;
+  } else if (std::string p = check_material(mesh.material, name + ".material"); !p.empty()) {
+    return p;
+  }
+  return {};
+}
 
 hemilight::material to_material(const hemilight_bake_material& m) {
   hemilight::material r;
@@ -90,9 +130,9 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
       for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
         const float v = o.environment_rgb[i];
-        if (!(v >= 0.0f) || !std::isfinite(v))
+        if (!(v >= 0.0f && v <= hemilight::max_radiance))
           return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
-                                 "; radiance must be finite and >= 0");
+                                 "; radiance must be finite, >= 0 and at most 1e30");
         faces.pixels[i] = v;
       }
       environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
@@ -100,12 +140,17 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
                              " but environment_rgb is NULL (use 0 without an environment map)");
     }
+    if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
+      return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in (0, 1] (checked "
+                         "whatever use_cache is)");
     for (const char* f : {"indirect_only", "use_cache"}) {
       const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
       if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
     }
-    if (!all_finite(o.sky_radiance, 3) || o.sky_radiance[0] < 0 || o.sky_radiance[1] < 0 || o.sky_radiance[2] < 0)
-      return invalid(fn, "options->sky_radiance must be finite and >= 0");
+    for (int c = 0; c < 3; ++c)
+      if (!(o.sky_radiance[c] >= 0.0f && o.sky_radiance[c] <= hemilight::max_radiance))
+        return invalid(fn, "options->sky_radiance[" + std::to_string(c) + "] = " + std::to_string(o.sky_radiance[c]) +
+                               "; it must be finite, >= 0 and at most 1e30");
     std::vector<hemilight::light> lights;
     const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
     if (lights_status != HEMILIGHT_OK) return lights_status;
@@ -132,6 +177,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
         return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
       if (mesh.triangle_count > 0 && !mesh.indices)
         return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
+      if (const std::string problem = check_mesh(mesh, name); !problem.empty()) return invalid(fn, problem);
       const auto base = std::uint32_t(positions.size());
       for (size_t v = 0; v < mesh.vertex_count; ++v) {
         positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
@@ -166,6 +212,12 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     } catch (const hemilight::error& e) {
       return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
     }
+    // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to a texel is not.
+    const auto finite = [](const hemilight::image& img) { return all_finite(img.pixels.data(), img.pixels.size()); };
+    bool all_ok = finite(r.irradiance);
+    for (const hemilight::image& img : r.sh_l1) all_ok = all_ok && finite(img);
+    for (const hemilight::image& img : r.hl2) all_ok = all_ok && finite(img);
+    if (!all_ok) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
     std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
     if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
     if (sh_l1_rgb)

@@ -88,6 +88,11 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
         for (std::size_t i = b; i < e; ++i) r.irradiance[i] += hemilight::direct_irradiance(sc, ls, p[i], glm::normalize(nn[i]));
       });
     }
+    // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to it is not.
+    for (size_t i = 0; i < count; ++i)
+      if (!all_finite(&r.irradiance[i].x, 3))
+        return invalid(fn, "the irradiance at point " + std::to_string(i) +
+                               " overflows float (a light too intense or too close to the point?)");
     for (size_t i = 0; i < count; ++i)
       for (int c = 0; c < 3; ++c) irradiance_rgb[3 * i + size_t(c)] = r.irradiance[i][c];
     if (stats) {

@@ -42,6 +42,10 @@ hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, con
     o.sky = scene->sky;
     o.lights = scene->lights;
     const hemilight::probe_result r = hemilight::sample_probes(scene->scene, p.data(), count, o);
+    // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to a probe is not.
+    for (std::size_t i = 0; i < count; ++i)
+      if (!all_finite(&r.probes[i][0].x, 27))
+        return invalid(fn, "point " + std::to_string(i) + ": the probe overflows float (a light too intense or too close?)");
     // Step 3: out, sh9_rgb[27 i + 3 k + c].
     for (std::size_t i = 0; i < count; ++i)
       for (std::size_t k = 0; k < 9; ++k)

@@ -24,7 +24,8 @@ struct point_sampler {
   /// Binds the scene (its sky) and makes the tables for `resolution` if they are not there.
   void prepare(const hemilight_scene& scene, int resolution);
   /// One point, checked before (check_point): render, integrate, the lights' direct irradiance.
-  void sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
+  /// Returns false (out untouched) if a result is not finite.
+  bool sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
               hemilight_irradiance& out);
 };
 

@@ -66,7 +66,7 @@ void point_sampler::prepare(const hemilight_scene& scene, int resolution) {
   if (!integrator || integrator->resolution() != resolution) integrator = std::make_unique<hemicube_integrator>(resolution);
 }
 
-void point_sampler::sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
+bool point_sampler::sample(const hemilight_scene& scene, int resolution, const float* position, const float* normal,
                            hemilight_irradiance& out) {
   const glm::vec3 unit = unit_normal(normal);
   const glm::vec3 x(position[0], position[1], position[2]);
@@ -87,12 +87,18 @@ void point_sampler::sample(const hemilight_scene& scene, int resolution, const f
   r.harmonic_mean_distance = s.harmonic_mean_distance;
   r.min_distance = s.min_distance;
   r.backface_fraction = s.backface_fraction;
+  // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to it is not.
+  if (!all_finite(r.irradiance, 3) || !all_finite(&r.rotation_gradient[0][0], 9) || !all_finite(&r.translation_gradient[0][0], 9))
+    return false;
   out = r;
+  return true;
 }
 
 }  // namespace hemilight::capi
 
 namespace {
+
+const char* const overflow_message = "the irradiance overflows float (a light too intense or too close to the point?)";
 
 using hemilight::capi::check_point;
 using hemilight::capi::check_resolution;
@@ -125,7 +131,9 @@ hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const
       }
     } guard{context};
     context.prepare(*scene, resolution);
-    context.sample(*scene, resolution, position, normal, *out);
+    hemilight_irradiance r;
+    if (!context.sample(*scene, resolution, position, normal, r)) return invalid(fn, overflow_message);
+    *out = r;
     return HEMILIGHT_OK;
   });
 }
@@ -158,7 +166,9 @@ hemilight_status hemilight_sampler_irradiance(hemilight_sampler* sampler, const 
       std::atomic<bool>& busy;
       ~release_after() { busy.store(false, std::memory_order_release); }
     } guard{sampler->busy};
-    sampler->context.sample(sampler->scene, sampler->resolution, position, normal, *out);
+    hemilight_irradiance r;
+    if (!sampler->context.sample(sampler->scene, sampler->resolution, position, normal, r)) return invalid(fn, overflow_message);
+    *out = r;
     return HEMILIGHT_OK;
   });
 }
@@ -188,11 +198,18 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
     const int workers = hemilight::resolve_thread_count(thread_count);
     std::vector<hemilight::capi::point_sampler> contexts(static_cast<std::size_t>(workers));
     std::vector<hemilight_irradiance> results(count);
+    std::atomic<std::size_t> first_bad{count};  // the lowest index whose result overflowed
     hemilight::parallel_for(count, workers, 16, [&](int worker, std::size_t b, std::size_t e) {
       hemilight::capi::point_sampler& c = contexts[std::size_t(worker)];
       if (!c.raster) c.prepare(*scene, resolution);
-      for (std::size_t i = b; i < e; ++i) c.sample(*scene, resolution, positions + 3 * i, normals + 3 * i, results[i]);
+      for (std::size_t i = b; i < e; ++i)
+        if (!c.sample(*scene, resolution, positions + 3 * i, normals + 3 * i, results[i])) {
+          std::size_t seen = first_bad.load();
+          while (i < seen && !first_bad.compare_exchange_weak(seen, i)) {
+          }
+        }
     });
+    if (first_bad.load() < count) return invalid(fn, "point " + std::to_string(first_bad.load()) + ": " + overflow_message);
     // Step 3: the results out, only now that all succeeded.
     std::copy(results.begin(), results.end(), out);
     return HEMILIGHT_OK;

@@ -119,13 +119,14 @@ hemilight_status hemilight_scene_create(const float* positions, size_t vertex_co
     if (triangle_count > 0 && !indices) return invalid(fn, "indices is NULL but triangle_count is " + std::to_string(triangle_count));
     if (triangle_count > 0 && !triangle_radiance)
       return invalid(fn, "triangle_radiance is NULL but triangle_count is " + std::to_string(triangle_count));
-    if (!all_finite(sky_radiance, 3) || sky_radiance[0] < 0 || sky_radiance[1] < 0 || sky_radiance[2] < 0)
-      return invalid(fn, "sky_radiance (" + std::to_string(sky_radiance[0]) + ", " + std::to_string(sky_radiance[1]) + ", " +
-                             std::to_string(sky_radiance[2]) + ") must be finite and >= 0");
+    for (int c = 0; c < 3; ++c)
+      if (!(sky_radiance[c] >= 0.0f && sky_radiance[c] <= hemilight::max_radiance))
+        return invalid(fn, "sky_radiance (" + std::to_string(sky_radiance[0]) + ", " + std::to_string(sky_radiance[1]) + ", " +
+                               std::to_string(sky_radiance[2]) + ") must be finite, >= 0 and at most 1e30");
     for (size_t i = 0; i < 3 * triangle_count; ++i)
-      if (!(triangle_radiance[i] >= 0.0f) || !std::isfinite(triangle_radiance[i]))
+      if (!(triangle_radiance[i] >= 0.0f && triangle_radiance[i] <= hemilight::max_radiance))
         return invalid(fn, "triangle_radiance[" + std::to_string(i) + "] = " + std::to_string(triangle_radiance[i]) +
-                               " (triangle " + std::to_string(i / 3) + "); radiance must be finite and >= 0");
+                               " (triangle " + std::to_string(i / 3) + "); radiance must be finite, >= 0 and at most 1e30");
     // glm::vec3 is three packed floats: the caller's arrays are read in place by scene::create,
     // which validates positions and indices with messages naming them.
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
@@ -167,9 +168,9 @@ hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, 
       return invalid(fn, "size " + std::to_string(size) + " is out of range: 1.." + std::to_string(hemilight::cubemap_max_size));
     hemilight::cube_image faces = hemilight::cube_image::make(size, 3);
     for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
-      if (!(faces_rgb[i] >= 0.0f) || !std::isfinite(faces_rgb[i]))
+      if (!(faces_rgb[i] >= 0.0f && faces_rgb[i] <= hemilight::max_radiance))
         return invalid(fn, "faces_rgb[" + std::to_string(i) + "] = " + std::to_string(faces_rgb[i]) +
-                               "; radiance must be finite and >= 0");
+                               "; radiance must be finite, >= 0 and at most 1e30");
       faces.pixels[i] = faces_rgb[i];
     }
     auto handle = std::make_unique<hemilight_scene>();

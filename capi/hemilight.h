@@ -9,6 +9,10 @@
  *   - Every function returns hemilight_status. On failure nothing is written to the caller's
  *     outputs and hemilight_last_error() describes the problem, naming the bad argument.
  *   - No C++ exception ever leaves this library.
+ *   - On HEMILIGHT_OK every output is finite. Radiance (triangles, skies, environment maps) and
+ *     light colours are limited to 1e30 so that sums of them stay finite; a result that would
+ *     still overflow float (a light of huge intensity next to a point) fails with
+ *     INVALID_ARGUMENT ("... overflows float") and writes nothing.
  *   - Directions and positions are float[3] (x, y, z); frames are right-handed.
  *   - Radiance is in W m^-2 sr^-1 (or any consistent unit); irradiance is the integral of
  *     L cos(theta) d omega, so a uniform sky of radiance L gives pi L. No hidden 1/pi.
@@ -143,8 +147,8 @@ typedef struct hemilight_scene hemilight_scene;
 /* Creates a scene, copying the arrays (the caller may free them afterwards):
  *   positions          3 * vertex_count floats (x, y, z), finite
  *   indices            3 * triangle_count vertex indices, each < vertex_count
- *   triangle_radiance  3 * triangle_count floats (RGB per triangle), finite and >= 0
- *   sky_radiance       3 floats, finite and >= 0
+ *   triangle_radiance  3 * triangle_count floats (RGB per triangle), in [0, 1e30]
+ *   sky_radiance       3 floats, in [0, 1e30]
  * An empty scene (vertex_count = triangle_count = 0; the arrays may then be NULL) is valid: every
  * texel sees the sky. On success *out receives the scene; release it with hemilight_scene_release.
  * Errors (nothing written to *out): INVALID_ARGUMENT for a NULL pointer with a nonzero count, a
@@ -167,7 +171,7 @@ HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
  * faces_rgb: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), size x size RGB floats each,
  * face-major, finite and >= 0; copied. Directions are the scene's world axes. Release the new
  * handle with hemilight_scene_release. Errors (nothing written to *out): INVALID_ARGUMENT for NULL
- * arguments, size outside [1, 16384], negative or non-finite values (the message names the index).
+ * arguments, size outside [1, 6688], negative or non-finite values (the message names the index).
  * Cost: O(6 size^2) to copy the map. */
 HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, const float* faces_rgb,
                                                                 int size, hemilight_scene** out);
@@ -420,7 +424,8 @@ static inline void hemilight_cache_stats_init(hemilight_cache_stats* stats) {
  * hemicube sees mostly back faces) are filled from valid records around them.
  * irradiance_rgb receives 3 * count floats; stats may be NULL.
  * Errors (nothing written): INVALID_ARGUMENT for NULL scene/positions/normals/options/output,
- * count 0, NaN/Inf positions, non-unit normals, options out of range (the message names the
+ * count 0, NaN/Inf positions, points spanning more than 1e18 units (their squared distances must
+ * fit in float), non-unit normals, options or struct_size out of range (the message names the
  * field); CANCELLED when the progress callback returned 0. */
 HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions,
                                                           const float* normals, size_t count,
@@ -469,7 +474,7 @@ typedef struct hemilight_bake_options {
    * environment_size x environment_size RGB floats each, face-major (the layout of
    * hemilight_scene_with_environment), finite and >= 0, read during the call only. Where a hemicube
    * texel hits nothing it sees the map's radiance along its world direction (seamless bilinear)
-   * instead of sky_radiance. environment_size: 1..16384 with a map, 0 without. */
+   * instead of sky_radiance. environment_size: 1..6688 with a map, 0 without. */
   const float* environment_rgb;
   int environment_size;
   /* Optional lights (default NULL, 0): light_count lights, read during the call only. Their direct
@@ -557,7 +562,7 @@ HEMILIGHT_API hemilight_status hemilight_bake_lightmap_directional(const hemilig
 /* ---- cube maps -----------------------------------------------------------------------------------
  * Float RGB cube maps: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), face-major, each
  * size x size texels, rows along the GL t coordinate, columns along s, RGB interleaved
- * (6 x size x size x 3 floats). Face sizes are 1..16384. A mip chain is its levels one after
+ * (6 x size x size x 3 floats). Face sizes are 1..6688. A mip chain is its levels one after
  * another, level i of size max(1, size >> i), down to 1 x 1 (hemilight_cubemap_chain_floats).
  * Details, formulas and measured accuracy: include/hemilight/cubemap.hpp, docs/cubemap.md. */
 
@@ -580,7 +585,7 @@ typedef enum hemilight_cube_sampling {
 } hemilight_cube_sampling;
 
 /* Unit direction of texel (x, y) of `face` (0..5) of a size x size face under a mapping.
- * Errors: INVALID_ARGUMENT for size outside [1, 16384], face outside [0, 5], x or y outside
+ * Errors: INVALID_ARGUMENT for size outside [1, 6688], face outside [0, 5], x or y outside
  * [0, size), an unknown fixup, or direction NULL (nothing written). Cost: O(1). */
 HEMILIGHT_API hemilight_status hemilight_cubemap_texel_direction(int size, int face, int x, int y,
                                                                  hemilight_edge_fixup fixup, float direction[3]);
@@ -593,7 +598,7 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_texel_direction(int size, int f
  * result is not normalised; the zero vector gives the zero vector. Also available as GLSL and HLSL
  * (include/hemilight/shaders/cubemap_fixup.glsl, .hlsl) with the same behaviour.
  * out_direction may alias direction. Errors: INVALID_ARGUMENT for NULL pointers, NaN or Inf in
- * direction or lod, size outside [1, 16384]. */
+ * direction or lod, size outside [1, 6688]. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_fixup_lookup(const float direction[3], int size, float lod,
                                                               float out_direction[3]);
 
@@ -603,7 +608,7 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_fixup_lookup(const float direct
  * the lobe spans many texels (max relative error ~0.3% against brute force on a sky with a sun,
  * docs/cubemap.md).
  * Uses all cores; deterministic. output holds 6 x output_size^2 x 3 floats and must not overlap
- * input. Errors: INVALID_ARGUMENT for NULL pointers, sizes outside [1, 16384], p not finite and
+ * input. Errors: INVALID_ARGUMENT for NULL pointers, sizes outside [1, 6688], p not finite and
  * > 0, an unknown fixup, or NaN/Inf in input (output untouched); OUT_OF_MEMORY. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_filter_cosine_power(const float* input, int input_size,
                                                                      float specular_power,
@@ -619,7 +624,7 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_filter_irradiance(const float* 
                                                                    int use_sh, float* output);
 
 /* Number of floats and levels of an RGB mip chain whose top level has size `size` (levels down to
- * 1 x 1). Either output may be NULL. Errors: INVALID_ARGUMENT for size outside [1, 16384]. */
+ * 1 x 1). Either output may be NULL. Errors: INVALID_ARGUMENT for size outside [1, 6688]. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_chain_floats(int size, size_t* floats, int* levels);
 
 /* A radiance mip chain (layout above) from an RGB cube map: level i is the cosine-power filter
@@ -633,11 +638,11 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_filter_mip_chain(const float* i
                                                                   float lobe_texels, float* output, size_t capacity);
 
 /* Samples an RGB cube map or mip chain (level_count levels, layout above, top-level size `size`)
- * along `direction` (need not be unit) at an explicit lod (clamped to [0, level_count - 1],
+ * along `direction` (need not be unit: any finite nonzero vector, 1e-45 or 1e38 long alike) at an explicit lod (clamped to [0, level_count - 1],
  * trilinear between levels), bilinear per face or seamless. apply_fixup = 1 first transforms the
  * direction with hemilight_cubemap_fixup_lookup(direction, size, lod) (lod < 0 is read as the
  * fixed-size form and samples level 0): use it for STRETCH-filtered maps. Errors:
- * INVALID_ARGUMENT for NULL pointers, size outside [1, 16384], level_count outside
+ * INVALID_ARGUMENT for NULL pointers, size outside [1, 6688], level_count outside
  * [1, levels of size], NaN/Inf direction or lod, a zero direction, an unknown sampling. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_sample(const float* chain, int size, int level_count,
                                                         const float direction[3], float lod,

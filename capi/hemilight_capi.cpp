@@ -129,7 +129,10 @@ hemilight_status hemilight_exr_save_rgb(const char* path, const float* rgb, int 
     if (!path) return invalid(fn, "path is NULL");
     if (!rgb) return invalid(fn, "rgb is NULL");
     if (!check_size(fn, "width", width, st) || !check_size(fn, "height", height, st)) return st;
-    hemilight::image img = hemilight::image::make(width, height, 3);  // validates the size limit
+    if (std::size_t(width) * std::size_t(height) > hemilight::max_image_pixels)
+      return invalid(fn, "width x height = " + std::to_string(width) + " x " + std::to_string(height) +
+                             " is over the limit of 2^28 pixels");
+    hemilight::image img = hemilight::image::make(width, height, 3);
     std::copy(rgb, rgb + img.pixels.size(), img.pixels.begin());
     hemilight::write_exr(path, img, half_float ? hemilight::exr_pixel_type::half16 : hemilight::exr_pixel_type::float32);
     return HEMILIGHT_OK;
@@ -159,6 +162,9 @@ hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* f
     if (!path) return invalid(fn, "path is NULL");
     if (!faces) return invalid(fn, "faces is NULL");
     if (!check_size(fn, "size", size, st)) return st;
+    if (size > hemilight::cubemap_max_size)
+      return invalid(fn, "size " + std::to_string(size) + " is over the limit of " + std::to_string(hemilight::cubemap_max_size) +
+                             " (six faces of at most 2^28 pixels in all)");
     hemilight::cube_image cube = hemilight::cube_image::make(size, 3);
     std::copy(faces, faces + cube.pixels.size(), cube.pixels.begin());
     hemilight::write_exr_cubemap(path, cube,

@@ -191,6 +191,7 @@ void check_options(const bake_options& o) {
     throw_invalid_argument(std::string(who) + ": dilation " + std::to_string(o.dilation) + " must be >= -1");
   if (o.thread_count < 0)
     throw_invalid_argument(std::string(who) + ": thread_count " + std::to_string(o.thread_count) + " must be >= 0");
+  validate_cache_options(o.cache, std::string(who) + ": cache");  // whatever use_cache says
   try {
     validate_lights(o.lights.data(), o.lights.size());
     validate_direct_options(o.direct);

@@ -728,20 +728,10 @@ float median_spacing(const glm::vec3* p, std::size_t count, float diagonal, cons
   return nn[nn.size() / 2];
 }
 
-void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const cache_options& o) {
-  const std::string fn = "cache_irradiance: ";
-  if (count == 0) throw_invalid_argument(fn + "count is 0: there are no points");
-  if (!positions) throw_invalid_argument(fn + "positions is NULL");
-  if (!normals) throw_invalid_argument(fn + "normals is NULL");
-  for (std::size_t i = 0; i < count; ++i) {
-    const glm::vec3 &p = positions[i], &n = normals[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite");
-    const float len = glm::length(n);
-    if (!(std::fabs(len - 1.0f) <= 1e-3f))
-      throw_invalid_argument(fn + "normals[" + std::to_string(i) + "] = " + vec_str(n) + " has length " +
-                             std::to_string(len) + "; it must be a unit vector");
-  }
+}  // namespace
+
+void validate_cache_options(const cache_options& o, const std::string& who) {
+  const std::string fn = who + ": ";
   if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
     throw_invalid_argument(fn + "error_threshold is " + std::to_string(o.error_threshold) + "; it must be in (0, 1]");
   if (!(o.min_radius >= 0.0f) || !std::isfinite(o.min_radius))
@@ -760,6 +750,33 @@ void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t 
   if (!(o.invalid_backface_fraction >= 0.0f && o.invalid_backface_fraction <= 1.0f))
     throw_invalid_argument(fn + "invalid_backface_fraction is " + std::to_string(o.invalid_backface_fraction) +
                            "; it must be in [0, 1]");
+}
+
+namespace {
+
+void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const cache_options& o) {
+  const std::string fn = "cache_irradiance: ";
+  if (count == 0) throw_invalid_argument(fn + "count is 0: there are no points");
+  if (!positions) throw_invalid_argument(fn + "positions is NULL");
+  if (!normals) throw_invalid_argument(fn + "normals is NULL");
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (std::size_t i = 0; i < count; ++i) {
+    const glm::vec3 &p = positions[i], &n = normals[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite");
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+    const float len = glm::length(n);
+    if (!(std::fabs(len - 1.0f) <= 1e-3f))
+      throw_invalid_argument(fn + "normals[" + std::to_string(i) + "] = " + vec_str(n) + " has length " +
+                             std::to_string(len) + "; it must be a unit vector");
+  }
+  // Distances between points are squared in float (weights, grids): the extent must keep them finite.
+  const double diagonal = glm::length(hi - lo);
+  if (diagonal > max_point_extent)
+    throw_invalid_argument(fn + "the points span " + std::to_string(diagonal) + " units (bounding-box diagonal); at most " +
+                           std::to_string(max_point_extent) + " is supported (squared distances must fit in float)");
+  validate_cache_options(o, "cache_irradiance");
 }
 
 // 64-bit mix (splitmix64 finaliser): a fixed pseudo-random order of the points.

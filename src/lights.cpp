@@ -359,6 +359,9 @@ void validate_lights(const light* lights, std::size_t count) {
     for (int c = 0; c < 3; ++c)
       if (l.color[c] < 0.0f)
         throw_invalid_argument(field(i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) + " is negative");
+      else if (l.color[c] > max_radiance)
+        throw_invalid_argument(field(i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) +
+                               " is over 1e30 (max_radiance: sums of it must stay finite)");
     if (l.type != light_type::point && normalize_robust(l.direction) == glm::vec3(0.0f))
       throw_invalid_argument(field(i, "direction") + " is zero");
     if (l.type != light_type::rect && l.radius < 0.0f)

@@ -17,9 +17,9 @@ const char* const axis_name[3] = {"x", "y", "z"};
 
 void check_non_negative(const std::string& name, const glm::vec3& v) {
   for (int c = 0; c < 3; ++c)
-    if (!(v[c] >= 0.0f) || !std::isfinite(v[c]))
+    if (!(v[c] >= 0.0f && v[c] <= max_radiance))
       throw_invalid_argument("scene::create: " + name + "." + "rgb"[c] + " is " + std::to_string(v[c]) +
-                             "; it must be finite and >= 0");
+                             "; it must be finite, >= 0 and at most 1e30 (max_radiance)");
 }
 
 }  // namespace

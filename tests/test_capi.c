@@ -87,7 +87,8 @@ static void test_exr(const char* dir) {
   CHECK_FAILS(hemilight_exr_save_rgb(path, rgb, 4, -3, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT, "height is -3");
   CHECK_FAILS(hemilight_exr_save_rgb(path, NULL, 4, 3, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT, "rgb is NULL");
   CHECK_FAILS(hemilight_exr_save_rgb(NULL, rgb, 4, 3, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT, "path is NULL");
-  CHECK_FAILS(hemilight_exr_save_rgb(path, rgb, 1 << 20, 1 << 20, 0), HEMILIGHT_ERROR_OUT_OF_MEMORY, "exceeds the limit");
+  CHECK_FAILS(hemilight_exr_save_rgb(path, rgb, 1 << 20, 1 << 20, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_exr_save_rgb: width x height = 1048576 x 1048576 is over the limit of 2^28 pixels");
 
   /* cube maps */
   faces = (float*)malloc(sizeof(float) * 6 * 8 * 8 * 3);

@@ -204,7 +204,7 @@ int main(void) {
   memcpy(bad_uv, uv_b, sizeof bad_uv);
   bad_uv[2] = 1.25f;
   meshes[1].lightmap_uvs = bad_uv;
-  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "outside [0, 1]");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes[1].lightmap_uvs[2] (vertex 1, u) = 1.25");
   bad_uv[2] = bad_uv[0]; /* vertex 1 = vertex 0 in UV: triangle 0 of mesh 1 (triangle 2 overall) is flat in UV */
   bad_uv[3] = bad_uv[1];
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "zero area in lightmap UV space");
@@ -217,7 +217,7 @@ int main(void) {
   memcpy(bad_pos, pos_b, sizeof bad_pos);
   bad_pos[4] = (float)NAN;
   meshes[1].positions = bad_pos;
-  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "not finite");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes[1].positions[4] (vertex 1) = nan");
   meshes[1].positions = pos_b;
   meshes[1].lightmap_uvs = NULL;
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lightmap_uvs is NULL");

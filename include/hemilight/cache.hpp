@@ -320,9 +320,19 @@ struct cache_result {
   cache_stats stats;
 };
 
+/// Checks the options as cache_irradiance does (the ranges listed there) and throws
+/// error(invalid_argument) naming the field, the message starting with `who` (e.g.
+/// "bake_lightmap: error_threshold is nan; ..."). Bakes call it whatever use_cache says. Cost: O(1).
+void validate_cache_options(const cache_options& options, const std::string& who);
+
+/// Largest extent (bounding-box diagonal, scene units) of the points cache_irradiance takes: the
+/// cache squares distances between points in float.
+inline constexpr double max_point_extent = 1e18;
+
 /// Irradiance at `count` points (positions and unit normals, world space) through the cache.
 /// Throws error(invalid_argument) naming the first bad input: count == 0, NULL arrays, a NaN/Inf
-/// position, a normal whose length is not 1 within 1e-3 (zero normals included), options out of
+/// position, points spanning more than max_point_extent, a normal whose length is not 1 within
+/// 1e-3 (zero normals included), options out of
 /// range (error_threshold not in (0, 1], negative or NaN radii, min_radius > max_radius when both
 /// are given, second_opinion negative or not finite, nearby_opinion not in [0, 16],
 /// sole_record_reach not in (0, 1], invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned

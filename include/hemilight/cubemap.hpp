@@ -47,9 +47,10 @@ enum class edge_fixup : int {
   warp = 2,     ///< NVTT warp: u = c + a c^3 on the centre c, a = n^2/(n-1)^3
 };
 
-/// Largest cube-map face size hemilight's cube-map functions accept (6 x 16384^2 RGBA floats
-/// is 25 GiB; anything larger is certainly a mistake).
-inline constexpr int cubemap_max_size = 16384;
+/// Largest cube-map face size hemilight's cube-map functions accept: the largest whose six faces
+/// fit in max_image_pixels (image_io.hpp: 2^28 pixels), so every size in [1, 6688] can be
+/// allocated, filtered and written (6 x 6688^2 RGB floats is 3 GiB).
+inline constexpr int cubemap_max_size = 6688;
 
 /// Face coordinate u in [-1, 1] of texel index x (0..n-1) of an n-texel face edge under a
 /// mapping (table above). n = 1 gives 0. Computed in double; symmetric (u(n-1-x) = -u(x)) and

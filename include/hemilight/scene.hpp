@@ -41,6 +41,11 @@ struct material {
   bool two_sided = false;    ///< seen from behind, a two-sided triangle looks like its front
 };
 
+/// Largest radiance (any channel, W m^-2 sr^-1) a scene, sky, environment map or light colour may
+/// hold: sums of it over hemicubes, bounces and lights stay finite in float. Larger finite values
+/// are rejected with error(invalid_argument) where they are given.
+inline constexpr float max_radiance = 1e30f;
+
 /// Largest vertex and triangle counts scene::create accepts (2^31 - 1): indices are uint32 and
 /// the rasterizer keeps triangle numbers in 32 bits. Larger counts get error(out_of_memory).
 inline constexpr std::size_t max_scene_elements = (std::size_t(1) << 31) - 1;

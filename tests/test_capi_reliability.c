@@ -1,0 +1,190 @@
+/* C99 regression tests of the C ABI's reliability fixes, one per reproducer of a fuzzing run:
+ * tiny and huge normals and directions (their squares under- or overflow float), points spanning
+ * more than float can square, radiance near FLT_MAX and lights whose irradiance overflows (refused,
+ * never +inf on OK), the EXR writers' and cube maps' size limits, and bake errors in the caller's
+ * terms (the mesh and the index within it). References: closed forms (a uniform sky gives pi L)
+ * and the same call with the unit vector. Prints failing checks and "N passed, N failed". */
+#include "capi_check.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double pi = 3.14159265358979323846;
+
+static void test_normals_and_radiance(void) {
+  /* A quad emitter (radiance 1) above the origin, off to the +x side, facing down. */
+  const float pos[] = {0.2f, -0.5f, 1.0f, 0.2f, 0.5f, 1.0f, 1.2f, 0.5f, 1.0f, 1.2f, -0.5f, 1.0f};
+  const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  const float rad[] = {1, 1, 1, 1, 1, 1}, big[] = {FLT_MAX, 1, 1, 1, 1, 1};
+  const float sky0[3] = {0, 0, 0}, skymax[3] = {FLT_MAX, 1, 1};
+  const float p[3] = {0, 0, 0};
+  const float unit[3] = {0.70710678f, 0, 0.70710678f};
+  const float normals[][3] = {{7.071e-23f, 0, 7.071e-23f}, {1e-30f, 0, 1e-30f}, {1e30f, 0, 1e30f}, {3e19f, 0, 3e19f}};
+  hemilight_scene *s = NULL, *bad = NULL;
+  hemilight_irradiance ref, r;
+  int i;
+  CHECK(hemilight_scene_create(pos, 4, idx, 2, rad, sky0, &s) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance(s, p, unit, 64, &ref) == HEMILIGHT_OK);
+  for (i = 0; i < 4; ++i) {
+    CHECK(hemilight_sample_irradiance(s, p, normals[i], 64, &r) == HEMILIGHT_OK);
+    /* The same direction: the same frame to float rounding of the unit vector (1e-5). */
+    CHECK(fabs(r.irradiance[0] - ref.irradiance[0]) <= 1e-5 * ref.irradiance[0]);
+  }
+  /* Radiance above 1e30 (max_radiance) is refused where it is given. */
+  bad = (hemilight_scene*)&passed;
+  CHECK_FAILS(hemilight_scene_create(pos, 4, idx, 2, rad, skymax, &bad), HEMILIGHT_ERROR_INVALID_ARGUMENT, "at most 1e30");
+  CHECK_FAILS(hemilight_scene_create(pos, 4, idx, 2, big, sky0, &bad), HEMILIGHT_ERROR_INVALID_ARGUMENT, "triangle_radiance[0]");
+  CHECK(bad == (hemilight_scene*)&passed);
+  hemilight_scene_release(s);
+}
+
+static void test_light_overflow(void) {
+  /* A point light of intensity 1e30 a hair above the point: I / d^2 overflows float. Refused,
+   * never OK with +inf. */
+  const float sky0[3] = {0, 0, 0}, p[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  hemilight_scene *empty = NULL, *lit = NULL;
+  hemilight_light l;
+  hemilight_irradiance r, untouched;
+  float sh[27], untouched_sh[27];
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky0, &empty) == HEMILIGHT_OK);
+  hemilight_light_init(&l, HEMILIGHT_LIGHT_POINT);
+  l.position[0] = 0, l.position[1] = 0, l.position[2] = 1e-10f;
+  l.color[0] = l.color[1] = l.color[2] = 1e30f;
+  CHECK(hemilight_scene_with_lights(empty, &l, 1, &lit) == HEMILIGHT_OK);
+  memset(&untouched, 0x5a, sizeof untouched);
+  r = untouched;
+  CHECK_FAILS(hemilight_sample_irradiance(lit, p, up, 8, &r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "overflows float");
+  CHECK(memcmp(&r, &untouched, sizeof r) == 0);
+  memset(untouched_sh, 0x5a, sizeof untouched_sh);
+  memcpy(sh, untouched_sh, sizeof sh);
+  CHECK_FAILS(hemilight_sample_probes(lit, p, 1, 8, 1, sh), HEMILIGHT_ERROR_INVALID_ARGUMENT, "point 0: the probe overflows");
+  CHECK(memcmp(sh, untouched_sh, sizeof sh) == 0);
+  l.color[0] = 2e30f;
+  hemilight_scene_release(lit);
+  lit = NULL;
+  CHECK_FAILS(hemilight_scene_with_lights(empty, &l, 1, &lit), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[0].color.r");
+  CHECK(lit == NULL);
+  hemilight_scene_release(empty);
+}
+
+static void test_cubemap_directions(void) {
+  /* A 2 x 2 map whose face f holds the value f + 1: the face a direction picks is visible. */
+  float map[6 * 2 * 2 * 3];
+  float rgb[3], ref[3];
+  int i, smp, fix;
+  const float dirs[][3] = {{1e-45f, 0, 0}, {1e-45f, 1e-45f, 1e-45f}, {FLT_MAX, FLT_MAX, FLT_MAX}, {-0.0f, -0.0f, 1e-40f},
+                           {0, -3e38f, 1e37f}};
+  const float units[][3] = {{1, 0, 0}, {1, 1, 1}, {1, 1, 1}, {0, 0, 1}, {0, -1, 1.0f / 30.0f}};
+  for (i = 0; i < 72; ++i) map[i] = (float)(i / 12 + 1);
+  for (i = 0; i < 5; ++i)
+    for (smp = 0; smp <= 1; ++smp)
+      for (fix = 0; fix <= 1; ++fix) {
+        rgb[0] = rgb[1] = rgb[2] = -7;
+        CHECK(hemilight_cubemap_sample(map, 2, 1, dirs[i], 0.0f, (hemilight_cube_sampling)smp, fix, rgb) == HEMILIGHT_OK);
+        CHECK(hemilight_cubemap_sample(map, 2, 1, units[i], 0.0f, (hemilight_cube_sampling)smp, fix, ref) == HEMILIGHT_OK);
+        CHECK(isfinite(rgb[0]) && fabs(rgb[0] - ref[0]) < 1e-5f);
+      }
+  CHECK(hemilight_cubemap_fixup_lookup(dirs[0], 64, 0.0f, rgb) == HEMILIGHT_OK);
+  CHECK(isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]) && rgb[0] > 0.0f);
+}
+
+static void test_cache_extent(void) {
+  const float sky[3] = {1, 1, 1};
+  const float nrm[6] = {0, 0, 1, 0, 0, 1};
+  const float half_extents[] = {1.1e19f, 2e38f};
+  float pos[6], out[6];
+  hemilight_scene* s = NULL;
+  hemilight_cache_options o;
+  int k;
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &s) == HEMILIGHT_OK);
+  hemilight_cache_options_init(&o);
+  o.resolution = 8;
+  o.thread_count = 1;
+  for (k = 0; k < 2; ++k) {
+    pos[0] = -half_extents[k], pos[1] = 0, pos[2] = 0, pos[3] = half_extents[k], pos[4] = 0, pos[5] = 0;
+    out[0] = out[3] = -7.0f;
+    CHECK_FAILS(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "the points span");
+    CHECK(out[0] == -7.0f && out[3] == -7.0f);
+  }
+  /* 1e17 apart works: a uniform sky gives pi L at both. */
+  pos[0] = -5e16f, pos[3] = 5e16f;
+  CHECK(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL) == HEMILIGHT_OK);
+  CHECK(fabs(out[0] / pi - 1.0) < 1e-5 && fabs(out[3] / pi - 1.0) < 1e-5);
+  hemilight_scene_release(s);
+}
+
+static void test_sizes_and_messages(const char* tmp) {
+  static float px[18];
+  char path[512];
+  FILE* f;
+  hemilight_scene *s = NULL, *e = NULL;
+  const float sky[3] = {1, 1, 1};
+  snprintf(path, sizeof path, "%s/reliability_over_limit.exr", tmp);
+  remove(path);
+  CHECK_FAILS(hemilight_exr_save_rgb(path, px, 16385, 16384, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_exr_save_rgb: width x height = 16385 x 16384 is over the limit");
+  CHECK_FAILS(hemilight_exr_save_cubemap_rgb(path, px, 6689, 0), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_exr_save_cubemap_rgb: size 6689 is over the limit of 6688");
+  f = fopen(path, "rb");
+  CHECK(f == NULL);
+  if (f) fclose(f);
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &s) == HEMILIGHT_OK);
+  CHECK_FAILS(hemilight_scene_with_environment(s, px, 6689, &e), HEMILIGHT_ERROR_INVALID_ARGUMENT, "out of range: 1..6688");
+  CHECK(e == NULL);
+  hemilight_scene_release(s);
+}
+
+static void test_bake_messages(void) {
+  /* Two floor quads; the second (meshes[1]) gets the bad values. */
+  static const float pa[] = {0, 0, 0, 0, 0, -1, 1, 0, -1, 1, 0, 0}, pb[] = {1, 0, 0, 1, 0, -1, 2, 0, -1, 2, 0, 0};
+  static const float ua[] = {0, 0, 0, 1, .5f, 1, .5f, 0}, ub[] = {.5f, 0, .5f, 1, 1, 1, 1, 0};
+  static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  hemilight_bake_material mats[2];
+  hemilight_bake_mesh m[2];
+  hemilight_bake_options o;
+  float out[3 * 64], untouched[3 * 64], bad_uv[8];
+  memset(m, 0, sizeof m);
+  memset(mats, 0, sizeof mats);
+  m[0].positions = pa, m[0].lightmap_uvs = ua, m[0].vertex_count = 4, m[0].indices = idx, m[0].triangle_count = 2;
+  m[1] = m[0];
+  m[1].positions = pb, m[1].lightmap_uvs = ub, m[1].materials = mats;
+  hemilight_bake_options_init(&o);
+  o.width = o.height = 8, o.resolution = 8;
+  memset(untouched, 0x5a, sizeof untouched);
+  memcpy(out, untouched, sizeof out);
+  CHECK(hemilight_bake_lightmap(m, 2, &o, out, 192, NULL, 0, NULL) == HEMILIGHT_OK);
+  memcpy(out, untouched, sizeof out);
+  mats[1].emission[2] = -1.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, out, 192, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_bake_lightmap: meshes[1].materials[1].emission[2] = -1");
+  mats[1].emission[2] = 0.0f;
+  mats[0].two_sided = 7;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, out, 192, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "meshes[1].materials[0].two_sided = 7");
+  mats[0].two_sided = 0;
+  memcpy(bad_uv, ub, sizeof bad_uv);
+  bad_uv[3] = NAN;
+  m[1].lightmap_uvs = bad_uv;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, out, 192, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "meshes[1].lightmap_uvs[3] (vertex 1, v)");
+  m[1].lightmap_uvs = ub;
+  o.error_threshold = NAN;
+  o.use_cache = 0;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, out, 192, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->error_threshold is nan");
+  CHECK(memcmp(out, untouched, sizeof out) == 0);
+}
+
+int main(int argc, char** argv) {
+  test_normals_and_radiance();
+  test_light_overflow();
+  test_cubemap_directions();
+  test_cache_extent();
+  test_sizes_and_messages(argc > 1 ? argv[1] : ".");
+  test_bake_messages();
+  printf("%d passed, %d failed\n", passed, failed);
+  return failed == 0 ? 0 : 1;
+}
