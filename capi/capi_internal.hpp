@@ -35,15 +35,25 @@ hemilight_status invalid(const char* function, const std::string& what);
 
 inline hemilight_status to_c(status s) { return static_cast<hemilight_status>(static_cast<int>(s)); }
 
+/// A C++ error's message in the C caller's terms: "read_exr: 'x.exr': ..." becomes
+/// "hemilight_exr_load_rgb: 'x.exr': ..." (the leading C++ function name, if any, replaced by the C
+/// function's); messages that already name a C function are kept.
+inline std::string c_message(const char* function, const std::string& m) {
+  if (m.compare(0, 10, "hemilight_") == 0) return m;
+  const std::size_t colon = m.find(": ");
+  if (colon != std::string::npos && m.find(' ') > colon) return std::string(function) + ": " + m.substr(colon + 2);
+  return std::string(function) + ": " + m;
+}
+
 /// Runs f() (which returns HEMILIGHT_OK or a status it set) and turns every exception into a
-/// status with a message: hemilight::error keeps its code, bad_alloc is OUT_OF_MEMORY, anything
-/// else is INTERNAL. No exception leaves.
+/// status with a message: hemilight::error keeps its code (its message named after the C
+/// function: c_message), bad_alloc is OUT_OF_MEMORY, anything else is INTERNAL. No exception leaves.
 template <class F>
 hemilight_status guarded(const char* function, F&& f) noexcept {
   try {
     return f();
   } catch (const error& e) {
-    return set_error(to_c(e.code()), e.what());
+    return set_error(to_c(e.code()), c_message(function, e.what()));
   } catch (const std::bad_alloc&) {
     return set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY, std::string(function) + ": out of memory");
   } catch (const std::exception& e) {

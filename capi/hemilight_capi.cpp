@@ -95,12 +95,12 @@ hemilight_status hemilight_exr_info(const char* path, int* width, int* height, i
   const char* fn = "hemilight_exr_info";
   return guarded(fn, [&] {
     if (!path) return invalid(fn, "path is NULL");
-    // Reading the pixels too keeps one code path for every check (truncation, channels); the
-    // cost is one decode of the file.
-    const hemilight::image img = hemilight::read_exr(path, 3);
-    if (width) *width = img.width;
-    if (height) *height = img.height;
-    if (is_cubemap) *is_cubemap = static_cast<long long>(img.height) == 6LL * img.width ? 1 : 0;
+    // The header alone (read_exr's checks but the pixels' decoding): crafted headers claiming huge
+    // images fail before anything is allocated.
+    const hemilight::exr_header_info info = hemilight::read_exr_header(path);
+    if (width) *width = info.width;
+    if (height) *height = info.height;
+    if (is_cubemap) *is_cubemap = static_cast<long long>(info.height) == 6LL * info.width ? 1 : 0;
     return HEMILIGHT_OK;
   });
 }

@@ -16,7 +16,9 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 namespace hemilight {
@@ -51,11 +53,60 @@ struct raw_read {
   Imf::Envmap envmap = Imf::ENVMAP_LATLONG;
 };
 
-raw_read read_raw(const std::string& path, int channels, const char* function) {
+// Walks the header(s) of an EXR file before OpenEXR parses them: every attribute's size must fit
+// in what is left of the file, so that a crafted size field fails here instead of making the
+// parser allocate it (a 599-byte file claiming a 1.6 GB attribute). Layout: magic, version, then
+// per part attributes (name\0 type\0 int32 size, value) ended by an empty name; multi-part files
+// end their list of headers with an empty header.
+void check_header_sizes(const std::string& path, const char* function) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(status::io, function, path, "cannot be opened");
+  in.seekg(0, std::ios::end);
+  const long long file_size = static_cast<long long>(in.tellg());
+  in.seekg(0, std::ios::beg);
+  unsigned char head[8];
+  if (!in.read(reinterpret_cast<char*>(head), 8)) fail(status::io, function, path, "not a readable EXR file (shorter than its header)");
+  if (!(head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01)) return;  // OpenEXR names the problem
+  const bool multipart = (head[5] & 0x10) != 0;  // version flag 0x1000
+  const auto read_string = [&](std::string& s) {
+    s.clear();
+    for (int i = 0; i < 256; ++i) {
+      const int c = in.get();
+      if (c == EOF) fail(status::io, function, path, "not a readable EXR file (its header is cut short)");
+      if (c == 0) return;
+      s.push_back(static_cast<char>(c));
+    }
+    fail(status::io, function, path, "not a readable EXR file (a header name is longer than 255 bytes)");
+  };
+  for (int part = 0;; ++part) {
+    std::string name, type;
+    int attributes = 0;
+    for (;; ++attributes) {
+      read_string(name);
+      if (name.empty()) break;
+      read_string(type);
+      unsigned char b[4];
+      if (!in.read(reinterpret_cast<char*>(b), 4)) fail(status::io, function, path, "not a readable EXR file (its header is cut short)");
+      const long long size = static_cast<long long>(static_cast<std::int32_t>(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
+                                                                              std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24));
+      const long long left = file_size - static_cast<long long>(in.tellg());
+      if (size < 0 || size > left)
+        fail(status::io, function, path,
+             "not a readable EXR file (header attribute '" + name + "' claims " + std::to_string(size) + " bytes; " +
+                 std::to_string(left) + " are left in the file)");
+      in.seekg(size, std::ios::cur);
+    }
+    if (!multipart || attributes == 0) return;
+    if (in.peek() == 0) return;  // the empty header that ends a multi-part list
+  }
+}
+
+raw_read read_raw(const std::string& path, int channels, const char* function, bool pixels = true) {
   check_channels_arg(channels, function, true);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(status::io, function, path, "no such file");
   if (std::filesystem::is_directory(path, ec)) fail(status::io, function, path, "is a directory, not an EXR file");
+  check_header_sizes(path, function);
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();
@@ -82,6 +133,13 @@ raw_read read_raw(const std::string& path, int channels, const char* function) {
     out.width = static_cast<int>(w);
     out.height = static_cast<int>(h);
     const std::size_t count = checked_pixel_count(w, h, 1, function);
+    // Before anything is allocated: a header claiming a huge image in a short file stops here.
+    if (!file.isComplete()) fail(status::io, function, path, "file is truncated (not all scanlines are present)");
+    if (Imf::hasEnvmap(header)) {
+      out.has_envmap = true;
+      out.envmap = Imf::envmap(header);
+    }
+    if (!pixels) return out;
     out.pixels.assign(count * static_cast<std::size_t>(out.channels), 0.0f);
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * static_cast<std::size_t>(out.channels);
@@ -90,12 +148,7 @@ raw_read read_raw(const std::string& path, int channels, const char* function) {
     for (int c = 0; c < out.channels; ++c)
       fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, out.pixels.data() + c, dw, xs, ys, 1, 1, c == 3 ? 1.0 : 0.0));
     file.setFrameBuffer(fb);
-    if (!file.isComplete()) fail(status::io, function, path, "file is truncated (not all scanlines are present)");
     file.readPixels(dw.min.y, dw.max.y);
-    if (Imf::hasEnvmap(header)) {
-      out.has_envmap = true;
-      out.envmap = Imf::envmap(header);
-    }
     return out;
   } catch (const error&) {
     throw;
@@ -223,6 +276,15 @@ cube_image cube_image::make(int size, int channels, float value) {
   cube.channels = channels;
   cube.pixels.assign(count * static_cast<std::size_t>(channels), value);
   return cube;
+}
+
+exr_header_info read_exr_header(const std::string& path) {
+  const raw_read raw = read_raw(path, 0, "read_exr_header", false);
+  exr_header_info info;
+  info.width = raw.width;
+  info.height = raw.height;
+  info.cube = static_cast<long long>(raw.height) == 6LL * raw.width && (!raw.has_envmap || raw.envmap == Imf::ENVMAP_CUBE);
+  return info;
 }
 
 image read_exr(const std::string& path, int channels) {

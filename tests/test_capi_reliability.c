@@ -178,6 +178,28 @@ static void test_bake_messages(void) {
   CHECK(memcmp(out, untouched, sizeof out) == 0);
 }
 
+/* Crafted EXR files (tests/data/): headers claiming 16384^2 pixels in an 8.5 KB file, and an
+ * attribute whose size field claims 1.6 GB in a 599-byte file. They fail (IO) from the header
+ * alone, before any pixel is allocated, with the C function's name; nothing is written. */
+static void test_crafted_exr(const char* data) {
+  const char* files[] = {"exr_header_16384x16384_incomplete.exr", "exr_header_16384x16385_incomplete.exr",
+                         "exr_opaque_attr_1.6GB_alloc.exr"};
+  /* (16384 x 16385 is over the 2^28-pixel limit: OUT_OF_MEMORY, as the header documents.) */
+  const char* why[] = {"truncated", "exceeds the limit of 2^28 pixels", "claims 1634231040 bytes"};
+  const hemilight_status code[] = {HEMILIGHT_ERROR_IO, HEMILIGHT_ERROR_OUT_OF_MEMORY, HEMILIGHT_ERROR_IO};
+  char path[1024];
+  int i, w = -7, h = -7, cube = -7;
+  float px[3] = {-7, -7, -7};
+  for (i = 0; i < 3; ++i) {
+    snprintf(path, sizeof path, "%s/%s", data, files[i]);
+    CHECK_FAILS(hemilight_exr_info(path, &w, &h, &cube), code[i], why[i]);
+    CHECK(strncmp(hemilight_last_error(), "hemilight_exr_info: ", 20) == 0);
+    CHECK_FAILS(hemilight_exr_load_rgb(path, px, 3, &w, &h), code[i], "hemilight_exr_load_rgb: ");
+    CHECK_FAILS(hemilight_exr_load_cubemap_rgb(path, px, 3, &w), code[i], "hemilight_exr_load_cubemap_rgb: ");
+  }
+  CHECK(w == -7 && h == -7 && cube == -7 && px[0] == -7.0f);
+}
+
 int main(int argc, char** argv) {
   test_normals_and_radiance();
   test_light_overflow();
@@ -185,6 +207,7 @@ int main(int argc, char** argv) {
   test_cache_extent();
   test_sizes_and_messages(argc > 1 ? argv[1] : ".");
   test_bake_messages();
+  if (argc > 2) test_crafted_exr(argv[2]);
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -66,6 +66,18 @@ enum class exr_pixel_type {
   half16,   ///< 16-bit half: relative error <= 2^-11, values above 65504 become +inf
 };
 
+/// What an EXR file's header says (read_exr_header).
+struct exr_header_info {
+  int width = 0, height = 0;
+  bool cube = false;  ///< width x 6 width pixels and not marked as a latlong map
+};
+
+/// The size of an EXR image from its header alone, with read_exr's checks short of decoding the
+/// pixels (channels R, G, B present and not subsampled, every scanline or tile present, at most
+/// max_image_pixels). Throws as read_exr. Cost: reads the header and the offset table only; a
+/// file whose pixel data is corrupt passes here and fails in read_exr.
+exr_header_info read_exr_header(const std::string& path);
+
 /// Reads a scanline EXR file as float RGB (channels = 3) or RGBA (channels = 4). The file must
 /// have R, G and B channels (any pixel type); when RGBA is asked for and the file has no A, alpha
 /// is 1. Other channels are ignored. channels = 0 means "as in the file": 4 if it has A, else 3.
