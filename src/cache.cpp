@@ -1821,14 +1821,23 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
     hemicube_integrator integrator;
     hemicube_buffer buffer;
   };
-  auto contexts = std::make_shared<std::vector<std::unique_ptr<context>>>();
-  for (int w = 0; w < workers; ++w)
-    contexts->push_back(std::make_unique<context>(context{hemicube_rasterizer(s, o.raster),
-                                                          hemicube_integrator(o.resolution, o.integrate), {}}));
-  return [contexts, o, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> cache_sample {
+  // One context per worker, made by the worker on its first call: a worker that never runs (a
+  // cache of a few points on many threads) costs nothing. The options are checked now, once.
+  { hemicube_rasterizer check(s, o.raster); }
+  if (!is_valid_hemicube_resolution(o.resolution))
+    throw_invalid_argument("make_hemicube_sampler: resolution " + std::to_string(o.resolution) +
+                           " is invalid: it must be even and in [2, 4096]");
+  if (!(o.integrate.min_wall_distance >= 0.0f) || !std::isfinite(o.integrate.min_wall_distance))  // as hemicube_integrator
+    throw_invalid_argument("make_hemicube_sampler: integrate.min_wall_distance is " + std::to_string(o.integrate.min_wall_distance) +
+                           "; it must be finite and >= 0 (0 = automatic)");
+  auto contexts = std::make_shared<std::vector<std::unique_ptr<context>>>(static_cast<std::size_t>(workers));
+  return [contexts, s, o, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> cache_sample {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
-    context& c = *(*contexts)[std::size_t(worker)];
+    std::unique_ptr<context>& slot = (*contexts)[std::size_t(worker)];
+    if (!slot)
+      slot = std::make_unique<context>(context{hemicube_rasterizer(s, o.raster), hemicube_integrator(o.resolution, o.integrate), {}});
+    context& c = *slot;
     frame f = make_frame(n);
     if (o.roll) {
       std::uint32_t bits[3];

@@ -299,7 +299,8 @@ struct hemicube_sampler_options {
 };
 
 /// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
-/// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache). Throws
+/// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache; each worker
+/// makes its context on its first call, so workers that never run cost nothing). Throws
 /// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
 /// options, or sh_l1 without integrate.rotation_gradient. The sampler throws error(invalid_argument) for a worker index out of range.
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
