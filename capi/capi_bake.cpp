@@ -151,6 +151,19 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       if (!(o.sky_radiance[c] >= 0.0f && o.sky_radiance[c] <= hemilight::max_radiance))
         return invalid(fn, "options->sky_radiance[" + std::to_string(c) + "] = " + std::to_string(o.sky_radiance[c]) +
                                "; it must be finite, >= 0 and at most 1e30");
+    bool mask = false;
+    for (int k = 0; k < 4; ++k) {
+      const int l = o.shadow_mask_lights[k];
+      if (l < -1 || (l >= 0 && std::size_t(l) >= o.light_count))
+        return invalid(fn, "options->shadow_mask_lights[" + std::to_string(k) + "] = " + std::to_string(l) +
+                               " is not -1 or a light index (light_count is " + std::to_string(o.light_count) + ")");
+      mask = mask || l >= 0;
+    }
+    if (mask && !o.shadow_mask_rgba)
+      return invalid(fn, "options->shadow_mask_lights names a light but options->shadow_mask_rgba is NULL");
+    if (mask && o.shadow_mask_capacity < 4 * texels)
+      return invalid(fn, "options->shadow_mask_capacity " + std::to_string(o.shadow_mask_capacity) +
+                             " is below 4 x width x height = " + std::to_string(4 * texels) + " floats");
     std::vector<hemilight::light> lights;
     const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
     if (lights_status != HEMILIGHT_OK) return lights_status;
@@ -219,6 +232,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     for (const hemilight::image& img : r.hl2) all_ok = all_ok && finite(img);
     if (!all_ok) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
     std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
+    if (mask) std::copy(r.shadow_mask.pixels.begin(), r.shadow_mask.pixels.end(), o.shadow_mask_rgba);
     if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
     if (sh_l1_rgb)
       for (std::size_t k = 0; k < 4; ++k) std::copy(r.sh_l1[k].pixels.begin(), r.sh_l1[k].pixels.end(), sh_l1_rgb + 3 * texels * k);

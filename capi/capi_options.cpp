@@ -38,7 +38,9 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, thread_count), HEMILIGHT_SPAN(hemilight_bake_options, sky_radiance),
     HEMILIGHT_SPAN(hemilight_bake_options, progress), HEMILIGHT_SPAN(hemilight_bake_options, progress_user),
     HEMILIGHT_SPAN(hemilight_bake_options, environment_rgb), HEMILIGHT_SPAN(hemilight_bake_options, environment_size),
-    HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count)};
+    HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
+    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
+    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity)};
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -52,7 +54,7 @@ const span bake_stats_fields[] = {
 // The sizes of this ABI's first layouts (x86-64 and every LP64 ABI). A struct that grows keeps
 // its old size here and its new fields start at or after it.
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 96, "hemilight_cache_options changed: see above");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 112, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 144, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
 
@@ -128,6 +130,9 @@ hemilight_bake_options default_bake_options() {
   o.environment_size = 0;
   o.lights = nullptr;
   o.light_count = 0;
+  for (int& l : o.shadow_mask_lights) l = -1;
+  o.shadow_mask_rgba = nullptr;
+  o.shadow_mask_capacity = 0;
   return o;
 }
 
@@ -210,6 +215,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.lights = std::move(lights);
   o.output_sh_l1 = output_sh_l1;
   o.output_hl2 = output_hl2;
+  for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;

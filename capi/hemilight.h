@@ -484,6 +484,16 @@ typedef struct hemilight_bake_options {
    * (the message names options->lights[i] and the field). */
   const hemilight_light* lights;
   size_t light_count;
+  /* Optional shadow mask (default all -1, NULL, 0): the visibility in [0, 1] of up to four lights
+   * per texel, the mask engines with real-time direct light multiply that light by. Channel c of
+   * shadow_mask_rgba (width x height RGBA floats, rows as the irradiance) holds the visibility of
+   * lights[shadow_mask_lights[c]] (1 for a light that casts no shadow, 0 where it is below the
+   * horizon or behind a RECT); -1 leaves channel c 0. Written, dilated, only when the bake succeeds
+   * and some index is not -1; shadow_mask_capacity is the floats available there (at least
+   * 4 x width x height). An index past light_count, or a mask with no buffer, is INVALID_ARGUMENT. */
+  int shadow_mask_lights[4];
+  float* shadow_mask_rgba;
+  size_t shadow_mask_capacity;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */

@@ -158,6 +158,42 @@ int main(void) {
       if (out[i] != 0.0f) ok = 0;
     CHECK(ok);
     o.indirect_only = 0;
+    /* The shadow mask: the unoccluded sun's visibility is 1 at every texel (channel R; the others
+     * unused: 0); a sun travelling upwards is below every texel's horizon: 0. */
+    {
+      static float mask[4 * W * H];
+      int all_ones = 1, all_zero = 1;
+      CHECK(o.shadow_mask_lights[0] == -1 && o.shadow_mask_lights[3] == -1 && o.shadow_mask_rgba == NULL);
+      o.shadow_mask_lights[0] = 0;
+      o.shadow_mask_rgba = mask;
+      o.shadow_mask_capacity = 4 * W * H;
+      memset(mask, 0x5a, sizeof mask);
+      CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL) == HEMILIGHT_OK);
+      for (i = 0; i < W * H; ++i) {
+        if (mask[4 * i] != 1.0f) all_ones = 0;
+        if (mask[4 * i + 1] != 0.0f || mask[4 * i + 2] != 0.0f || mask[4 * i + 3] != 0.0f) all_zero = 0;
+      }
+      CHECK(all_ones && all_zero);
+      sun[0].direction[1] = 1.0f, sun[0].direction[2] = 0.0f;
+      CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL) == HEMILIGHT_OK);
+      all_zero = 1;
+      for (i = 0; i < 4 * W * H; ++i)
+        if (mask[i] != 0.0f) all_zero = 0;
+      CHECK(all_zero);
+      sun[0].direction[1] = sun[0].direction[2] = -1.0f;
+      o.shadow_mask_lights[2] = 1;
+      CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                  "options->shadow_mask_lights[2] = 1 is not -1 or a light index (light_count is 1)");
+      o.shadow_mask_lights[2] = -1;
+      o.shadow_mask_capacity = 4 * W * H - 1;
+      CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                  "options->shadow_mask_capacity");
+      o.shadow_mask_rgba = NULL;
+      CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                  "shadow_mask_rgba is NULL");
+      o.shadow_mask_lights[0] = -1;
+      o.shadow_mask_capacity = 0;
+    }
     /* A bad light fails the call naming options->lights[i] and the field; nothing written. */
     hemilight_light_init(&sun[1], HEMILIGHT_LIGHT_POINT);
     sun[1].radius = -0.5f;

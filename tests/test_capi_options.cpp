@@ -117,6 +117,8 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   c.thread_count = 2;
   c.progress = count_progress;
   c.progress_user = &progress_calls;
+  c.shadow_mask_lights[0] = 2;
+  c.shadow_mask_lights[3] = 0;
   light l;
   l.position = {1, 2, 3};
   const auto env = std::make_shared<const cubemap>();
@@ -136,6 +138,9 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.lights[0].position.z == 3.0f);
   CHECK(o.output_sh_l1);
   CHECK(!o.output_hl2);
+  CHECK(o.shadow_mask_lights[0] == 2);
+  CHECK(o.shadow_mask_lights[1] == -1);
+  CHECK(o.shadow_mask_lights[3] == 0);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
