@@ -34,9 +34,9 @@ std::string check_material(const hemilight_bake_material& m, const std::string& 
 // baker checks the concatenated scene again; these checks keep the messages in the caller's terms.)
 std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name) {
   for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
-    if (!std::isfinite(mesh.positions[i]))
+    if (!(std::fabs(mesh.positions[i]) <= hemilight::max_coordinate))
       return name + ".positions[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
-             std::to_string(mesh.positions[i]) + "; it must be finite";
+             std::to_string(mesh.positions[i]) + "; it must be finite and at most 1e18 in magnitude";
   for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i)
     if (!(mesh.lightmap_uvs[i] >= 0.0f && mesh.lightmap_uvs[i] <= 1.0f))
       return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
@@ -140,8 +140,8 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
                              " but environment_rgb is NULL (use 0 without an environment map)");
     }
-    if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
-      return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in (0, 1] (checked "
+    if (!(o.error_threshold >= hemilight::min_error_threshold && o.error_threshold <= 1.0f))
+      return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in [0.001, 1] (checked "
                          "whatever use_cache is)");
     for (const char* f : {"indirect_only", "use_cache"}) {
       const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;

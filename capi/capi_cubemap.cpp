@@ -47,14 +47,16 @@ bool check_filter_args(const char* fn, const float* input, int input_size, const
 
 std::size_t face_floats(int size) { return 6u * std::size_t(size) * std::size_t(size) * 3u; }
 
-// Copies an RGB cube map from the caller (validated: finite values) into a cubemap of one level.
+// Copies an RGB cube map from the caller (validated: finite values within +-max_radiance, so that
+// every weighted sum stays finite) into a cubemap of one level.
 hemilight::cubemap load_input(const char* fn, const float* input, int size) {
   hemilight::cube_image img = hemilight::cube_image::make(size, 3);
   std::copy(input, input + img.pixels.size(), img.pixels.begin());
   for (std::size_t i = 0; i < img.pixels.size(); ++i)
-    if (!std::isfinite(img.pixels[i]))
-      throw hemilight::error(hemilight::status::invalid_argument,
-                             std::string(fn) + ": input value " + std::to_string(i) + " is not finite");
+    if (!(std::fabs(img.pixels[i]) <= hemilight::max_radiance))
+      throw hemilight::error(hemilight::status::invalid_argument, std::string(fn) + ": input value " + std::to_string(i) + " = " +
+                                                                      std::to_string(img.pixels[i]) +
+                                                                      " is not finite or beyond +-1e30");
   return hemilight::cubemap::from_image(std::move(img), false);
 }
 
@@ -232,6 +234,8 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
     const auto mode = sampling_value == HEMILIGHT_CUBE_SAMPLING_SEAMLESS ? hemilight::cube_sampling::seamless
                                                                    : hemilight::cube_sampling::clamp_per_face;
     const glm::vec4 v = hemilight::cubemap_detail::sample_lod_raw(levels, level_count, d, std::max(0.0f, lod), mode);
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      return invalid(fn, "the sample is not finite: the chain holds NaN, Inf or values near the float limit");
     rgb[0] = v.x;
     rgb[1] = v.y;
     rgb[2] = v.z;

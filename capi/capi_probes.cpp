@@ -29,10 +29,11 @@ hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, con
       return invalid(fn, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
     if (thread_count < 0) return invalid(fn, "thread_count is " + std::to_string(thread_count) + "; it must be >= 0 (0 = all cores)");
     for (std::size_t i = 0; i < count; ++i)
-      if (!all_finite(positions + 3 * i, 3))
+      if (!all_finite(positions + 3 * i, 3) || std::fabs(positions[3 * i]) > hemilight::max_coordinate ||
+          std::fabs(positions[3 * i + 1]) > hemilight::max_coordinate || std::fabs(positions[3 * i + 2]) > hemilight::max_coordinate)
         return invalid(fn, "point " + std::to_string(i) + ": position (" + std::to_string(positions[3 * i]) + ", " +
                                std::to_string(positions[3 * i + 1]) + ", " + std::to_string(positions[3 * i + 2]) +
-                               ") is not finite");
+                               ") is not finite or beyond 1e18");
     // Step 2: the probes (into the library's own arrays: nothing is written on failure).
     std::vector<glm::vec3> p(count);
     for (std::size_t i = 0; i < count; ++i) p[i] = {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};

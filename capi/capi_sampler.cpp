@@ -44,6 +44,9 @@ hemilight_status check_point(const char* function, const std::string& where, con
   if (!position) return invalid(function, where + "position is NULL");
   if (!normal) return invalid(function, where + "normal is NULL");
   if (!all_finite(position, 3)) return invalid(function, where + "position " + triple(position) + " is not finite");
+  for (int c = 0; c < 3; ++c)
+    if (std::fabs(position[c]) > max_coordinate)
+      return invalid(function, where + "position " + triple(position) + " is beyond 1e18 (max_coordinate)");
   if (!all_finite(normal, 3)) return invalid(function, where + "normal " + triple(normal) + " is not finite");
   if (normal[0] == 0.0f && normal[1] == 0.0f && normal[2] == 0.0f)
     return invalid(function, where + "normal " + triple(normal) + " has no direction (zero length)");

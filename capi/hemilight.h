@@ -359,7 +359,7 @@ typedef struct hemilight_cache_options {
   size_t struct_size;     /* sizeof(hemilight_cache_options) as the caller was built: set by
                              hemilight_cache_options_init (see "Structs that grow" at the top) */
   int resolution;         /* hemicube N, even, 2..4096 (default 64) */
-  float error_threshold;  /* Ward's a, (0, 1]: larger = fewer hemicubes, more error (default 0.2) */
+  float error_threshold;  /* Ward's a, [0.001, 1]: larger = fewer hemicubes, more error (default 0.2) */
   float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
                                    min = (median point spacing) / a, max = 0.2 x the points' extent */
   int use_gradients;      /* 0 or 1: interpolate with rotation and translation gradients (default 1) */
@@ -462,7 +462,7 @@ typedef struct hemilight_bake_options {
   int resolution;          /* hemicube N, even, 2..4096 (default 64) */
   int bounces;             /* 1 = direct light only, up to 64 (default 1) */
   int indirect_only;       /* 0 or 1: store everything but the first bounce (default 0) */
-  float error_threshold;   /* irradiance cache's Ward a, (0, 1] (default 0.2) */
+  float error_threshold;   /* irradiance cache's Ward a, [0.001, 1] (default 0.2) */
   float min_coverage;      /* texels covered less than this fraction get no sample, [0, 1] (default 0.01) */
   int dilation;            /* rings of dilation around charts, >= 0, or -1 to fill every texel (default 16) */
   int use_cache;           /* 1: irradiance cache; 0: a hemicube at every texel (reference, slow) (default 1) */
@@ -619,7 +619,8 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_fixup_lookup(const float direct
  * docs/cubemap.md).
  * Uses all cores; deterministic. output holds 6 x output_size^2 x 3 floats and must not overlap
  * input. Errors: INVALID_ARGUMENT for NULL pointers, sizes outside [1, 6688], p not finite and
- * > 0, an unknown fixup, or NaN/Inf in input (output untouched); OUT_OF_MEMORY. */
+ * > 0, an unknown fixup, or NaN/Inf or values beyond +-1e30 in input (output untouched);
+ * OUT_OF_MEMORY. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_filter_cosine_power(const float* input, int input_size,
                                                                      float specular_power,
                                                                      hemilight_edge_fixup fixup, int output_size,

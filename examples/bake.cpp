@@ -76,7 +76,7 @@ const char* usage =
     "options:\n"
     "  --size N           lightmap width and height in texels, 1..8192 (default 256)\n"
     "  --resolution N     hemicube resolution, even, 2..4096 (default 64)\n"
-    "  --error A          irradiance cache error threshold (Ward's a), (0, 1] (default 0.2)\n"
+    "  --error A          irradiance cache error threshold (Ward's a), [0.001, 1] (default 0.2)\n"
     "  --bounces K        light bounces, 1 = direct only, 1..64 (default 3)\n"
     "  --threads T        worker threads, 0 = all cores (default 0)\n"
     "  --out DIR          output directory (default out)\n"
@@ -168,7 +168,7 @@ settings parse(int argc, char** argv) {
       s.options.resolution = parse_int("--resolution", value(), 2, 4096);
       if (s.options.resolution % 2) fail("--resolution " + std::to_string(s.options.resolution) + " is invalid: it must be even", 2);
     } else if (a == "--error") {
-      s.options.cache.error_threshold = parse_float("--error", value(), 0.0f, 1.0f, true);
+      s.options.cache.error_threshold = parse_float("--error", value(), 0.001f, 1.0f, false);
     } else if (a == "--bounces") {
       s.options.bounces = parse_int("--bounces", value(), 1, 64);
     } else if (a == "--threads") {

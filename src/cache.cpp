@@ -732,8 +732,9 @@ float median_spacing(const glm::vec3* p, std::size_t count, float diagonal, cons
 
 void validate_cache_options(const cache_options& o, const std::string& who) {
   const std::string fn = who + ": ";
-  if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
-    throw_invalid_argument(fn + "error_threshold is " + std::to_string(o.error_threshold) + "; it must be in (0, 1]");
+  if (!(o.error_threshold >= min_error_threshold && o.error_threshold <= 1.0f))
+    throw_invalid_argument(fn + "error_threshold is " + std::to_string(o.error_threshold) +
+                           "; it must be in [0.001, 1] (below 0.001 every point would be a record: use a hemicube per point)");
   if (!(o.min_radius >= 0.0f) || !std::isfinite(o.min_radius))
     throw_invalid_argument(fn + "min_radius is " + std::to_string(o.min_radius) + "; it must be finite and >= 0 (0 = automatic)");
   if (!(o.max_radius >= 0.0f) || !std::isfinite(o.max_radius))
@@ -762,8 +763,8 @@ void validate(const glm::vec3* positions, const glm::vec3* normals, std::size_t 
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
   for (std::size_t i = 0; i < count; ++i) {
     const glm::vec3 &p = positions[i], &n = normals[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite");
+    if (!(std::fabs(p.x) <= max_coordinate && std::fabs(p.y) <= max_coordinate && std::fabs(p.z) <= max_coordinate))
+      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite or beyond 1e18");
     lo = glm::min(lo, glm::dvec3(p));
     hi = glm::max(hi, glm::dvec3(p));
     const float len = glm::length(n);
@@ -983,9 +984,9 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
 }
 
 void fit_record_hessians(std::vector<cache_record>& records, const cache_options& o) {
-  if (!(o.error_threshold > 0.0f && o.error_threshold <= 1.0f))
+  if (!(o.error_threshold >= min_error_threshold && o.error_threshold <= 1.0f))
     throw_invalid_argument("fit_record_hessians: options.error_threshold is " + std::to_string(o.error_threshold) +
-                           "; it must be in (0, 1]");
+                           "; it must be in [0.001, 1]");
   for (std::size_t i = 0; i < records.size(); ++i) {
     const cache_record& r = records[i];
     const std::string which = "fit_record_hessians: record " + std::to_string(i);

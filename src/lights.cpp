@@ -349,6 +349,10 @@ void validate_lights(const light* lights, std::size_t count) {
     if (type < 0 || type > 3) throw_invalid_argument(field(i, "type") + " = " + std::to_string(type) + " is unknown");
     check_finite(i, "color", l.color, "rgb");
     check_finite(i, "position", l.position, "xyz");
+    for (int c = 0; c < 3; ++c)
+      if (std::fabs(l.position[c]) > max_coordinate)
+        throw_invalid_argument(field(i, "position") + "." + "xyz"[c] + " = " + number(l.position[c]) +
+                               " is beyond 1e18 (max_coordinate)");
     check_finite(i, "direction", l.direction, "xyz");
     check_finite(i, "tangent", l.tangent, "xyz");
     check_finite(i, "width", l.width);

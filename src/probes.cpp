@@ -181,9 +181,9 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   }
   for (std::size_t i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(positions[i][c]))
+      if (!(std::fabs(positions[i][c]) <= max_coordinate))
         throw_invalid_argument("sample_probes: positions[" + std::to_string(i) + "]." + "xyz"[c] + " is " +
-                               std::to_string(positions[i][c]) + "; it must be finite");
+                               std::to_string(positions[i][c]) + "; it must be finite and at most 1e18 in magnitude");
   // Step 2: the tables, one context per worker.
   probe_result out;
   out.probes.resize(count);

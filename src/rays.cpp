@@ -108,6 +108,22 @@ bool valid_query(const glm::vec3& origin, const glm::vec3& d, float t_max) noexc
   return t_max > 0.0f && finite3(origin) && finite3(d) && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f);
 }
 
+// Embree takes rays whose origin and direction components are at most FLT_LARGE = 1.844e18 in
+// magnitude (its ray.valid(); a build with assertions aborts on others). Origins stay within
+// max_coordinate (scene.hpp) plus offsets; a longer direction (a shadow ray to a light 1e18 away)
+// is scaled to its largest component 1, and t_max by the inverse: the same segment. Returns the
+// factor that turns the scaled ray's t back into the caller's (1 when nothing was scaled), or 0
+// for an origin Embree cannot take (the fallback traversal answers those).
+float fit_embree_range(const glm::vec3& origin, glm::vec3& d, float& t_max) noexcept {
+  constexpr float large = 1.8e18f;
+  if (!(std::fabs(origin.x) <= large && std::fabs(origin.y) <= large && std::fabs(origin.z) <= large)) return 0.0f;
+  const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  if (m <= large) return 1.0f;
+  d /= m;
+  t_max *= m;  // +inf stays +inf; a huge finite t_max may become +inf (the segment then reaches on)
+  return 1.0f / m;
+}
+
 // Embree accepts tnear <= t <= tfar on its float t = rcp(den) * T, a few ulps from the true t
 // (an approximate reciprocal refined once). tnear = the smallest positive float gives t > 0; tfar
 // = t_max (1 - 2^-20) keeps a triangle at exactly t_max (a shadow ray's end point on a light)
@@ -249,11 +265,13 @@ void prepare_rays(const scene& s) {
 bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
   if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
   const detail::ray_accel* a = detail::built(s);
-  if (!a || !a->rtc) return detail::occluded_bvh(s, origin, direction, t_max);
+  glm::vec3 d = direction;
+  float t = t_max;
+  if (!a || !a->rtc || detail::fit_embree_range(origin, d, t) == 0.0f) return detail::occluded_bvh(s, origin, direction, t_max);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay r;
-  detail::set_ray(r, origin, direction, t_max);
+  detail::set_ray(r, origin, d, t);
   rtcOccluded1(a->rtc, &context, &r);
   return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
@@ -263,17 +281,28 @@ namespace {
 // One Embree packet of up to N rays from `origin` (N = 4 or 8: RTCRay4 / RTCRay8), lanes past
 // `count` and invalid rays inactive (valid mask 0, answered false without tracing).
 template <std::size_t N, class Packet>
-void occluded_packet(RTCScene rtc, RTCIntersectContext& context, const glm::vec3& origin, const glm::vec3* directions,
-                     const float* t_max, std::size_t count, bool* out) noexcept {
+void occluded_packet(const scene& s, RTCScene rtc, RTCIntersectContext& context, const glm::vec3& origin,
+                     const glm::vec3* directions, const float* t_max, std::size_t count, bool* out) noexcept {
   alignas(32) int valid[N];
   Packet r;
   int live = 0;
+  bool outside[N] = {};  // valid queries Embree cannot take (detail::fit_embree_range): the fallback's
   for (std::size_t j = 0; j < N; ++j) {
-    const bool ok = j < count && detail::valid_query(origin, directions[j], t_max[j]);
+    bool ok = j < count && detail::valid_query(origin, directions[j], t_max[j]);
+    glm::vec3 d = glm::vec3(0.0f, 0.0f, 1.0f);
+    float t = 1.0f;
+    if (ok) {
+      d = directions[j];
+      t = t_max[j];
+      if (detail::fit_embree_range(origin, d, t) == 0.0f) {
+        outside[j] = true;
+        ok = false;
+        d = glm::vec3(0.0f, 0.0f, 1.0f);
+        t = 1.0f;
+      }
+    }
     valid[j] = ok ? -1 : 0;
     live += ok ? 1 : 0;
-    const glm::vec3 d = ok ? directions[j] : glm::vec3(0.0f, 0.0f, 1.0f);
-    const float t = ok ? t_max[j] : 1.0f;
     r.org_x[j] = origin.x;
     r.org_y[j] = origin.y;
     r.org_z[j] = origin.z;
@@ -293,7 +322,9 @@ void occluded_packet(RTCScene rtc, RTCIntersectContext& context, const glm::vec3
     else
       rtcOccluded4(valid, rtc, &context, &r);
   }
-  for (std::size_t j = 0; j < count; ++j) out[j] = valid[j] != 0 && r.tfar[j] < 0.0f;  // tfar = -inf on a hit
+  for (std::size_t j = 0; j < count; ++j)
+    out[j] = outside[j] ? detail::occluded_bvh(s, origin, directions[j], t_max[j])
+                        : valid[j] != 0 && r.tfar[j] < 0.0f;  // tfar = -inf on a hit
 }
 
 }  // namespace
@@ -317,9 +348,9 @@ void occluded_many(const scene& s, const glm::vec3& origin, const glm::vec3* dir
   for (std::size_t base = 0; base < count; base += 8) {
     const std::size_t n = std::min<std::size_t>(8, count - base);
     if (n <= 4)
-      occluded_packet<4, RTCRay4>(a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+      occluded_packet<4, RTCRay4>(s, a->rtc, context, origin, directions + base, t_max + base, n, out + base);
     else
-      occluded_packet<8, RTCRay8>(a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+      occluded_packet<8, RTCRay8>(s, a->rtc, context, origin, directions + base, t_max + base, n, out + base);
   }
 }
 
@@ -327,18 +358,21 @@ bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& directi
                ray_hit& hit) noexcept {
   if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
   const detail::ray_accel* a = detail::built(s);
-  if (!a || !a->rtc) return detail::intersect_bvh(s, origin, direction, t_max, hit);
+  glm::vec3 d = direction;
+  float t = t_max;
+  const float back = a && a->rtc ? detail::fit_embree_range(origin, d, t) : 0.0f;
+  if (back == 0.0f) return detail::intersect_bvh(s, origin, direction, t_max, hit);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  detail::set_ray(rh.ray, origin, direction, t_max);
+  detail::set_ray(rh.ray, origin, d, t);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(a->rtc, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   const std::uint32_t i = rh.hit.primID;
-  hit.distance = rh.ray.tfar;
+  hit.distance = back == 1.0f ? rh.ray.tfar : rh.ray.tfar * back;  // in units of the caller's direction
   hit.drawable = i;
   hit.triangle = s.triangles()[i].index;
   // Embree's Ng is (v1 - v0) x (v2 - v0) up to scale: our front normal.

@@ -106,9 +106,9 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
   for (std::size_t i = 0; i < desc.vertex_count; ++i) {
     const glm::vec3& p = s->positions_[i];
     for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(p[c]))
+      if (!(std::fabs(p[c]) <= max_coordinate))
         throw_invalid_argument("scene::create: positions[" + std::to_string(i) + "]." + axis_name[c] + " is " +
-                               std::to_string(p[c]) + "; positions must be finite");
+                               std::to_string(p[c]) + "; positions must be finite and at most 1e18 in magnitude");
     s->lo_ = glm::min(s->lo_, p);
     s->hi_ = glm::max(s->hi_, p);
   }

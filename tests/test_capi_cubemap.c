@@ -125,7 +125,7 @@ static void test_filters(void) {
               HEMILIGHT_ERROR_INVALID_ARGUMENT, "fixup -1");
   in[100] = (float)NAN;
   CHECK_FAILS(hemilight_cubemap_filter_cosine_power(in, n, 20.0f, HEMILIGHT_EDGE_FIXUP_NONE, m, out),
-              HEMILIGHT_ERROR_INVALID_ARGUMENT, "input value 100 is not finite");
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "input value 100 = nan is not finite");
   CHECK_FAILS(hemilight_cubemap_filter_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, 1, out),
               HEMILIGHT_ERROR_INVALID_ARGUMENT, "not finite");
   CHECK_FAILS(hemilight_cubemap_filter_mip_chain(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, 1.0f, chain, floats),

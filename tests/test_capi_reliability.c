@@ -88,13 +88,24 @@ static void test_cubemap_directions(void) {
         CHECK(isfinite(rgb[0]) && fabs(rgb[0] - ref[0]) < 1e-5f);
       }
   CHECK(hemilight_cubemap_fixup_lookup(dirs[0], 64, 0.0f, rgb) == HEMILIGHT_OK);
+  /* Filter input near FLT_MAX (found by fuzz_cubemap: sums overflowed to +inf on OK): refused. */
+  {
+    float out[72];
+    map[5] = 3e38f;
+    CHECK_FAILS(hemilight_cubemap_filter_irradiance(map, 2, HEMILIGHT_EDGE_FIXUP_NONE, 2, 0, out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                "input value 5");
+    map[5] = 1.0f;
+  }
   CHECK(isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]) && rgb[0] > 0.0f);
 }
 
 static void test_cache_extent(void) {
   const float sky[3] = {1, 1, 1};
   const float nrm[6] = {0, 0, 1, 0, 0, 1};
-  const float half_extents[] = {1.1e19f, 2e38f};
+  /* Coordinates beyond 1e18 (max_coordinate) are refused as such; within it, points spanning more
+   * than 1e18 (max_point_extent) too. */
+  const float half_extents[] = {1.1e19f, 2e38f, 9e17f};
+  const char* why[] = {"beyond 1e18", "beyond 1e18", "the points span"};
   float pos[6], out[6];
   hemilight_scene* s = NULL;
   hemilight_cache_options o;
@@ -103,14 +114,19 @@ static void test_cache_extent(void) {
   hemilight_cache_options_init(&o);
   o.resolution = 8;
   o.thread_count = 1;
-  for (k = 0; k < 2; ++k) {
+  for (k = 0; k < 3; ++k) {
     pos[0] = -half_extents[k], pos[1] = 0, pos[2] = 0, pos[3] = half_extents[k], pos[4] = 0, pos[5] = 0;
     out[0] = out[3] = -7.0f;
-    CHECK_FAILS(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "the points span");
+    CHECK_FAILS(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, why[k]);
     CHECK(out[0] == -7.0f && out[3] == -7.0f);
   }
   /* 1e17 apart works: a uniform sky gives pi L at both. */
   pos[0] = -5e16f, pos[3] = 5e16f;
+  /* A denormal error threshold (found by fuzz_cache: the spacings a R underflowed to 0 and the
+   * placement never ended) is refused: [0.001, 1]. */
+  o.error_threshold = 9.4e-40f;
+  CHECK_FAILS(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "[0.001, 1]");
+  o.error_threshold = 0.2f;
   CHECK(hemilight_cache_irradiance(s, pos, nrm, 2, &o, out, NULL) == HEMILIGHT_OK);
   CHECK(fabs(out[0] / pi - 1.0) < 1e-5 && fabs(out[3] / pi - 1.0) < 1e-5);
   hemilight_scene_release(s);

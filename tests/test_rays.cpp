@@ -206,6 +206,33 @@ TEST_CASE("rays: t_max is respected (exclusive) and t is in units of |direction|
   CHECK_FALSE(q.intersect(*empty, o, {0, 0, 1}, inf, h));
 }
 
+TEST_CASE("rays: origins and directions beyond Embree's range (1.8e18) are answered, not asserted on", "[rays]") {
+  // Embree's ray.valid() wants |origin|, |direction| components <= 1.844e18 (Debian's build
+  // aborts on others). Scenes and points stop at max_coordinate = 1e18, but a shadow ray's
+  // direction (to a light up to 1e18 away, from a point up to 1e18 the other way) can reach 2e18:
+  // such rays are scaled to a unit direction (and t_max by the inverse). A quad at z = 0, 2e9 wide:
+  scene_mesh m;
+  m.add_quad({-1e9f, -1e9f, 0}, {1e9f, -1e9f, 0}, {1e9f, 1e9f, 0}, {-1e9f, 1e9f, 0}, material{});
+  const auto s = scene::create(m.desc());
+  const glm::vec3 far_origin(5e8f, 0.0f, 1e9f), down(0, 0, -2e18f);
+  CHECK(occluded(*s, far_origin, down, inf));                 // hits the quad at t = 5e-10
+  CHECK_FALSE(occluded(*s, far_origin, -down, inf));          // away from it
+  CHECK_FALSE(occluded(*s, far_origin, down, 4e-10f));        // t_max before it
+  CHECK(occluded(*s, far_origin, down, 6e-10f));
+  ray_hit h;
+  REQUIRE(intersect(*s, far_origin, down, inf, h));
+  CHECK(h.distance == Approx(5e-10).epsilon(1e-5));
+  glm::vec3 dirs[6];
+  float t[6];
+  bool out[6];
+  for (int i = 0; i < 6; ++i) {
+    dirs[i] = i % 2 ? -down : down;
+    t[i] = inf;
+  }
+  occluded_many(*s, far_origin, dirs, t, 6, out);
+  for (int i = 0; i < 6; ++i) CHECK(out[i] == (i % 2 == 0));
+}
+
 TEST_CASE("rays: both faces are hit, and the closest of several is reported", "[rays]") {
   const backend& q = backends[GENERATE(0, 1)];
   INFO("backend " << q.name);

@@ -129,10 +129,14 @@ enum class cache_weight {
   ward_continuous,  // last, so the earlier values stay as they were (and match the C ABI's numbering)
 };
 
+/// Smallest error_threshold the cache takes: below it every point would be its own record (and
+/// the spacings a R underflow), so a hemicube per point is the right tool.
+inline constexpr float min_error_threshold = 0.001f;
+
 /// Options of the irradiance cache. Lengths are in scene units.
 struct cache_options {
   /// Ward's a: larger means fewer records and more error. Radiance's defaults are 0.1 (rtrace),
-  /// 0.2 (rpict), 0.3 (rvu). Range (0, 1].
+  /// 0.2 (rpict), 0.3 (rvu). Range [min_error_threshold = 0.001, 1].
   float error_threshold = 0.2f;
   /// Smallest and largest radius. 0 = automatic: min_radius = (median spacing of the points) / a,
   /// so that a record covers at least its neighbouring points; max_radius = 0.2 x the diagonal of
@@ -334,7 +338,7 @@ inline constexpr double max_point_extent = 1e18;
 /// Throws error(invalid_argument) naming the first bad input: count == 0, NULL arrays, a NaN/Inf
 /// position, points spanning more than max_point_extent, a normal whose length is not 1 within
 /// 1e-3 (zero normals included), options out of
-/// range (error_threshold not in (0, 1], negative or NaN radii, min_radius > max_radius when both
+/// range (error_threshold not in [0.001, 1], negative or NaN radii, min_radius > max_radius when both
 /// are given, second_opinion negative or not finite, nearby_opinion not in [0, 16],
 /// sole_record_reach not in (0, 1], invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned
 /// false. Exceptions thrown by the sampler propagate unchanged. Cost: one sampler call per
@@ -363,7 +367,7 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
 ///    to 0 and the record stays first-order.
 /// Records with fewer than 2 neighbours get 0. Deterministic for any thread count
 /// (options.thread_count; 0 = all cores). Throws error(invalid_argument), naming the first bad
-/// record, when error_threshold is not in (0, 1], a record's radius is negative or not finite, its
+/// record, when error_threshold is not in [0.001, 1], a record's radius is negative or not finite, its
 /// position is not finite or its normal's length is not 1 within 1e-3; records are then unchanged.
 /// Irradiance and gradients are not checked: NaN in them gives that record a zero Hessian.
 /// Cost: O(records x neighbours).

@@ -46,6 +46,11 @@ struct material {
 /// are rejected with error(invalid_argument) where they are given.
 inline constexpr float max_radiance = 1e30f;
 
+/// Largest coordinate magnitude (scene units) of vertices, lights and query points: products of
+/// coordinates (edge functions, squared distances) must stay finite in float, and Embree's rays
+/// take components up to 1.8e18. Larger finite values are rejected where they are given.
+inline constexpr float max_coordinate = 1e18f;
+
 /// Largest vertex and triangle counts scene::create accepts (2^31 - 1): indices are uint32 and
 /// the rasterizer keeps triangle numbers in 32 bits. Larger counts get error(out_of_memory).
 inline constexpr std::size_t max_scene_elements = (std::size_t(1) << 31) - 1;
