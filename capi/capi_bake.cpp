@@ -32,7 +32,7 @@ std::string check_material(const hemilight_bake_material& m, const std::string& 
 
 // What is wrong with one mesh's arrays, naming the mesh and the index within it, or "". (The
 // baker checks the concatenated scene again; these checks keep the messages in the caller's terms.)
-std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name) {
+std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, int width, int height) {
   for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
     if (!(std::fabs(mesh.positions[i]) <= hemilight::max_coordinate))
       return name + ".positions[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
@@ -46,6 +46,23 @@ std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name)
       if (!std::isfinite(mesh.normals[i]))
         return name + ".normals[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
                std::to_string(mesh.normals[i]) + "; it must be finite";
+  // A triangle with 3D area but no UV area: the baker's own test (bake.cpp, make_tri), computed the
+  // same way, so that the message names the mesh and the triangle within it.
+  for (std::size_t t = 0; t < mesh.triangle_count; ++t) {
+    const std::uint32_t* idx = mesh.indices + 3 * t;
+    if (idx[0] >= mesh.vertex_count || idx[1] >= mesh.vertex_count || idx[2] >= mesh.vertex_count) continue;  // named later
+    glm::dvec2 uv[3];
+    glm::dvec3 p[3];
+    for (int k = 0; k < 3; ++k) {
+      uv[k] = glm::dvec2(double(mesh.lightmap_uvs[2 * idx[k]]) * width, double(mesh.lightmap_uvs[2 * idx[k] + 1]) * height);
+      p[k] = glm::dvec3(glm::vec3(mesh.positions[3 * idx[k]], mesh.positions[3 * idx[k] + 1], mesh.positions[3 * idx[k] + 2]));
+    }
+    const double uv_area = 0.5 * std::fabs((uv[1].x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[1].y - uv[0].y) * (uv[2].x - uv[0].x));
+    const double area3 = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+    if (area3 > 0.0 && !(uv_area > 1e-12 * double(width) * double(height)))
+      return name + ": triangle " + std::to_string(t) + " (indices[" + std::to_string(3 * t) + ".." + std::to_string(3 * t + 2) +
+             "]) has zero area in lightmap UV space (but not in 3D): it would get no texels";
+  }
   if (mesh.materials) {
     for (std::size_t t = 0; t < mesh.triangle_count; ++t)
       if (std::string p = check_material(mesh.materials[t], name + ".materials[" + std::to_string(t) + "]"); !p.empty()) return p;
@@ -190,7 +207,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
         return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
       if (mesh.triangle_count > 0 && !mesh.indices)
         return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
-      if (const std::string problem = check_mesh(mesh, name); !problem.empty()) return invalid(fn, problem);
+      if (const std::string problem = check_mesh(mesh, name, o.width, o.height); !problem.empty()) return invalid(fn, problem);
       const auto base = std::uint32_t(positions.size());
       for (size_t v = 0; v < mesh.vertex_count; ++v) {
         positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);

@@ -243,7 +243,8 @@ int main(void) {
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes[1].lightmap_uvs[2] (vertex 1, u) = 1.25");
   bad_uv[2] = bad_uv[0]; /* vertex 1 = vertex 0 in UV: triangle 0 of mesh 1 (triangle 2 overall) is flat in UV */
   bad_uv[3] = bad_uv[1];
-  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "zero area in lightmap UV space");
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "meshes[1]: triangle 0 (indices[0..2]) has zero area in lightmap UV space");
   meshes[1].lightmap_uvs = uv_b;
   memcpy(bad_idx, idx, sizeof bad_idx);
   bad_idx[4] = 4;
