@@ -107,10 +107,7 @@ hemilight_status hemilight_cubemap_fixup_lookup(const float direction[3], int si
     if (!all_finite(direction, 3)) return invalid(fn, "direction has a NaN or infinite component");
     if (!std::isfinite(lod)) return invalid(fn, "lod is NaN or infinite");
     if (!check_cube_size(fn, "size", size, st)) return st;
-    glm::vec3 d(direction[0], direction[1], direction[2]);
-    const float major = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-    if (major > 0.0f && (major < 1e-18f || major > 1e18f)) d /= major;  // as hemilight_cubemap_sample (zero stays zero)
-    d = hemilight::fixup_lookup(d, size, lod);
+    const glm::vec3 d = hemilight::fixup_lookup({direction[0], direction[1], direction[2]}, size, lod);
     out_direction[0] = d.x;
     out_direction[1] = d.y;
     out_direction[2] = d.z;
@@ -225,11 +222,6 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
       src += face_floats(s);
     }
     glm::vec3 d(direction[0], direction[1], direction[2]);
-    // Directions far from unit length (tiny: their ratios and squares underflow; huge: their
-    // squares overflow) are scaled by their largest component first, which keeps the direction
-    // exactly where the float range allows; the usual ones are used as given.
-    const float major = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-    if (major < 1e-18f || major > 1e18f) d /= major;
     if (apply_fixup) d = hemilight::fixup_lookup(d, size, lod);
     const auto mode = sampling_value == HEMILIGHT_CUBE_SAMPLING_SEAMLESS ? hemilight::cube_sampling::seamless
                                                                    : hemilight::cube_sampling::clamp_per_face;

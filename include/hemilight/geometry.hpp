@@ -243,6 +243,11 @@ inline cube_coord cube_face_from_direction(const glm::vec3& d) noexcept {
     tc = -d.y;
   }
   if (!(ma > 0.0f) || !std::isfinite(ma)) return {cube_face::pos_x, 0.5f, 0.5f};
+  if (ma < 1e-30f) {  // 1 / ma would overflow for subnormal ma: divide instead (|sc|, |tc| <= ma)
+    sc /= ma;
+    tc /= ma;
+    ma = 1.0f;
+  }
   const float inv = 1.0f / ma;
   return {face, 0.5f * (sc * inv + 1.0f), 0.5f * (tc * inv + 1.0f)};
 }
