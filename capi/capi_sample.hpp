@@ -29,6 +29,9 @@ struct point_sampler {
               hemilight_irradiance& out);
 };
 
+/// True if check_point would accept the point (no message built: for loops over many points).
+bool point_ok(const float* position, const float* normal) noexcept;
+
 /// Checks a point for `function`: position and normal non-NULL and finite, the normal nonzero.
 /// Any finite nonzero normal is accepted, however small or large (unit_normal).
 /// `where` prefixes the message's subject ("" or e.g. "point 7: "). On a bad point sets the error

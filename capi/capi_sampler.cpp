@@ -40,7 +40,15 @@ glm::vec3 unit_normal(const float* normal) {
   return glm::vec3(n / glm::length(n));
 }
 
+bool point_ok(const float* position, const float* normal) noexcept {
+  if (!position || !normal || !all_finite(position, 3) || !all_finite(normal, 3)) return false;
+  for (int c = 0; c < 3; ++c)
+    if (std::fabs(position[c]) > max_coordinate) return false;
+  return normal[0] != 0.0f || normal[1] != 0.0f || normal[2] != 0.0f;
+}
+
 hemilight_status check_point(const char* function, const std::string& where, const float* position, const float* normal) {
+  if (point_ok(position, normal)) return HEMILIGHT_OK;
   if (!position) return invalid(function, where + "position is NULL");
   if (!normal) return invalid(function, where + "normal is NULL");
   if (!all_finite(position, 3)) return invalid(function, where + "position " + triple(position) + " is not finite");
@@ -194,8 +202,8 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
     if (const hemilight_status st = check_resolution(fn, resolution)) return st;
     if (thread_count < 0) return invalid(fn, "thread_count is " + std::to_string(thread_count) + "; it must be >= 0 (0 = all cores)");
     for (std::size_t i = 0; i < count; ++i)
-      if (const hemilight_status st = check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i))
-        return st;
+      if (!hemilight::capi::point_ok(positions + 3 * i, normals + 3 * i))  // the message only for the bad one
+        return check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i);
     // Step 2: the points on the workers, one context each, into a buffer of our own (each
     // point's result depends on that point alone: the same for any thread count).
     const int workers = hemilight::resolve_thread_count(thread_count);
