@@ -226,32 +226,43 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
 
 }  // namespace hemilight::capi
 
+namespace hemilight::capi {
+namespace {
+
+// The _init_sized functions: the defaults into the first `size` bytes' fields, then struct_size.
+template <class T, std::size_t K>
+void init_sized(T* out, std::size_t size, const T& defaults, const span (&fields)[K]) {
+  if (!out || size < sizeof(std::size_t)) return;
+  copy_fields(fields, &defaults, out, std::min(size, sizeof defaults));
+  out->struct_size = size;
+}
+
+template <class T>
+T zeroed() {
+  T t;
+  std::memset(&t, 0, sizeof t);
+  return t;
+}
+
+}  // namespace
+}  // namespace hemilight::capi
+
 extern "C" {
 
 void hemilight_cache_options_init_sized(hemilight_cache_options* options, size_t struct_size) {
-  if (!options || struct_size < sizeof(size_t)) return;
-  const hemilight_cache_options d = hemilight::capi::default_cache_options();
-  hemilight::capi::copy_fields(hemilight::capi::cache_options_fields, &d, options, std::min(struct_size, sizeof d));
-  options->struct_size = struct_size;
+  hemilight::capi::init_sized(options, struct_size, hemilight::capi::default_cache_options(), hemilight::capi::cache_options_fields);
 }
 
 void hemilight_bake_options_init_sized(hemilight_bake_options* options, size_t struct_size) {
-  if (!options || struct_size < sizeof(size_t)) return;
-  const hemilight_bake_options d = hemilight::capi::default_bake_options();
-  hemilight::capi::copy_fields(hemilight::capi::bake_options_fields, &d, options, std::min(struct_size, sizeof d));
-  options->struct_size = struct_size;
+  hemilight::capi::init_sized(options, struct_size, hemilight::capi::default_bake_options(), hemilight::capi::bake_options_fields);
 }
 
 void hemilight_cache_stats_init_sized(hemilight_cache_stats* stats, size_t struct_size) {
-  if (!stats || struct_size < sizeof(size_t)) return;
-  std::memset(stats, 0, std::min(struct_size, sizeof *stats));
-  stats->struct_size = struct_size;
+  hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_cache_stats>(), hemilight::capi::cache_stats_fields);
 }
 
 void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_size) {
-  if (!stats || struct_size < sizeof(size_t)) return;
-  std::memset(stats, 0, std::min(struct_size, sizeof *stats));
-  stats->struct_size = struct_size;
+  hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_bake_stats>(), hemilight::capi::bake_stats_fields);
 }
 
 }  // extern "C"

@@ -5,21 +5,11 @@
  * clear message. Each struct lies in a buffer with guard bytes after it, which must survive.
  * References: closed forms (a uniform sky gives irradiance pi L at every point). */
 #include "capi_older_layout.h"
+#include "capi_check.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-static int passed = 0, failed = 0;
-#define CHECK(cond)                                                \
-  do {                                                             \
-    if (cond) {                                                    \
-      ++passed;                                                    \
-    } else {                                                       \
-      ++failed;                                                    \
-      printf("FAILED %s:%d: %s\n", __FILE__, __LINE__, #cond);     \
-    }                                                              \
-  } while (0)
 
 enum { guard = 64 };
 static const unsigned char guard_byte = 0xa7;
