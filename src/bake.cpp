@@ -825,6 +825,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   co.thread_count = o.thread_count;
   co.progress = nullptr;
   std::vector<std::uint8_t> valid(count, 1);
+  std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass
   pass_values current, first;
   const light_set lights(o.lights.data(), o.lights.size());
   direct_values direct;
@@ -867,6 +868,12 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
     std::function<bool(float)> pass_progress;
     if (o.progress) pass_progress = [&](float f) { return report(base + span * f); };
+    // Points an earlier pass found inside geometry are inside in this one too (the geometry is
+    // the same): the cache renders no hemicube for them.
+    if (pass > 0) {
+      for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(valid[i] ? 0 : 1);
+      co.known_inside = inside.data();
+    }
     current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, r.stats)
                           : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, r.stats);
     if (!lights.empty()) add_direct(direct, current);

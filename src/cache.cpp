@@ -626,7 +626,6 @@ struct coverage_detail {
   float max_weight = 0.0f;       // largest weight of a covering record
   std::uint32_t last = 0;        // index of the last covering record (the only one when records == 1)
   float last_prediction = 0.0f;  // its luminance prediction at the point
-  float max_backface = 0.0f;     // largest backface_fraction of a covering record
   std::size_t visited = 0;       // records whose box the query visited (covering or not)
 };
 
@@ -686,7 +685,6 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
       detail->last = i;
       detail->max_weight = std::max(detail->max_weight, w);
       detail->last_prediction = l;
-      detail->max_backface = std::max(detail->max_backface, r.backface_fraction);
       detail->first_order = std::max(detail->first_order, std::fabs(l - li) / std::max({li, detail->floor, 1e-30f}));
     }
     at_record = at_record || r.position == x;
@@ -1023,11 +1021,10 @@ namespace {
 //                     -> fill_invalid
 // Per point the state is: covered (a record's weight passes 1/a and the opinions agree), own
 // invalid sample (inside geometry: its own hemicube saw back faces), presumed inside (within the
-// exclusion ball of an invalid sample on the same side of the same surface), contested (presumed
-// inside, but a valid record covers it too: the point may be on either side of a contact, so it
-// gets its own hemicube). A point is open when it is none of covered, own invalid or
-// presumed-but-uncontested; an open point is a seed candidate when its rank in the fixed
-// pseudo-random order is below the round's candidate_count.
+// exclusion ball of an invalid sample on the same side of the same surface; final, as own invalid
+// is). A point is open when it is none of covered, own invalid or presumed; an open point is a
+// seed candidate when its rank in the fixed pseudo-random order is below the round's
+// candidate_count.
 // Where the time goes and why each structure is there: docs/cache.md, "Placement".
 // The structures, each kept up to date as records are added:
 //   lists_      per point, the records of few points whose sphere held it, and
@@ -1146,7 +1143,11 @@ class placement {
     list_budget_ = list_entries_per_point * count_;
     large_tree_.build(records_, o_, 1, &large_records_);
     record_cells_.reset(lo_, hi_, std::max(nearby_reach_, finest_), count_);
-    for (auto* v : {&covered_, &own_invalid_, &presumed_, &contested_}) v->assign(count_, 0);
+    for (auto* v : {&covered_, &own_invalid_, &presumed_}) v->assign(count_, 0);
+    // Points the caller knows to be inside geometry (cache_options::known_inside) are invalid
+    // from the start, as if their own sample had been: no hemicube, no coverage test.
+    if (o_.known_inside)
+      for (std::size_t i = 0; i < count_; ++i) own_invalid_[i] = o_.known_inside[i] ? 1 : 0;
     dirty_.assign(count_, 1);  // the first coverage pass tests every point
     dirty_list_.resize(count_);
     std::iota(dirty_list_.begin(), dirty_list_.end(), std::uint32_t(0));
@@ -1163,7 +1164,7 @@ class placement {
     coverage_options_.second_order = false;  // the Hessians are fitted after placement
   }
 
-  bool inside(std::size_t i) const { return own_invalid_[i] || (presumed_[i] && !contested_[i]); }
+  bool inside(std::size_t i) const { return own_invalid_[i] || presumed_[i]; }
   bool open(std::size_t i) const { return !covered_[i] && !inside(i); }
   float radius_of(std::size_t j) const { return lists_[j].radius; }  // compact: the record's radius
 
@@ -1210,7 +1211,7 @@ class placement {
       tally& t = tallies[std::size_t(worker)];
       for (std::size_t k = b; k < e; ++k) {
         const std::size_t i = dirty_list_[k];
-        if (own_invalid_[i] || rank_[i] >= candidates_) continue;
+        if (inside(i) || rank_[i] >= candidates_) continue;
         std::size_t visited = 0;
         check_point(i, visited);
         ++t.checked;
@@ -1294,19 +1295,6 @@ class placement {
     const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
-    // Presumed inside: a valid record that covers the point contests the presumption (the point
-    // may lie across a contact from the invalid sample); from then on it needs its own hemicube.
-    if (presumed_[i] && !contested_[i]) {
-      if (!ok) {
-        covered_[i] = 0;
-        return;
-      }
-      contested_[i] = 1;
-    }
-    if (contested_[i]) ok = ok && own;
-    // A covering record that saw back faces stands at a contact or an intersection: its
-    // neighbours get their own hemicubes rather than its extrapolation.
-    if (ok && !own && detail.max_backface > contact_backface_) ok = false;
     if (ok && o_.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e_);
     // Second opinion: a point that only one record covers is not covered while that record's
     // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
@@ -1424,13 +1412,7 @@ class placement {
         ++stats_.invalid_samples;
         ++round.invalid_samples;
         own_invalid_[i] = 1;
-        for (std::uint32_t j : presumed[k]) {
-          presumed_[j] = 1;
-          if (!dirty_[j]) {
-            dirty_[j] = 1;
-            dirty_list_.push_back(j);
-          }
-        }
+        for (std::uint32_t j : presumed[k]) presumed_[j] = 1;  // final: never tested or seeded again
         continue;
       }
       records_.push_back(made[k]);
@@ -1463,6 +1445,11 @@ class placement {
       const float e = luminance(s.irradiance);
       if (gt > 0.0f && e > 0.0f) radius = std::min(radius, e / gt);
     }
+    // A record that saw back faces stands at a contact (where parts meet or intersect): its
+    // reach stops short of the nearest geometry its hemicube saw, so it never covers points
+    // across the contact (the ball of radius min_distance around it holds no geometry).
+    if (s.backface_fraction > contact_backface_ && std::isfinite(s.min_distance) && s.min_distance > 0.0f)
+      radius = std::min(radius, s.min_distance);
     r.radius = std::clamp(radius, o_.min_radius, o_.max_radius);
     return r;
   }
@@ -1470,10 +1457,10 @@ class placement {
   // An invalid sample at point i saw nothing nearer than min_distance in its visible half-space:
   // points within 0.9 of that distance, on the visible side of its tangent plane (not below it by
   // more than 1% of the ball) and with a similar normal (n . n_i > 0.9), lie in the same closed
-  // region, so they are presumed inside without a hemicube of their own. Points on other surfaces
-  // (a wall meeting the floor, a slab's underside inside another slab) are never presumed: the
-  // ball says nothing behind the sample. A valid record covering a presumed point contests it
-  // (check_point).
+  // region, so they are presumed inside without a hemicube of their own, for good: a surface
+  // separating such a point from the sample would cross the ball, where the hemicube saw nothing.
+  // Points on other surfaces (a wall meeting the floor, a slab's underside inside another slab)
+  // are never presumed: the ball says nothing behind the sample.
   std::vector<std::uint32_t> presumed_by(std::size_t i, float min_distance) const {
     std::vector<std::uint32_t> out;
     if (!std::isfinite(min_distance) || !(min_distance > 0.0f)) return out;
@@ -1766,7 +1753,7 @@ class placement {
   cache_options coverage_options_;
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
-  float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (check_point)
+  float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (make_record)
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;
   std::vector<cache_record> records_;
@@ -1781,7 +1768,7 @@ class placement {
   incremental_grid<std::uint32_t> record_cells_;  // the records' positions (nearby_records_agree)
   std::vector<std::uint32_t> record_point_;  // per record: the point it was placed at
   point_grid grid_of_points_;
-  std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_, contested_;
+  std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_;
   incremental_grid<seed> seed_cells_;  // pick_seeds: the round's seeds so far
   glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
   std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it

@@ -97,9 +97,9 @@ struct cache_record {
   float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
   float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
   /// The sample's irradiance_sample::backface_fraction (at most invalid_backface_fraction, or it
-  /// would not be a record). Points covered by a record with a nonzero value (other than the
-  /// record's own point) get their own hemicube: such a record stands at a contact or where
-  /// surfaces intersect.
+  /// would not be a record). A record whose value passes a tenth of invalid_backface_fraction
+  /// stands at a contact or where surfaces intersect: its radius is limited to its sample's
+  /// min_distance (the nearest hit), so its reach a R never crosses the geometry it touches.
   float backface_fraction = 0.0f;
   /// L1 spherical harmonics of the incoming radiance, world space, the sample's
   /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
@@ -201,6 +201,13 @@ struct cache_options {
   /// left at 0, for callers that fill them in their own terms (the baker dilates valid texels of
   /// the same chart into them).
   bool fill_invalid = true;
+  /// Optional, one entry per point (count entries; not owned, read during the call): nonzero marks
+  /// a point known to be inside geometry, for instance one that an earlier cache_irradiance over
+  /// the same points and scene reported invalid (cache_result::valid = 0: whether a point is
+  /// inside depends on the geometry only, not on the light). Such a point gets no hemicube and no
+  /// coverage test; it is reported invalid and, with fill_invalid, filled like the others. The
+  /// baker passes each bounce pass the points the earlier passes found inside. nullptr = none.
+  const std::uint8_t* known_inside = nullptr;
   /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
   /// sh_l1; the sampler must compute it: make_hemicube_sampler with sh_l1 or
   /// integrate.directional) and its HL2 cone (cache_sample::cone, hemicube_sampler_options::hl2_cone;
