@@ -11,11 +11,7 @@ alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the point
                          DIR/cache_resolution.png and DIR/cache_resolution.md (the table of
                          interpolated hemicube fractions at the targets and gradient savings);
                          the same for cache_resolution_k128.csv (hexagon ceiling and Cornell box,
-                         128 x 128 grid) and cache_cornell_rules.csv (docs/cache.md, the single-record
-                         rules: variant base = before them, c1 = the defaults with them, nearby_only /
-                         sole_reach_only = the ablation), cache_session5.csv (defaults against
-                         extrapolate_wall_depth, and N = 1024), cache_finest_spacing.csv (a scratch
-                         build's coarser finest records, tried and dropped) and cache_weights.csv
+                         128 x 128 grid), cache_weights.csv
                          (cache_weight::ward against ward_continuous; bash benchmarks/run.sh cache_weights)
                          and cache_second_order.csv (cache_options::second_order against first order;
                          bash benchmarks/run.sh cache_second_order). Rows may carry a `variant` column (sweep_cache --variant: which
@@ -178,8 +174,7 @@ def table(rows, path):
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 if os.path.exists(f"{out}/cache_sweep.csv"):
     chart(load_csv(f"{out}/cache_sweep.csv"), f"{out}/cache.png")
-for name in ("cache_resolution", "cache_resolution_k128", "cache_cornell_rules", "cache_session5", "cache_finest_spacing",
-             "cache_weights", "cache_second_order"):
+for name in ("cache_resolution", "cache_resolution_k128", "cache_weights", "cache_second_order"):
     if os.path.exists(f"{out}/{name}.csv"):
         rows = load_csv(f"{out}/{name}.csv")
         if not rows:

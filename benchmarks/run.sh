@@ -7,9 +7,10 @@
 #   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 #   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
-#                                     ward_continuous (docs/cache.md, session 6; not run by default)
+#                                     ward_continuous, first order (docs/cache.md; 15-30 min; not run by default)
 #   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
-#                                     both weights (docs/cache.md, session 7; ~25 min; not run by default)
+#                                     both weights (docs/cache.md; ~25 min; not run by default)
+# What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
 # benchmarks/plot_NAME.py (if any) draws docs/bench/NAME.png from the CSV(s).
@@ -32,10 +33,11 @@ if [ ${#names[@]} -eq 0 ]; then
 fi
 for n in "${names[@]}"; do
   if [ "$n" = cache_second_order ]; then
-    # cache_options::second_order (the default since session 7) against first order, each with
-    # cache_weight::ward and ward_continuous, on the 128 grid with gradients: docs/cache.md,
-    # session 7. The same records for all four; only the interpolation differs. ~25 min on 2 cores
-    # with the per-point references of cache_weights already in build-bench/cache_truth.
+    # cache_options::second_order (on by default) against first order, each with
+    # cache_weight::ward and ward_continuous, on the 128 grid with gradients: docs/cache.md, "The
+    # defaults at N = 64-1024, and the two weights". The same records for all four; only the
+    # interpolation differs. ~10 min on 2 cores with the per-point references of cache_weights
+    # already in build-bench/cache_truth, ~25 min without.
     echo "== sweep_cache (second-order interpolation)"
     csv=docs/bench/cache_second_order.csv truth="$build/cache_truth"
     rm -f "$csv"; mkdir -p "$truth"
@@ -59,8 +61,8 @@ for n in "${names[@]}"; do
   fi
   if [ "$n" = cache_weights ]; then
     # cache_weight::ward against ward_continuous (and each with integrate_options::
-    # extrapolate_wall_depth) on the 128 grid, with gradients: docs/cache.md, session 6 (first
-    # order, as measured then: --second-order no). The same
+    # extrapolate_wall_depth) on the 128 grid, with gradients, first order (--second-order no):
+    # docs/cache.md. The same
     # records for both weights; only the interpolation differs. ~15 min on 2 cores here
     # (the per-point references at N = 512 and 1024 dominate; kept in build-bench/cache_truth).
     echo "== sweep_cache (interpolation weights)"
@@ -91,7 +93,7 @@ for n in "${names[@]}"; do
     echo "== sweep_cache (resolution study)"
     csv=docs/bench/cache_resolution.csv truth="$build/cache_truth" a=0.05,0.1,0.2,0.3,0.5
     rm -f "$csv"; mkdir -p "$truth"
-    common=(--append --grid 64 --a "$a" --truth-cache "$truth" --rolls 4 --second-order no)  # first order, as in sessions 4-5
+    common=(--append --grid 64 --a "$a" --truth-cache "$truth" --rolls 4 --second-order no)  # first order: the study compares resolutions, not interpolants
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes hexagon --n 64,128,256,512 \
       --converged 1024 --stride 7 --check 2048 --check-stride 4
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes cornell --n 64,128,256,512 \

@@ -477,8 +477,9 @@ int main(int argc, char** argv) {
             }
           }
           if (record_regions && ps.key == "cornell") {
-            // Where the records are (docs/cache.md, session 5): the floor and the walls, dark
-            // (E < 0.3 x the mean record E) or not, and the walls' rows under the emitter's plane.
+            // Where the records are (docs/cache.md, "Where the error and the records are"): the
+            // floor and the walls, dark (E < 0.3 x the mean record E) or not, and the walls' rows
+            // under the emitter's plane.
             double mean_e = 0.0;
             for (const cache_record& rec : r.records) mean_e += double(lum(rec.irradiance));
             mean_e /= double(std::max<std::size_t>(r.records.size(), 1));

@@ -124,7 +124,7 @@ enum class cache_weight {
   /// as with `ward` (placement and statistics are identical), but a record's weight falls to 0 at
   /// the edge of its reach instead of jumping from 1/a to 0 there, so the interpolated irradiance
   /// is continuous where a record's reach ends. Ward's own weight (and its jump) remains inside
-  /// the coverage tests. docs/cache.md (session 6): Cornell box N = 512, a = 0.5, 1.16% -> 1.02%
+  /// the coverage tests. docs/cache.md ("Measured"): Cornell box N = 512, a = 0.5, 1.16% -> 1.02%
   /// RMS at the same 10.6% of the points; hexagon ceiling a = 0.5, 1.28% -> 1.03%.
   ward_continuous,  // last, so the earlier values stay as they were (and match the C ABI's numbering)
 };
@@ -189,7 +189,7 @@ struct cache_options {
   /// Placement and statistics are unchanged (the same records); only the final values differ.
   /// First-order predictions all miss a curved E the same way (below it where E is convex), so
   /// averaging them does not cancel that error. The term is clamped to +-a E_i per channel.
-  /// docs/cache.md (session 7): Cornell box N = 512, a = 0.5, 1.16% -> 0.82% RMS against a
+  /// docs/cache.md ("Measured"): Cornell box N = 512, a = 0.5, 1.16% -> 0.82% RMS against a
   /// hemicube at every point, at the same 10.65% of the points; hexagon ceiling 1.28% -> 0.62%;
   /// lower RMS in every row measured (N = 64 to 1024). Off when use_gradients is off.
   /// Cost: about 3 us per record once (0.1 s for 35,824 records on 2 cores), and 3 quadratic

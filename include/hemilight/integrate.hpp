@@ -61,7 +61,7 @@ struct integrate_options {
   /// emitter 2 mm above the point's plane, N = 256, 23% -> 0.97% error; of a wall beside the
   /// point, 3.8% -> 0.13%). Cost: ~1.0-1.1x the integration time with the AVX2 kernels, one more
   /// pass over the walls without them. Off by default: the cache's error curves with it are mixed
-  /// (docs/cache.md, session 5).
+  /// (docs/cache.md, "Measured"; docs/design/cache.md).
   bool extrapolate_wall_depth = false;
   bool directional = false;  ///< also compute L1 spherical harmonics and the Half-Life 2 basis irradiance
   bool double_precision = false;  ///< accumulate in double instead of float (slower; for checks)
