@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 
 using namespace hemilight;
 using namespace hemilight::test;
@@ -954,4 +955,55 @@ TEST_CASE("cache: fill_invalid = false leaves points inside geometry at 0 and ev
       CHECK(filled.irradiance[i].x > 0.0f);
     }
   }
+}
+
+TEST_CASE("cache: known_inside points get no hemicube and stay invalid; the rest is sampled as before", "[cache]") {
+  // The floor of the lit room with a closed box standing on it (as the tests above): a first
+  // run finds the floor points under the box inside; a second run is told them.
+  closed_form_scene s = lit_room();
+  const glm::dvec3 lo(0.2, 0.2, -0.01), hi(0.6, 0.6, 0.5);
+  auto q = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) { add_quad(s.tris, a, b, c, d, glm::vec3(0.5f)); };
+  q({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
+  q({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
+  q({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});
+  q({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});
+  q({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});
+  std::vector<glm::vec3> p, n;
+  floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.05f, p, n);
+  const irradiance_sampler inner = raycast_sampler(s, 16);
+  std::mutex m;
+  std::vector<glm::vec3> sampled_at;
+  const irradiance_sampler counting = [&](int worker, const glm::vec3& x, const glm::vec3& nx) {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      sampled_at.push_back(x);
+    }
+    return inner(worker, x, nx);
+  };
+  cache_options o;
+  o.fill_invalid = false;
+  const cache_result first = cache_irradiance(p.data(), n.data(), p.size(), counting, o);
+  std::vector<std::uint8_t> inside(p.size());
+  std::size_t inside_count = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    inside[i] = first.valid[i] ? 0 : 1;
+    inside_count += inside[i];
+    // Every point strictly under the box (its footprint less a margin of one grid step) is inside.
+    if (p[i].x > lo.x + 0.05 && p[i].x < hi.x - 0.05 && p[i].y > lo.y + 0.05 && p[i].y < hi.y - 0.05) CHECK(inside[i] == 1);
+  }
+  REQUIRE(inside_count > 0);
+  sampled_at.clear();
+  o.known_inside = inside.data();
+  const cache_result second = cache_irradiance(p.data(), n.data(), p.size(), counting, o);
+  CHECK(second.stats.invalid_samples == 0);  // nothing left inside to find: no hemicube saw back faces
+  CHECK(second.stats.hemicubes == sampled_at.size());
+  CHECK(second.stats.hemicubes < first.stats.hemicubes);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (inside[i]) {
+      CHECK(second.valid[i] == 0);
+      CHECK(second.irradiance[i] == glm::vec3(0.0f));
+      for (const glm::vec3& x : sampled_at) CHECK(x != p[i]);
+    } else {
+      CHECK(second.valid[i] == 1);
+    }
 }
