@@ -1,6 +1,6 @@
 // Lights (lights.hpp) in bakes: cost, penumbra accuracy and the cache on the indirect part.
 //   usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K]
-//                       [--cornell-sizes 128,256,512]
+//                       [--cornell-sizes 128,256,512] [--reference-cache DIR]
 // Writes OUT_PREFIX_direct.csv, OUT_PREFIX_penumbra.csv and OUT_PREFIX_cornell.csv (a trailing
 // "_sweep.csv" or ".csv" is dropped from OUT_PREFIX: `bash benchmarks/run.sh lights` passes
 // docs/bench/lights_sweep.csv and gets docs/bench/lights_*.csv, drawn by plot_lights.py).
@@ -258,7 +258,32 @@ double relative_rms(const bake_result& a, const bake_result& ref) {
 // The cache on indirect light at each lightmap size in `sizes`: the emissive quad (at 128 x 128
 // only: it is the slow half, and its trend is the RECT's) and the RECT light; the cached bakes at
 // N = 64 and 256 for each error threshold against a hemicube per texel at N = 256.
-void cornell(const std::string& path, const std::vector<int>& sizes) {
+// --reference-cache DIR: the references are kept in DIR (cornell_rect_SIZE.bin,
+// cornell_quad_SIZE.bin: the reference's wall time as a double, then the W x H RGB irradiance as
+// floats, then the W x H valid flags), read when present instead of baked again. The references
+// do not depend on the cache, so they stay valid across cache changes.
+bool read_reference(const std::string& file, int size, bake_result& ref) {
+  std::FILE* f = std::fopen(file.c_str(), "rb");
+  if (!f) return false;
+  const std::size_t texels = std::size_t(size) * std::size_t(size);
+  ref.irradiance = image::make(size, size, 3);
+  ref.valid.resize(texels);
+  const bool ok = std::fread(&ref.stats.seconds, sizeof(double), 1, f) == 1 &&
+                  std::fread(ref.irradiance.pixels.data(), sizeof(float), 3 * texels, f) == 3 * texels &&
+                  std::fread(ref.valid.data(), 1, texels, f) == texels;
+  std::fclose(f);
+  return ok;
+}
+void write_reference(const std::string& file, const bake_result& ref) {
+  std::FILE* f = std::fopen(file.c_str(), "wb");
+  if (!f) return;
+  std::fwrite(&ref.stats.seconds, sizeof(double), 1, f);
+  std::fwrite(ref.irradiance.pixels.data(), sizeof(float), ref.irradiance.pixels.size(), f);
+  std::fwrite(ref.valid.data(), 1, ref.valid.size(), f);
+  std::fclose(f);
+}
+
+void cornell(const std::string& path, const std::vector<int>& sizes, const std::string& reference_cache) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
     std::fprintf(stderr, "cannot write %s\n", path.c_str());
@@ -281,9 +306,16 @@ void cornell(const std::string& path, const std::vector<int>& sizes) {
       o.lights = ls.lights;
       o.use_cache = false;
       o.resolution = 256;
-      const bake_result ref = bake_lightmap(in, o);
-      std::printf("cornell %d^2 (%s): reference (hemicube per texel, N = 256): %.1f s\n", size, rect ? "rect light" : "emissive quad",
-                  ref.stats.seconds);
+      bake_result ref;
+      const std::string cached = reference_cache.empty() ? std::string()
+                                                         : reference_cache + "/cornell_" + (rect ? "rect_" : "quad_") + std::to_string(size) + ".bin";
+      const bool from_cache = !cached.empty() && read_reference(cached, size, ref);
+      if (!from_cache) {
+        ref = bake_lightmap(in, o);
+        if (!cached.empty()) write_reference(cached, ref);
+      }
+      std::printf("cornell %d^2 (%s): reference (hemicube per texel, N = 256): %.1f s%s\n", size, rect ? "rect light" : "emissive quad",
+                  ref.stats.seconds, from_cache ? " (kept in the reference cache)" : "");
       std::fflush(stdout);
       o.use_cache = true;
       for (const int n : {64, 256})
@@ -307,7 +339,7 @@ void cornell(const std::string& path, const std::vector<int>& sizes) {
 
 int main(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K] [--cornell-sizes 128,256,512]\n");
+    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K] [--cornell-sizes 128,256,512] [--reference-cache DIR]\n");
     return 2;
   }
   // run.sh passes docs/bench/lights_sweep.csv: the prefix is then docs/bench/lights.
@@ -321,10 +353,12 @@ int main(int argc, char** argv) {
   std::string only = "direct,penumbra,cornell";
   direct_options tested;  // the defaults unless --penumbra-samples
   std::vector<int> cornell_sizes = {128, 256, 512};
+  std::string reference_cache;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--runs") runs = std::max(1, std::atoi(argv[i + 1]));
     else if (a == "--only") only = argv[i + 1];
+    else if (a == "--reference-cache") reference_cache = argv[i + 1];
     else if (a == "--penumbra-samples") tested.penumbra_samples = std::atoi(argv[i + 1]);
     else if (a == "--cornell-sizes") {
       cornell_sizes.clear();
@@ -340,7 +374,7 @@ int main(int argc, char** argv) {
   std::printf("load average before: %s\n", load_average().c_str());
   if (wants("direct")) direct_target(prefix + "_direct.csv", runs);
   if (wants("penumbra")) penumbra(prefix + "_penumbra.csv", tested);
-  if (wants("cornell")) cornell(prefix + "_cornell.csv", cornell_sizes);
+  if (wants("cornell")) cornell(prefix + "_cornell.csv", cornell_sizes, reference_cache);
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
 }
