@@ -13,6 +13,8 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <unordered_map>
+#include <array>
 
 namespace hemilight {
 
@@ -589,5 +591,109 @@ glm::vec3 direct_irradiance(const scene& s, const light_set& lights, const glm::
 }
 
 void validate_direct_options(const direct_options& options) { check_options(options); }
+
+}  // namespace hemilight
+
+namespace hemilight {
+
+namespace {
+
+// An edge by its two end positions' bits, smaller first: the same edge whatever the indices.
+struct edge_key {
+  std::array<std::uint32_t, 6> bits;
+  bool operator==(const edge_key& o) const noexcept { return bits == o.bits; }
+};
+struct edge_key_hash {
+  std::size_t operator()(const edge_key& k) const noexcept {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
+    return static_cast<std::size_t>(h);
+  }
+};
+edge_key key_of(const glm::vec3& a, const glm::vec3& b) {
+  std::array<std::uint32_t, 3> ba, bb;
+  std::memcpy(ba.data(), &a, sizeof(a));
+  std::memcpy(bb.data(), &b, sizeof(b));
+  if (bb < ba) std::swap(ba, bb);
+  return {{ba[0], ba[1], ba[2], bb[0], bb[1], bb[2]}};
+}
+
+bool same_bits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof(a)) == 0; }
+
+// The RECT the two triangles t (corners p, q shared, r its own) and u (s its own) form, if they
+// form a rectangle with diagonal p-q (see emissive_rects_to_lights).
+bool rect_of(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& r, const glm::dvec3& s, const glm::dvec3& normal_t,
+             const glm::dvec3& normal_u, light& out) {
+  const double diagonal = glm::length(q - p);
+  if (!(diagonal > 0.0)) return false;
+  const double tol = 1e-4 * diagonal;
+  const glm::dvec3 u = p - r, v = q - r;  // the sides at r
+  const double lu = glm::length(u), lv = glm::length(v);
+  if (!(lu > tol) || !(lv > tol)) return false;
+  if (std::fabs(glm::dot(u, v)) > tol * std::max(lu, lv)) return false;  // right angle at r
+  if (glm::length(s - (p + q - r)) > tol) return false;                   // the fourth corner
+  const double nt = glm::length(normal_t), nu = glm::length(normal_u);
+  if (!(nt > 0.0) || !(nu > 0.0) || glm::dot(normal_t, normal_u) < (1.0 - 1e-6) * nt * nu) return false;  // same facing
+  out.type = light_type::rect;
+  out.position = glm::vec3(0.5 * (p + q));
+  out.direction = glm::vec3(normal_t / nt);
+  out.tangent = glm::vec3(u / lu);
+  out.width = float(lu);
+  out.height = float(lv);
+  out.casts_shadows = true;
+  return true;
+}
+
+}  // namespace
+
+std::vector<light> emissive_rects_to_lights(scene_mesh& mesh) {
+  std::vector<light> lights;
+  const std::size_t triangles = std::min(mesh.triangle_count(), mesh.materials.size());
+  const std::size_t vertices = mesh.positions.size();
+  const auto corner = [&](std::size_t t, int k) { return mesh.positions[mesh.indices[3 * t + std::size_t(k)]]; };
+  const auto candidate = [&](std::size_t t) {
+    const material& m = mesh.materials[t];
+    if (m.two_sided || m.emission == glm::vec3(0.0f)) return false;
+    for (int k = 0; k < 3; ++k)
+      if (mesh.indices[3 * t + std::size_t(k)] >= vertices) return false;
+    return true;
+  };
+  // Step 1: the edges of the candidate triangles, each with the triangles that have it.
+  std::unordered_map<edge_key, std::vector<std::uint32_t>, edge_key_hash> edges;
+  for (std::size_t t = 0; t < triangles; ++t) {
+    if (!candidate(t)) continue;
+    for (int k = 0; k < 3; ++k) edges[key_of(corner(t, k), corner(t, (k + 1) % 3))].push_back(static_cast<std::uint32_t>(t));
+  }
+  // Step 2: greedy pairing in index order.
+  std::vector<std::uint8_t> used(triangles, 0);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    if (used[t] || !candidate(t)) continue;
+    const glm::dvec3 a(corner(t, 0)), b(corner(t, 1)), c(corner(t, 2));
+    const glm::dvec3 normal_t = glm::cross(b - a, c - a);
+    for (int k = 0; k < 3 && !used[t]; ++k) {
+      const glm::vec3 p = corner(t, k), q = corner(t, (k + 1) % 3), r = corner(t, (k + 2) % 3);
+      for (const std::uint32_t u : edges[key_of(p, q)]) {
+        if (u == t || used[u] || !same_bits(mesh.materials[u].emission, mesh.materials[t].emission)) continue;
+        int own = -1;  // u's corner that is not on the shared edge
+        for (int j = 0; j < 3; ++j)
+          if (!same_bits(corner(u, j), p) && !same_bits(corner(u, j), q)) own = j;
+        if (own < 0) continue;
+        const glm::dvec3 ua(corner(u, 0)), ub(corner(u, 1)), uc(corner(u, 2));
+        light l;
+        if (!rect_of(glm::dvec3(p), glm::dvec3(q), glm::dvec3(r), glm::dvec3(corner(u, own)), normal_t,
+                     glm::cross(ub - ua, uc - ua), l))
+          continue;
+        l.color = mesh.materials[t].emission;
+        lights.push_back(l);
+        used[t] = used[u] = 1;
+        break;
+      }
+    }
+  }
+  // Step 3: the paired triangles stop emitting (the lights carry their light now).
+  for (std::size_t t = 0; t < triangles; ++t)
+    if (used[t]) mesh.materials[t].emission = glm::vec3(0.0f);
+  return lights;
+}
 
 }  // namespace hemilight

@@ -4,6 +4,7 @@
 // L cos(theta) (cos(theta') / d^2) over the light's directions or area.
 #include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/reference_scenes.hpp"
 
 #include "raycast_reference.hpp"
 #include "test_support.hpp"
@@ -464,4 +465,87 @@ TEST_CASE("lights: per-point results are bitwise the same in any call order and 
     }
   }
   CHECK(penumbra > 20);  // the points do cross penumbrae, where the sampling pattern matters
+}
+
+TEST_CASE("lights: emissive_rects_to_lights turns the Cornell box's light quad into its RECT light", "[lights]") {
+  scene_mesh m = cornell_box();
+  const scene_mesh original = m;
+  const std::vector<light> ls = emissive_rects_to_lights(m);
+  REQUIRE(ls.size() == 1);
+  const light& l = ls[0];
+  // The quad (reference_scenes.cpp): 0.13 x 0.105 m centred at (0.278, 0.5478, 0.2795), facing
+  // down, radiance (17, 12, 4); the same light cornell_box_rect_light places by hand.
+  const light by_hand = cornell_box_rect_light().lights.at(0);
+  CHECK(l.type == light_type::rect);
+  CHECK(glm::length(l.position - by_hand.position) < 1e-6f);
+  CHECK(glm::length(glm::normalize(l.direction) - glm::vec3(0, -1, 0)) < 1e-6f);
+  CHECK(l.color == by_hand.color);
+  CHECK(l.casts_shadows);
+  const bool along_x = std::fabs(l.tangent.x) > 0.999f;
+  CHECK((along_x || std::fabs(l.tangent.z) > 0.999f));
+  CHECK(std::fabs((along_x ? l.width : l.height) - 0.13f) < 1e-6f);
+  CHECK(std::fabs((along_x ? l.height : l.width) - 0.105f) < 1e-6f);
+  // The quad stays as geometry and stops emitting; nothing else changes.
+  REQUIRE(m.positions == original.positions);
+  REQUIRE(m.indices == original.indices);
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    CHECK(m.materials[t].emission == glm::vec3(0.0f));
+    CHECK(m.materials[t].albedo == original.materials[t].albedo);
+  }
+  // The light gives what the triangles gave: Lambert's formula over the original two triangles
+  // (tests/raycast_reference.hpp, independent of the conversion) at floor and wall points.
+  const light_set set(ls.data(), ls.size());
+  for (const auto& pn : {std::pair<glm::vec3, glm::vec3>{{0.2f, 0.0f, 0.3f}, {0, 1, 0}}, {{0.556f, 0.3f, 0.2f}, {-1, 0, 0}},
+                         {{0.1f, 0.25f, 0.5592f}, {0, 0, -1}}}) {
+    glm::dvec3 phi(0.0);
+    for (std::size_t t = 0; t < original.triangle_count(); ++t) {
+      const glm::vec3 e = original.materials[t].emission;
+      if (e == glm::vec3(0.0f)) continue;
+      std::vector<glm::dvec3> tri;
+      for (int k = 0; k < 3; ++k) tri.push_back(glm::dvec3(original.positions[original.indices[3 * t + std::size_t(k)]]));
+      phi += polygon_vector_irradiance(tri, glm::dvec3(pn.first), double(e.x));
+    }
+    const double expected = glm::dot(phi, glm::dvec3(pn.second));
+    CHECK(rel(unoccluded_irradiance(set, 0, pn.first, pn.second).x, expected) < 1e-4);  // both exact: float rounding
+  }
+}
+
+TEST_CASE("lights: emissive_rects_to_lights leaves other emitters alone", "[lights]") {
+  const material glow{{2.0f, 2.0f, 2.0f}, glm::vec3(0.5f), false};
+  const auto untouched = [](scene_mesh m, const char* what) {
+    const scene_mesh before = m;
+    INFO(what);
+    CHECK(emissive_rects_to_lights(m).empty());
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) CHECK(m.materials[t].emission == before.materials[t].emission);
+  };
+  scene_mesh lone;
+  lone.add_triangle({0, 0, 1}, {1, 0, 1}, {0, 1, 1}, glow);
+  untouched(lone, "a lone triangle");
+  scene_mesh slanted;  // a parallelogram, not a rectangle
+  slanted.add_quad({0, 0, 1}, {1, 0, 1}, {1.5f, 1, 1}, {0.5f, 1, 1}, glow);
+  untouched(slanted, "a parallelogram");
+  scene_mesh both_sides;
+  both_sides.add_quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, material{{2.0f, 2.0f, 2.0f}, glm::vec3(0.5f), true});
+  untouched(both_sides, "a two-sided rectangle");
+  scene_mesh two_colours;
+  two_colours.add_triangle({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, glow);
+  two_colours.add_triangle({0, 0, 1}, {1, 1, 1}, {0, 1, 1}, material{{2.0f, 2.0f, 2.5f}, glm::vec3(0.5f), false});
+  untouched(two_colours, "two emissions");
+  scene_mesh folded;  // the second triangle faces the other way
+  folded.add_triangle({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, glow);
+  folded.add_triangle({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, glow);
+  untouched(folded, "opposite facings");
+  scene_mesh bent;  // a rectangle folded along its diagonal by 1% of it
+  bent.add_triangle({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, glow);
+  bent.add_triangle({0, 0, 1}, {1, 1, 1}, {0, 1, 1.014f}, glow);
+  untouched(bent, "a folded rectangle");
+  // Separate vertices (add_triangle) still pair: edges match by position.
+  scene_mesh split;
+  split.add_triangle({0, 0, 1}, {2, 0, 1}, {2, 1, 1}, glow);
+  split.add_triangle({0, 0, 1}, {2, 1, 1}, {0, 1, 1}, glow);
+  const std::vector<light> ls = emissive_rects_to_lights(split);
+  REQUIRE(ls.size() == 1);
+  CHECK(ls[0].width * ls[0].height == Approx(2.0f).epsilon(1e-6));
+  CHECK(glm::length(ls[0].position - glm::vec3(1.0f, 0.5f, 1.0f)) < 1e-6f);
+  CHECK(glm::length(ls[0].direction - glm::vec3(0, 0, 1)) < 1e-6f);
 }

@@ -204,4 +204,22 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
 glm::vec3 direct_irradiance(const scene& s, const light_set& lights, const glm::vec3& p, const glm::vec3& n,
                             const direct_options& options = {}, light_sample* per_light = nullptr);
 
+/// Emissive rectangles as RECT lights, so that their direct light is computed exactly at every
+/// point (closed form, shadow rays) instead of seen by hemicubes (which alias small emitters and
+/// make the cache place records along their light's edges).
+/// Finds pairs of one-sided emissive triangles of `mesh` that share an edge (the same two vertex
+/// positions, bit for bit, whatever the indices), have the same emission (bit for bit), face the
+/// same way and together form a rectangle: the shared edge is its diagonal, the two other corners
+/// see it at right angles and the fourth corner is where a rectangle puts it, each within 1e-4 of
+/// the rectangle's diagonal. For each pair it returns a RECT light (centre, normal = the front
+/// face, tangent = the side from the first triangle's third corner to the first shared corner,
+/// width and height = the side lengths, color = the emission, casts_shadows) and sets both
+/// triangles' emission to 0: hemicubes no longer see them as a source, and they stay in the scene
+/// (they block and reflect as before). A triangle pairs at most once, greedily in index order.
+/// Two-sided emitters, lone triangles and other shapes (parallelograms, triangle fans) are left as
+/// they are. Append the result to bake_options::lights. Mesh indices must be < positions.size()
+/// (scene::create's checks; here triangles with an index out of range are skipped).
+/// Cost: O(emissive triangles) expected (a hash of their edges).
+std::vector<light> emissive_rects_to_lights(scene_mesh& mesh);
+
 }  // namespace hemilight
