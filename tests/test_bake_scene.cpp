@@ -89,12 +89,11 @@ scene_mesh turned(scene_mesh m, glm::vec3 t) {
   return m;
 }
 
-// Largest |a - b| / max(|b|, floor) over the sampled texels of two bakes of the same grid.
+// Largest |a - b| / max(|b|, floor) over all texels (sampled and dilated) of two bakes of the same grid.
 double worst_relative(const bake_result& a, const bake_result& b, double floor_value) {
   REQUIRE(a.irradiance.pixels.size() == b.irradiance.pixels.size());
   double worst = 0.0;
   for (std::size_t k = 0; k < a.sampled.size(); ++k)
-    if (b.sampled[k])
       for (std::size_t c = 0; c < 3; ++c) {
         const double x = a.irradiance.pixels[3 * k + c], y = b.irradiance.pixels[3 * k + c];
         worst = std::max(worst, std::fabs(x - y) / std::max(std::fabs(y), floor_value));
