@@ -52,6 +52,7 @@
 #include "hemilight/reference_scenes.hpp"
 
 #include "model_import.hpp"
+#include "preview.hpp"
 
 #include <png.h>
 
@@ -96,6 +97,10 @@ const char* usage =
     "  --probes P         also write NAME_probes.json: SH9 light probes (probes.hpp) that see the\n"
     "                     baked surfaces, at the centres of an AxBxC grid over the scene's bounds\n"
     "                     (P like 8x4x8) or at the points of a text file (x y z per line, # comments)\n"
+    "  --preview [CAMERA] also write NAME_preview.png: the baked scene rendered (lightmap x albedo +\n"
+    "                     emission, bilinear) from CAMERA = EX,EY,EZ,TX,TY,TZ[,FOV] (eye, target, field\n"
+    "                     of view in degrees, (0, 90], default 60) or a view chosen from the scene's\n"
+    "                     bounds; built-in scenes always get one\n"
     "  --lightmap-uv C    the model's UV channel holding the lightmap UVs, 0..7 (default 1: glTF's\n"
     "                     TEXCOORD_1; OBJ files have only channel 0)\n"
     "  --quiet            no progress bar\n"
@@ -116,6 +121,9 @@ struct settings {
   glm::vec3 sky{1.0f};
   bool quiet = false, shadow_mask = false;
   unsigned lightmap_uv = 1;  // --lightmap-uv: the model's UV channel holding the lightmap UVs
+  bool preview = false;      // --preview: a rendered picture of each baked model (built-in scenes: always)
+  bool has_camera = false;   // --preview EX,EY,EZ,TX,TY,TZ[,FOV]
+  preview::camera camera;
   std::string probes;  // --probes: "AxBxC" or a file of points; empty: none
 };
 
@@ -220,6 +228,20 @@ settings parse(int argc, char** argv) {
       s.shadow_mask = true;
     } else if (a == "--probes") {
       s.probes = value();
+    } else if (a == "--preview") {
+      s.preview = true;
+      // An optional camera: the next argument if it reads as one (a model path does not).
+      if (i + 1 < argc && argv[i + 1][0] != '-') {
+        preview::camera cam;
+        if (preview::parse_camera(argv[i + 1], cam)) {
+          s.camera = cam;
+          s.has_camera = true;
+          ++i;
+        } else if (std::strchr(argv[i + 1], ',')) {
+          fail(std::string("--preview ") + argv[i + 1] + " is invalid: the camera is EX,EY,EZ,TX,TY,TZ[,FOV] with FOV in (0, 90] "
+               "degrees and the eye away from the target", 2);
+        }
+      }
     } else if (a == "--lightmap-uv") {
       s.lightmap_uv = unsigned(parse_int("--lightmap-uv", value(), 0, 7));
     } else if (a == "--quiet") {
@@ -425,6 +447,17 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
     if (p == 0)
       for (const std::string& w : written) suffixes += w.substr(base.size() + 1) + ",";
   }
+  std::string preview_line;
+  if (s.preview || s.model.empty()) {
+    const std::vector<image> radiance = preview::page_radiance(in, sr);
+    const preview::camera cam = s.has_camera ? s.camera : preview::default_camera(in, radiance);
+    preview::write_png(base + "_preview.png", preview::render(in, radiance, cam, 512));
+    char line[256];
+    std::snprintf(line, sizeof line, "  preview from (%.3g, %.3g, %.3g) towards (%.3g, %.3g, %.3g), %.3g degrees: %s_preview.png\n",
+                  double(cam.eye.x), double(cam.eye.y), double(cam.eye.z), double(cam.target.x), double(cam.target.y),
+                  double(cam.target.z), double(cam.fov_degrees), base.c_str());
+    preview_line = line;
+  }
   const bake_stats& st = sr.stats;
   std::printf("%s: %zu triangles, %zu page%s of %d x %d, N = %d, %d bounce%s%s, %d threads\n", name.c_str(),
               in.geometry.scene.triangle_count, sr.pages.size(), sr.pages.size() > 1 ? "s" : "", o.width, o.height, o.resolution,
@@ -440,6 +473,7 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
     std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
   std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}%s\n", st.seconds, st.coverage_seconds, base.c_str(),
               suffixes.c_str(), sr.pages.size() > 1 ? (" and the same for pages 1.." + std::to_string(sr.pages.size() - 1) + " (" + base + "_pageP_*)").c_str() : "");
+  std::fputs(preview_line.c_str(), stdout);
   if (s.probes.empty()) return;
   // Probes that see the baked surfaces (emission + albedo E / pi), the sky and the lights.
   const auto t0 = std::chrono::steady_clock::now();

@@ -123,6 +123,15 @@ expect_fail "bad.exr" -- quad.obj --lightmap-uv 0 --environment bad.exr
 expect_fail "no lightmap UVs (UV channel 0)" "mesh 0" -- nouv.obj --lightmap-uv 0
 expect_fail "outside \[0, 1\]" -- outside.obj --lightmap-uv 0
 expect_fail "zero area in lightmap UV space" -- flat.obj --lightmap-uv 0
+# Previews: --preview renders the baked model (default camera, or eye,target,fov); a bad camera
+# is a usage error.
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --preview --out pv
+[ -s pv/quad_preview.png ] || { echo "FAIL: pv/quad_preview.png not written"; fails=$((fails + 1)); }
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --preview 0.5,2,0.5,0.5,0,0.5,50 --out pv2
+grep -q "preview from (0.5, 2, 0.5) towards (0.5, 0, 0.5), 50 degrees" ok.log || { echo "FAIL: camera not used:"; cat ok.log; fails=$((fails + 1)); }
+[ -e pv2/quad_irradiance.png ] && [ -s pv2/quad_preview.png ] || { echo "FAIL: pv2 outputs"; fails=$((fails + 1)); }
+expect_fail "--preview 1,1,1,1,1,1" "EX,EY,EZ,TX,TY,TZ" -- quad.obj --lightmap-uv 0 --preview 1,1,1,1,1,1
+expect_fail "--preview 0,1,0,0,0,0,150" -- quad.obj --lightmap-uv 0 --preview 0,1,0,0,0,0,150
 # Lightmap UVs come from UV channel 1 by default: an OBJ has only channel 0, named with its mesh.
 expect_fail "no lightmap UVs (UV channel 1)" "mesh 0" "--lightmap-uv 0" -- quad.obj
 # A texture that cannot be read is an error naming the material and the file.

@@ -212,3 +212,111 @@ TEST_CASE("Model import: a missing texture and meshes without lightmap UVs are o
     CHECK(std::string(e.what()).find("no such file") != std::string::npos);
   }
 }
+
+// ---- previews (examples/preview.hpp) ---------------------------------------------------------------
+
+#include "preview.hpp"
+
+namespace {
+
+// Two floor quads under a uniform sky (E = pi at every texel, so radiance = albedo exactly), one
+// per page (the second page narrower, placed by scale and offset).
+struct two_floors {
+  scene_mesh mesh;
+  scene_bake_input in;
+  two_floors() {
+    material a, b;
+    a.albedo = glm::vec3(0.5f);
+    b.albedo = glm::vec3(0.25f);
+    mesh.add_quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}, a);
+    mesh.add_quad({1.5f, 0, 0}, {1.5f, 0, 1}, {2.5f, 0, 1}, {2.5f, 0, 0}, b);
+    // Quad 1 fills its page; quad 2's UVs are in [2, 3] x [0, 1], offset by -2 into its page.
+    mesh.lightmap_uvs = {{0, 0}, {0, 1}, {1, 1}, {1, 0}, {2, 0}, {2, 1}, {3, 1}, {3, 0}};
+    in.geometry.scene = mesh.desc();
+    in.geometry.scene.sky_radiance = glm::vec3(1.0f);
+    lightmap_page p0, p1;
+    p0.width = p0.height = 16;
+    p1.width = 8;
+    p1.height = 12;
+    in.pages = {p0, p1};
+    bake_mesh m0, m1;
+    m0.triangle_count = 2;
+    m0.page = 0;
+    m1.first_triangle = 2;
+    m1.triangle_count = 2;
+    m1.page = 1;
+    m1.uv_offset = glm::vec2(-2.0f, 0.0f);
+    in.meshes = {m0, m1};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Preview: every pixel shows lightmap x albedo exactly where the bake is uniform, across pages, or the sky", "[preview]") {
+  const two_floors s;
+  bake_options o;
+  o.resolution = 16;
+  o.bounces = 2;
+  o.thread_count = 2;
+  const scene_bake_result r = bake_scene(s.in, o);
+  const std::vector<image> radiance = preview::page_radiance(s.in, r);
+  preview::camera cam;
+  cam.eye = {1.25f, 2.0f, 0.5f};
+  cam.target = {1.25f, 0.0f, 0.5f};
+  cam.fov_degrees = 80.0f;
+  const image pic = preview::render(s.in, radiance, cam, 64);
+  REQUIRE(pic.width == 64);
+  int a = 0, b = 0, sky = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float v = pic.at(x, y)[0];
+      // Up-facing floors see only the sky: E = pi (float sums of exact hemicube weights, 1e-4
+      // relative), radiance = albedo E / pi. Any bleeding between pages or black at a page's
+      // border would show as another value.
+      if (std::fabs(v - 0.5f) < 1e-4f) ++a;
+      else if (std::fabs(v - 0.25f) < 1e-4f) ++b;
+      else if (v == 1.0f) ++sky;
+      else FAIL_CHECK("pixel (" << x << ", " << y << ") = " << v);
+    }
+  CHECK(a > 300);
+  CHECK(b > 300);
+  CHECK(sky > 300);
+  // Looking straight down (-y) with +z at the top of the picture, +x points left (right =
+  // forward x up = -x): the first floor (x < 1) is on the right.
+  CHECK(std::fabs(pic.at(44, 32)[0] - 0.5f) < 1e-4f);
+  CHECK(std::fabs(pic.at(20, 32)[0] - 0.25f) < 1e-4f);
+}
+
+TEST_CASE("Preview: the default camera sees a closed room from inside and cameras are checked", "[preview]") {
+  scene_mesh room;
+  material grey;
+  grey.albedo = glm::vec3(0.5f);
+  room.add_box({0, 0, 0}, {4, 3, 5}, grey, true);
+  generate_lightmap_uvs(room, 32, 2);
+  scene_bake_input in;
+  in.geometry.scene = room.desc();
+  lightmap_page page;
+  page.width = page.height = 32;
+  in.pages = {page};
+  bake_mesh all;
+  all.triangle_count = room.triangle_count();
+  all.page = 0;
+  in.meshes = {all};
+  const std::vector<image> radiance(1, image::make(32, 32, 3, 1.0f));
+  const preview::camera cam = preview::default_camera(in, radiance);
+  // Inside the room's bounds (from outside every wall shows its back).
+  for (int c = 0; c < 3; ++c) {
+    CHECK(cam.eye[c] > 0.0f);
+    CHECK(cam.eye[c] < (c == 0 ? 4.0f : c == 1 ? 3.0f : 5.0f));
+  }
+  preview::camera parsed;
+  CHECK(preview::parse_camera("1,2,3,4,5,6", parsed));
+  CHECK(parsed.fov_degrees == 60.0f);
+  CHECK(preview::parse_camera("1,2,3,4,5,6,45", parsed));
+  CHECK(parsed.fov_degrees == 45.0f);
+  CHECK_FALSE(preview::parse_camera("1,2,3,1,2,3", parsed));     // eye at the target
+  CHECK_FALSE(preview::parse_camera("1,2,3,4,5,6,120", parsed)); // wider than a hemicube face
+  CHECK_FALSE(preview::parse_camera("1,2,3,4,5", parsed));
+  CHECK_FALSE(preview::parse_camera("model.gltf", parsed));
+  test::require_error([&] { preview::render(in, radiance, cam, 8); }, status::invalid_argument, "size 8 is not in [16, 4096]");
+}
