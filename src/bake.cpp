@@ -277,7 +277,25 @@ std::vector<std::string> write_bake_exrs(const bake_result& r, const std::string
   return written;
 }
 
-lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height) {
+namespace {
+
+// Step 1 for the covered texels only (the baker's own form of lightmap_samples): one entry per
+// texel with coverage > 0, in texel order, each field as lightmap_samples defines it. Memory: a
+// 4-byte slot per texel while it is computed, then about 80 bytes per covered texel.
+struct sparse_samples {
+  int width = 0, height = 0;
+  std::vector<std::size_t> texel;  // texel index (row-major), increasing
+  std::vector<float> coverage;
+  std::vector<std::uint32_t> owner, sample_triangle;
+  std::vector<glm::vec2> centroid;
+  std::vector<glm::vec3> position, normal, tangent, bitangent;
+  std::vector<float> texel_world_size;
+  std::size_t overlapping_texels = 0;
+
+  std::size_t size() const { return texel.size(); }
+};
+
+sparse_samples compute_sparse_samples(const bake_input& input, int width, int height) {
   const char* who = "compute_lightmap_samples";
   check_size(who, width, height);
   check_input(who, input);
@@ -296,64 +314,100 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
 
   // Pass A: coverage sum, area-weighted centroid, owner (largest area, ties to the lower index:
   // triangles are visited in index order and only a strictly larger area replaces the owner).
-  std::vector<double> sum_area(texels, 0.0), owner_area(texels, 0.0);
-  std::vector<glm::dvec2> sum_centroid(texels, glm::dvec2(0.0)), owner_centroid(texels, glm::dvec2(0.0));
-  std::vector<std::uint32_t> owner(texels, none);
+  // Per covered texel: a slot, made when a triangle first covers it (the sums per texel are
+  // formed in triangle order whatever the slot).
+  constexpr std::uint32_t no_slot = 0xffffffffu;
+  std::vector<std::uint32_t> slot_of(texels, no_slot);
+  std::vector<std::size_t> slot_texel;
+  std::vector<double> sum_area, owner_area;
+  std::vector<glm::dvec2> sum_centroid, owner_centroid;
+  std::vector<std::uint32_t> owner;
   for (std::size_t i = 0; i < d.triangle_count; ++i)
     for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
       const clip_d c = clip_texel(tris[i].t, x, y);
       if (!(c.area > 0.0)) return;
-      sum_area[k] += c.area;
-      sum_centroid[k] += c.area * c.centroid;
-      if (c.area > owner_area[k]) {
-        owner_area[k] = c.area;
-        owner[k] = std::uint32_t(i);
-        owner_centroid[k] = c.centroid;
+      std::uint32_t q = slot_of[k];
+      if (q == no_slot) {
+        if (slot_texel.size() >= std::size_t(no_slot))
+          throw error(status::out_of_memory, std::string(who) + ": more than 2^32 - 1 covered texels");
+        q = slot_of[k] = std::uint32_t(slot_texel.size());
+        slot_texel.push_back(k);
+        sum_area.push_back(0.0);
+        owner_area.push_back(0.0);
+        sum_centroid.emplace_back(0.0);
+        owner_centroid.emplace_back(0.0);
+        owner.push_back(none);
+      }
+      sum_area[q] += c.area;
+      sum_centroid[q] += c.area * c.centroid;
+      if (c.area > owner_area[q]) {
+        owner_area[q] = c.area;
+        owner[q] = std::uint32_t(i);
+        owner_centroid[q] = c.centroid;
       }
     });
-  std::vector<glm::dvec2> centroid(texels);
-  for (std::size_t k = 0; k < texels; ++k)
-    centroid[k] = sum_area[k] > 0.0 ? sum_centroid[k] / sum_area[k] : glm::dvec2(0.0);
+  // Slots in texel order (the order of the samples downstream), and the map to them.
+  const std::size_t count = slot_texel.size();
+  std::vector<std::uint32_t> order(count);
+  for (std::size_t q = 0; q < count; ++q) order[q] = std::uint32_t(q);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return slot_texel[a] < slot_texel[b]; });
+  const auto permute = [&](auto& v) {
+    std::remove_reference_t<decltype(v)> out(count);
+    for (std::size_t n = 0; n < count; ++n) out[n] = v[order[n]];
+    v = std::move(out);
+  };
+  permute(slot_texel);
+  permute(sum_area);
+  permute(owner_area);
+  permute(sum_centroid);
+  permute(owner_centroid);
+  permute(owner);
+  for (std::size_t n = 0; n < count; ++n) slot_of[slot_texel[n]] = std::uint32_t(n);
+  std::vector<glm::dvec2> centroid(count);
+  for (std::size_t n = 0; n < count; ++n) centroid[n] = sum_centroid[n] / sum_area[n];
+  std::vector<glm::dvec2>().swap(sum_centroid);
 
   // Pass B: the triangle the combined centroid is mapped through: the owner if it contains it,
   // else the covering triangle with the largest area that contains it (ties: lower index).
   const double eps = 1e-9;
-  std::vector<std::uint32_t> through(texels, none);
-  std::vector<double> through_area(texels, 0.0);
+  std::vector<std::uint32_t> through(count, none);
+  std::vector<double> through_area(count, 0.0);
   for (std::size_t i = 0; i < d.triangle_count; ++i)
     for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
-      if (owner[k] == none || through[k] == owner[k]) return;
+      const std::uint32_t q = slot_of[k];
+      if (q == no_slot || through[q] == owner[q]) return;
       double b1, b2;
-      if (!barycentric(tris[i].t, centroid[k], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) return;
+      if (!barycentric(tris[i].t, centroid[q], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) return;
       const clip_d c = clip_texel(tris[i].t, x, y);
       if (!(c.area > 0.0)) return;
-      if (std::uint32_t(i) == owner[k] || through[k] == none || c.area > through_area[k]) {
-        through[k] = std::uint32_t(i);
-        through_area[k] = c.area;
+      if (std::uint32_t(i) == owner[q] || through[q] == none || c.area > through_area[q]) {
+        through[q] = std::uint32_t(i);
+        through_area[q] = c.area;
       }
     });
+  std::vector<std::uint32_t>().swap(slot_of);
 
-  lightmap_samples s;
+  sparse_samples s;
   s.width = width;
   s.height = height;
-  s.coverage.assign(texels, 0.0f);
-  s.owner = owner;
-  s.sample_triangle.assign(texels, none);
-  s.centroid.assign(texels, glm::vec2(0.0f));
-  s.position.assign(texels, glm::vec3(0.0f));
-  s.normal.assign(texels, glm::vec3(0.0f, 0.0f, 1.0f));
-  s.texel_world_size.assign(texels, 0.0f);
-  s.tangent.assign(texels, glm::vec3(1.0f, 0.0f, 0.0f));
-  s.bitangent.assign(texels, glm::vec3(0.0f, 1.0f, 0.0f));
-  for (std::size_t k = 0; k < texels; ++k) {
-    if (owner[k] == none) continue;
-    s.coverage[k] = float(std::min(1.0, sum_area[k]));
-    if (sum_area[k] > 1.001) ++s.overlapping_texels;
-    std::uint32_t ti = through[k];
-    glm::dvec2 q = centroid[k];
+  s.texel = std::move(slot_texel);
+  s.coverage.resize(count);
+  s.owner = std::move(owner);
+  s.sample_triangle.resize(count);
+  s.centroid.resize(count);
+  s.position.resize(count);
+  s.normal.resize(count);
+  s.texel_world_size.resize(count);
+  s.tangent.resize(count);
+  s.bitangent.resize(count);
+  for (std::size_t n = 0; n < count; ++n) {
+    s.coverage[n] = float(std::min(1.0, sum_area[n]));
+    if (sum_area[n] > 1.001) ++s.overlapping_texels;
+    std::uint32_t ti = through[n];
+    glm::dvec2 q = centroid[n];
     if (ti == none) {  // the combined centroid lies on no covering triangle: the owner's own centroid
-      ti = owner[k];
-      q = owner_centroid[k];
+      ti = s.owner[n];
+      q = owner_centroid[n];
     }
     const tri_data& t = tris[ti];
     double b1 = 0, b2 = 0;
@@ -365,23 +419,57 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
     const std::uint32_t* idx = d.indices + 3 * std::size_t(ti);
     const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
     const glm::dvec3 face = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    glm::dvec3 n = face;
+    glm::dvec3 nrm = face;
     if (input.normals) {
       const glm::dvec3 ni =
           b0 * glm::dvec3(input.normals[idx[0]]) + b1 * glm::dvec3(input.normals[idx[1]]) + b2 * glm::dvec3(input.normals[idx[2]]);
       const double len = glm::length(ni);
-      if (len > 1e-6) n = ni / len;
+      if (len > 1e-6) nrm = ni / len;
     }
-    s.sample_triangle[k] = ti;
-    s.centroid[k] = glm::vec2(float(q.x / width), float(q.y / height));
-    s.position[k] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
-    s.normal[k] = glm::vec3(n);
-    s.texel_world_size[k] = float(std::sqrt(t.area3 / t.uv_area));
+    s.sample_triangle[n] = ti;
+    s.centroid[n] = glm::vec2(float(q.x / width), float(q.y / height));
+    s.position[n] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
+    s.normal[n] = glm::vec3(nrm);
+    s.texel_world_size[n] = float(std::sqrt(t.area3 / t.uv_area));
     const glm::vec3 tp[3] = {d.positions[idx[0]], d.positions[idx[1]], d.positions[idx[2]]};
     const glm::vec2 tuv[3] = {d.lightmap_uvs[idx[0]], d.lightmap_uvs[idx[1]], d.lightmap_uvs[idx[2]]};
-    const frame f = lightmap_tangent_frame(tp, tuv, s.normal[k]);
-    s.tangent[k] = f.t;
-    s.bitangent[k] = f.b;
+    const frame f = lightmap_tangent_frame(tp, tuv, s.normal[n]);
+    s.tangent[n] = f.t;
+    s.bitangent[n] = f.b;
+  }
+  return s;
+}
+
+}  // namespace
+
+lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height) {
+  const sparse_samples sp = compute_sparse_samples(input, width, height);
+  const std::size_t texels = std::size_t(width) * std::size_t(height);
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+  lightmap_samples s;
+  s.width = width;
+  s.height = height;
+  s.coverage.assign(texels, 0.0f);
+  s.owner.assign(texels, none);
+  s.sample_triangle.assign(texels, none);
+  s.centroid.assign(texels, glm::vec2(0.0f));
+  s.position.assign(texels, glm::vec3(0.0f));
+  s.normal.assign(texels, glm::vec3(0.0f, 0.0f, 1.0f));
+  s.texel_world_size.assign(texels, 0.0f);
+  s.tangent.assign(texels, glm::vec3(1.0f, 0.0f, 0.0f));
+  s.bitangent.assign(texels, glm::vec3(0.0f, 1.0f, 0.0f));
+  s.overlapping_texels = sp.overlapping_texels;
+  for (std::size_t n = 0; n < sp.size(); ++n) {
+    const std::size_t k = sp.texel[n];
+    s.coverage[k] = sp.coverage[n];
+    s.owner[k] = sp.owner[n];
+    s.sample_triangle[k] = sp.sample_triangle[n];
+    s.centroid[k] = sp.centroid[n];
+    s.position[k] = sp.position[n];
+    s.normal[k] = sp.normal[n];
+    s.texel_world_size[k] = sp.texel_world_size[n];
+    s.tangent[k] = sp.tangent[n];
+    s.bitangent[k] = sp.bitangent[n];
   }
   return s;
 }
@@ -466,6 +554,8 @@ namespace {
 struct sample_points {
   std::vector<std::size_t> texel_of;     // texel index of each sample
   std::vector<glm::vec3> positions, normals;
+  std::vector<std::uint32_t> owner;      // the texel's owner triangle (its material)
+  std::vector<glm::vec3> tangents, bitangents;  // the texel's lightmap tangent frame (with normals)
 };
 
 // A 2 x 2 block of texels of a scene bake's atlas that holds the radiance of the occluder-only
@@ -507,22 +597,27 @@ struct pass_values {
 };
 
 // Step 2 of bake.hpp: the sampled texels, offset along their normals.
-sample_points place_samples(const lightmap_samples& s, const scene& sc, const bake_options& o, const bake_layout& layout,
+sample_points place_samples(const sparse_samples& s, const scene& sc, const bake_options& o, const bake_layout& layout,
                             bake_result& r) {
-  const std::size_t texels = s.coverage.size();
+  const std::size_t texels = std::size_t(layout.width) * std::size_t(layout.height);
   const float min_offset = 2.0f * default_near_distance(sc);
   sample_points out;
-  r.coverage = s.coverage;
+  r.coverage.assign(texels, 0.0f);
   r.sampled.assign(texels, 0);
-  for (std::size_t k = 0; k < texels; ++k) {
-    if (s.coverage[k] > 0.0f) ++r.stats.covered_texels;
-    if (s.sample_triangle[k] == lightmap_samples::no_triangle || !(s.coverage[k] >= o.min_coverage) || !(s.coverage[k] > 0.0f))
+  for (std::size_t n = 0; n < s.size(); ++n) {
+    const std::size_t k = s.texel[n];
+    r.coverage[k] = s.coverage[n];
+    if (s.coverage[n] > 0.0f) ++r.stats.covered_texels;
+    if (s.sample_triangle[n] == lightmap_samples::no_triangle || !(s.coverage[n] >= o.min_coverage) || !(s.coverage[n] > 0.0f))
       continue;
     r.sampled[k] = 1;
     out.texel_of.push_back(k);
-    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[k]);
-    out.positions.push_back(s.position[k] + offset * s.normal[k]);
-    out.normals.push_back(s.normal[k]);
+    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[n]);
+    out.positions.push_back(s.position[n] + offset * s.normal[n]);
+    out.normals.push_back(s.normal[n]);
+    out.owner.push_back(s.owner[n]);
+    out.tangents.push_back(s.tangent[n]);
+    out.bitangents.push_back(s.bitangent[n]);
   }
   r.stats.sampled_texels = out.texel_of.size();
   if (out.texel_of.empty())
@@ -534,13 +629,13 @@ sample_points place_samples(const lightmap_samples& s, const scene& sc, const ba
 // (or of the layout's per-texel images), dilated (at least 2 rings) so that hemicubes looking at
 // chart borders do not see black; then the occluder blocks and the guards. With e = null (pass 1
 // of a bake with emission images): the emission alone.
-image pass_radiance_texture(const lightmap_samples& s, const scene& sc, const sample_points& pts,
-                            const std::vector<glm::vec3>* e, const bake_options& o, const bake_layout& layout) {
+image pass_radiance_texture(const scene& sc, const sample_points& pts, const std::vector<glm::vec3>* e, const bake_options& o,
+                            const bake_layout& layout) {
   image texture = image::make(layout.width, layout.height, 3);
   std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
   for (std::size_t i = 0; i < pts.texel_of.size(); ++i) {
     const std::size_t k = pts.texel_of[i];
-    const material& m = sc.triangle_material(s.owner[k]);
+    const material& m = sc.triangle_material(pts.owner[i]);
     const glm::vec3 emission = layout.emission.empty() ? m.emission : layout.emission[k];
     const glm::vec3 albedo = layout.albedo.empty() ? m.albedo : layout.albedo[k];
     const glm::vec3 l = e ? emission + albedo * (*e)[i] / pi_f : emission;
@@ -572,12 +667,13 @@ image bake_radiance_texture(const bake_input& input, const bake_options& o, cons
   if (r.irradiance.width != o.width || r.irradiance.height != o.height || r.sampled.size() != std::size_t(o.width) * std::size_t(o.height))
     throw_invalid_argument("bake_radiance_texture: the result's size does not match options (" + std::to_string(o.width) + " x " +
                            std::to_string(o.height) + ")");
-  const lightmap_samples s = compute_lightmap_samples(input, o.width, o.height);
+  const sparse_samples s = compute_sparse_samples(input, o.width, o.height);
   image texture = image::make(o.width, o.height, 3);
   std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
-  for (std::size_t k = 0; k < filled.size(); ++k) {
-    if (!r.sampled[k] || s.owner[k] == lightmap_samples::no_triangle) continue;
-    const material m = input.scene.materials ? input.scene.materials[s.owner[k]] : material{};
+  for (std::size_t n = 0; n < s.size(); ++n) {
+    const std::size_t k = s.texel[n];
+    if (!r.sampled[k]) continue;
+    const material m = input.scene.materials ? input.scene.materials[s.owner[n]] : material{};
     const glm::vec3 e(r.irradiance.pixels[3 * k], r.irradiance.pixels[3 * k + 1], r.irradiance.pixels[3 * k + 2]);
     const glm::vec3 l = m.emission + m.albedo * e / pi_f;
     std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
@@ -701,7 +797,7 @@ struct direct_values {
 
 // Step 3b: the lights' direct irradiance at every sample (parallel, in blocks so that
 // cancellation stays live; deterministic: each sample's value depends on its point only).
-direct_values direct_pass(const lightmap_samples& s, const sample_points& pts, const scene& sc, const light_set& lights,
+direct_values direct_pass(const sample_points& pts, const scene& sc, const light_set& lights,
                           const bake_options& o, const std::function<bool()>& keep_going) {
   const std::size_t count = pts.texel_of.size();
   const bool mask = std::any_of(o.shadow_mask_lights.begin(), o.shadow_mask_lights.end(), [](int l) { return l >= 0; });
@@ -728,8 +824,7 @@ direct_values direct_pass(const lightmap_samples& s, const sample_points& pts, c
             if (l >= 0) d.mask[c / 3][i][int(c % 3)] = per_light[std::size_t(l)].visibility;
           }
         if (!o.output_sh_l1 && !o.output_hl2) continue;
-        const std::size_t k = pts.texel_of[i];
-        const frame f{s.tangent[k], s.bitangent[k], s.normal[k]};
+        const frame f{pts.tangents[i], pts.bitangents[i], pts.normals[i]};
         std::array<glm::vec3, 3> basis{};  // the texel's HL2 vectors in world space
         if (o.output_hl2)
           for (std::size_t j = 0; j < 3; ++j) basis[j] = f.to_world(glm::vec3(hl2_basis[j][0], hl2_basis[j][1], hl2_basis[j][2]));
@@ -798,7 +893,7 @@ void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_l
 
 // Step 5 and 6: the lightmap images from the last pass (less the first with indirect_only),
 // dilated around every chart.
-void write_outputs(const lightmap_samples& s, const sample_points& pts, const pass_values& last, const pass_values* first,
+void write_outputs(const sample_points& pts, const pass_values& last, const pass_values* first,
                    const direct_values* direct, const std::vector<std::uint8_t>& valid, const bake_options& o,
                    const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled) {
   const std::size_t texels = std::size_t(layout.width) * std::size_t(layout.height);
@@ -832,11 +927,10 @@ void write_outputs(const lightmap_samples& s, const sample_points& pts, const pa
   if (o.output_hl2) {
     std::vector<std::array<glm::vec3, 3>> h(count);
     for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t k = pts.texel_of[i];
       hl2_cone c = last.cone[i];
       if (first)
         for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) c.coefficients[t] -= first->cone[i].coefficients[t];
-      h[i] = hl2_from_cone(c, frame{s.tangent[k], s.bitangent[k], s.normal[k]});
+      h[i] = hl2_from_cone(c, frame{pts.tangents[i], pts.bitangents[i], pts.normals[i]});
       if (direct && !first)
         for (std::size_t j = 0; j < 3; ++j) h[i][j] += direct->hl2[j][i];
     }
@@ -856,7 +950,7 @@ void write_outputs(const lightmap_samples& s, const sample_points& pts, const pa
 
 // Steps 2-6 of bake.hpp on the samples of a layout (one lightmap, or a scene bake's atlas):
 // the passes, the lights, the outputs. `filled` receives the texels written or dilated.
-bake_result bake_samples(const lightmap_samples& s, const std::shared_ptr<const scene>& sc, const bake_options& o,
+bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
                          const bake_layout& layout, std::chrono::steady_clock::time_point t0,
                          std::vector<std::uint8_t>& filled) {
   bake_result r;
@@ -865,6 +959,7 @@ bake_result bake_samples(const lightmap_samples& s, const std::shared_ptr<const 
   r.stats.overlapping_texels = s.overlapping_texels;
   const sample_points pts = place_samples(s, *sc, o, layout, r);
   const std::size_t count = pts.texel_of.size();
+  s = sparse_samples{};  // what the passes need is in pts now
 
   const int workers = resolve_thread_count(o.thread_count);
   const bool directional = o.output_sh_l1 || o.output_hl2;
@@ -881,7 +976,7 @@ bake_result bake_samples(const lightmap_samples& s, const std::shared_ptr<const 
     prepare_rays(*sc);
     std::function<bool()> keep_going;
     if (o.progress) keep_going = [&] { return o.progress(0.0f); };
-    direct = direct_pass(s, pts, *sc, lights, o, keep_going);
+    direct = direct_pass(pts, *sc, lights, o, keep_going);
     r.stats.direct_seconds = seconds_since(td);
   }
   image texture;
@@ -906,7 +1001,7 @@ bake_result bake_samples(const lightmap_samples& s, const std::shared_ptr<const 
     so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
     so.hl2_cone = pass_directional && o.output_hl2;
     if (pass > 0 || layout.textured_first_pass) {
-      texture = pass_radiance_texture(s, *sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
+      texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
       texture_view = radiance_texture(texture);
       so.texture = &texture_view;
     }
@@ -923,7 +1018,7 @@ bake_result bake_samples(const lightmap_samples& s, const std::shared_ptr<const 
   }
   if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
   if (!lights.empty()) fill_direct_outputs(pts, valid, layout, direct);
-  write_outputs(s, pts, current, o.indirect_only ? &first : nullptr, lights.empty() ? nullptr : &direct, valid, o, layout, r,
+  write_outputs(pts, current, o.indirect_only ? &first : nullptr, lights.empty() ? nullptr : &direct, valid, o, layout, r,
                 filled);
   r.stats.seconds = seconds_since(t0);
   return r;
@@ -946,12 +1041,11 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   check_input("bake_lightmap", input);
   const std::shared_ptr<const scene> sc = scene::create(input.scene);
   check_environment("bake_lightmap", o);
-  const lightmap_samples s = compute_lightmap_samples(input, o.width, o.height);
   bake_layout layout;
   layout.width = o.width;
   layout.height = o.height;
   std::vector<std::uint8_t> filled;
-  return bake_samples(s, sc, o, layout, t0, filled);
+  return bake_samples(compute_sparse_samples(input, o.width, o.height), sc, o, layout, t0, filled);
 }
 
 // ---- bake_scene: pages and occluders -------------------------------------------------------------
@@ -1176,21 +1270,13 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   combined.lightmap_uvs = atlas_uvs.data();
   const std::shared_ptr<const scene> sc = scene::create(combined);
 
-  // Step 1 per page, in the page's own texel grid (its UVs), merged into the atlas.
-  lightmap_samples s;
+  // Step 1 per page, in the page's own texel grid (its UVs), merged into the atlas (pages in
+  // order: the atlas texel indices stay increasing).
+  sparse_samples s;
   const std::size_t texels = W * std::size_t(layout.height);
   constexpr std::uint32_t none = lightmap_samples::no_triangle;
   s.width = layout.width;
   s.height = layout.height;
-  s.coverage.assign(texels, 0.0f);
-  s.owner.assign(texels, none);
-  s.sample_triangle.assign(texels, none);
-  s.centroid.assign(texels, glm::vec2(0.0f));
-  s.position.assign(texels, glm::vec3(0.0f));
-  s.normal.assign(texels, glm::vec3(0.0f, 0.0f, 1.0f));
-  s.texel_world_size.assign(texels, 0.0f);
-  s.tangent.assign(texels, glm::vec3(1.0f, 0.0f, 0.0f));
-  s.bitangent.assign(texels, glm::vec3(0.0f, 1.0f, 0.0f));
   std::vector<std::size_t> page_overlapping(input.pages.size(), 0);
   for (std::size_t p = 0; p < input.pages.size(); ++p) {
     const lightmap_page& page = input.pages[p];
@@ -1237,25 +1323,39 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
     sub.scene.materials = mats.data();
     sub.scene.lightmap_uvs = uvs.data();
     sub.normals = nrm.empty() ? nullptr : nrm.data();
-    const lightmap_samples ps = compute_lightmap_samples(sub, page.width, page.height);
+    sparse_samples ps = compute_sparse_samples(sub, page.width, page.height);
     page_overlapping[p] = ps.overlapping_texels;
     s.overlapping_texels += ps.overlapping_texels;
     const std::size_t y0 = std::size_t(atlas.page_y[p]);
-    for (std::size_t y = 0; y < std::size_t(page.height); ++y)
-      for (std::size_t x = 0; x < std::size_t(page.width); ++x) {
-        const std::size_t j = y * std::size_t(page.width) + x, k = (y0 + y) * W + x;
-        if (ps.owner[j] == none) continue;
-        s.coverage[k] = ps.coverage[j];
-        s.owner[k] = tris[ps.owner[j]];
-        s.sample_triangle[k] = ps.sample_triangle[j] == none ? none : tris[ps.sample_triangle[j]];
-        s.centroid[k] = glm::vec2(float(double(ps.centroid[j].x) * page.width / double(W)),
-                                  float((double(ps.centroid[j].y) * page.height + double(y0)) / double(layout.height)));
-        s.position[k] = ps.position[j];
-        s.normal[k] = ps.normal[j];
-        s.texel_world_size[k] = ps.texel_world_size[j];
-        s.tangent[k] = ps.tangent[j];
-        s.bitangent[k] = ps.bitangent[j];
+    if (s.size() == 0 && y0 == 0 && std::size_t(page.width) == W) {
+      // The first page at the atlas's origin with its width: its texel indices are the atlas's;
+      // taken over in place (no second copy of the samples at the peak).
+      sparse_samples moved = std::move(ps);
+      for (std::size_t n = 0; n < moved.size(); ++n) {
+        moved.owner[n] = tris[moved.owner[n]];
+        moved.sample_triangle[n] = moved.sample_triangle[n] == none ? none : tris[moved.sample_triangle[n]];
+        moved.centroid[n] = glm::vec2(float(double(moved.centroid[n].x) * page.width / double(W)),
+                                      float((double(moved.centroid[n].y) * page.height) / double(layout.height)));
       }
+      moved.width = layout.width;
+      moved.height = layout.height;
+      s = std::move(moved);
+      continue;
+    }
+    for (std::size_t n = 0; n < ps.size(); ++n) {
+      const std::size_t j = ps.texel[n], x = j % std::size_t(page.width), y = j / std::size_t(page.width);
+      s.texel.push_back((y0 + y) * W + x);
+      s.coverage.push_back(ps.coverage[n]);
+      s.owner.push_back(tris[ps.owner[n]]);
+      s.sample_triangle.push_back(ps.sample_triangle[n] == none ? none : tris[ps.sample_triangle[n]]);
+      s.centroid.emplace_back(float(double(ps.centroid[n].x) * page.width / double(W)),
+                              float((double(ps.centroid[n].y) * page.height + double(y0)) / double(layout.height)));
+      s.position.push_back(ps.position[n]);
+      s.normal.push_back(ps.normal[n]);
+      s.texel_world_size.push_back(ps.texel_world_size[n]);
+      s.tangent.push_back(ps.tangent[n]);
+      s.bitangent.push_back(ps.bitangent[n]);
+    }
   }
 
   // Per-texel materials where a page has images (the other pages: their owners' materials).
@@ -1264,20 +1364,29 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   if (any_albedo) layout.albedo.assign(texels, glm::vec3(0.0f));
   if (any_emission) layout.emission.assign(texels, glm::vec3(0.0f));
   layout.textured_first_pass = any_emission;
-  for (std::size_t p = 0; p < input.pages.size() && (any_albedo || any_emission); ++p) {
-    const lightmap_page& page = input.pages[p];
-    const std::size_t y0 = std::size_t(atlas.page_y[p]);
-    for (int y = 0; y < page.height; ++y)
-      for (int x = 0; x < page.width; ++x) {
-        const std::size_t k = (y0 + std::size_t(y)) * W + std::size_t(x);
-        const material m = s.owner[k] != none && d.materials ? d.materials[s.owner[k]] : material{};
-        if (any_albedo) layout.albedo[k] = page.albedo.width > 0 ? glm::vec3(page.albedo.at(x, y)[0], page.albedo.at(x, y)[1], page.albedo.at(x, y)[2]) : m.albedo;
-        if (any_emission) layout.emission[k] = page.emission.width > 0 ? glm::vec3(page.emission.at(x, y)[0], page.emission.at(x, y)[1], page.emission.at(x, y)[2]) : m.emission;
-      }
+  if (any_albedo || any_emission) {
+    // The page of every atlas row (-1: a guard or the occluders' blocks).
+    std::vector<int> row_page(std::size_t(layout.height), -1);
+    for (std::size_t p = 0; p < input.pages.size(); ++p)
+      for (int y = 0; y < input.pages[p].height; ++y) row_page[std::size_t(atlas.page_y[p] + y)] = int(p);
+    for (std::size_t n = 0; n < s.size(); ++n) {
+      const std::size_t k = s.texel[n];
+      const int p = row_page[k / W];
+      const lightmap_page& page = input.pages[std::size_t(p)];
+      const int x = int(k % W), y = int(k / W) - atlas.page_y[std::size_t(p)];
+      const material m = d.materials ? d.materials[s.owner[n]] : material{};
+      if (any_albedo)
+        layout.albedo[k] = page.albedo.width > 0 ? glm::vec3(page.albedo.at(x, y)[0], page.albedo.at(x, y)[1], page.albedo.at(x, y)[2])
+                                                 : m.albedo;
+      if (any_emission)
+        layout.emission[k] = page.emission.width > 0
+                                 ? glm::vec3(page.emission.at(x, y)[0], page.emission.at(x, y)[1], page.emission.at(x, y)[2])
+                                 : m.emission;
+    }
   }
 
   std::vector<std::uint8_t> filled;
-  bake_result all = bake_samples(s, sc, o, layout, t0, filled);
+  bake_result all = bake_samples(std::move(s), sc, o, layout, t0, filled);
 
   // Per page: the atlas rows of the page.
   scene_bake_result out;

@@ -81,9 +81,11 @@
 
 namespace hemilight {
 
-/// Largest lightmap width or height bake_lightmap accepts. Peak memory is about 210 bytes per
-/// sampled texel (measured at 2048^2 and 4096^2 with every texel sampled, one bounce: 0.9 and
-/// 3.5 GiB; docs/bake.md, "Scaling"), so 8192^2 needs about 14 GiB; larger maps are refused with
+/// Largest lightmap width or height bake_lightmap accepts. The per-sample state is kept for
+/// covered texels only: peak memory is about 32 bytes per texel (the result's images and masks)
+/// plus, per sampled texel, about 124 bytes on a flat quad at N = 8 and up to about 210 bytes on
+/// a heightfield at N = 64 with more cache records (docs/bake.md, "Scaling" and "Memory"), so a
+/// fully sampled 8192^2 needs up to about 14 GiB; larger maps are refused with
 /// error(invalid_argument).
 inline constexpr int max_lightmap_size = 8192;
 
