@@ -1129,7 +1129,7 @@ scene_atlas make_atlas(const std::vector<lightmap_page>& pages, std::size_t occl
 // and, per vertex, its page UV (for the per-page samples).
 struct scene_geometry {
   std::vector<glm::vec3> positions, normals;
-  std::vector<glm::vec2> atlas_uvs, page_uvs;
+  std::vector<glm::vec2> page_uvs;
   std::vector<std::uint32_t> indices;
   std::vector<int> triangle_page;  // per triangle: page, or -1 (occluder)
   std::vector<material> occluder_materials;
