@@ -216,7 +216,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& options);
 /// One lightmap page of a scene bake (bake_scene): its size and optional per-texel materials.
 struct lightmap_page {
   int width = 256, height = 256;  ///< texels, each in [1, max_lightmap_size]
-  /// Optional per-texel albedo (Enlighten-style): width x height, 3 channels, each value in
+  /// Optional per-texel albedo: width x height, 3 channels, each value in
   /// [0, 1], indexed like the page's texels. Used for the bounces instead of the owner triangle's
   /// albedo. Empty (width 0): the triangles' albedo.
   image albedo;
