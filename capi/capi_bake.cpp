@@ -32,15 +32,34 @@ std::string check_material(const hemilight_bake_material& m, const std::string& 
 
 // What is wrong with one mesh's arrays, naming the mesh and the index within it, or "". (The
 // baker checks the concatenated scene again; these checks keep the messages in the caller's terms.)
-std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, int width, int height) {
+// Where a mesh's UVs go: a lightmap of width x height; with `placement`, a page of a scene bake
+// (page UV = uv * uv_scale + uv_offset) or, for page -1, nowhere (an occluder: no UVs needed).
+struct uv_target {
+  int width = 0, height = 0;
+  const hemilight_bake_placement* placement = nullptr;
+  bool occluder() const { return placement && placement->page < 0; }
+  // The page UV of component c (0: u, 1: v) of a mesh UV, in float as bake_scene computes it.
+  float map(float uv, int c) const { return placement ? uv * placement->uv_scale[c] + placement->uv_offset[c] : uv; }
+};
+
+std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, const uv_target& target) {
+  const int width = target.width, height = target.height;
   for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
     if (!(std::fabs(mesh.positions[i]) <= hemilight::max_coordinate))
       return name + ".positions[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
              std::to_string(mesh.positions[i]) + "; it must be finite and at most 1e18 in magnitude";
-  for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i)
-    if (!(mesh.lightmap_uvs[i] >= 0.0f && mesh.lightmap_uvs[i] <= 1.0f))
-      return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
-             ") = " + std::to_string(mesh.lightmap_uvs[i]) + "; it must be in [0, 1]";
+  if (!target.occluder())
+    for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i) {
+      const float q = target.map(mesh.lightmap_uvs[i], int(i % 2));
+      if (!(q >= 0.0f && q <= 1.0f)) {
+        if (!target.placement)
+          return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
+                 ") = " + std::to_string(mesh.lightmap_uvs[i]) + "; it must be in [0, 1]";
+        return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
+               ") = " + std::to_string(mesh.lightmap_uvs[i]) + " maps to " + std::to_string(q) + " in page " +
+               std::to_string(target.placement->page) + " (uv * uv_scale + uv_offset); it must be in [0, 1]";
+      }
+    }
   if (mesh.normals)
     for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
       if (!std::isfinite(mesh.normals[i]))
@@ -48,20 +67,22 @@ std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name,
                std::to_string(mesh.normals[i]) + "; it must be finite";
   // A triangle with 3D area but no UV area: the baker's own test (bake.cpp, make_tri), computed the
   // same way, so that the message names the mesh and the triangle within it.
-  for (std::size_t t = 0; t < mesh.triangle_count; ++t) {
+  for (std::size_t t = 0; t < mesh.triangle_count && !target.occluder(); ++t) {
     const std::uint32_t* idx = mesh.indices + 3 * t;
     if (idx[0] >= mesh.vertex_count || idx[1] >= mesh.vertex_count || idx[2] >= mesh.vertex_count) continue;  // named later
     glm::dvec2 uv[3];
     glm::dvec3 p[3];
     for (int k = 0; k < 3; ++k) {
-      uv[k] = glm::dvec2(double(mesh.lightmap_uvs[2 * idx[k]]) * width, double(mesh.lightmap_uvs[2 * idx[k] + 1]) * height);
+      uv[k] = glm::dvec2(double(target.map(mesh.lightmap_uvs[2 * idx[k]], 0)) * width,
+                         double(target.map(mesh.lightmap_uvs[2 * idx[k] + 1], 1)) * height);
       p[k] = glm::dvec3(glm::vec3(mesh.positions[3 * idx[k]], mesh.positions[3 * idx[k] + 1], mesh.positions[3 * idx[k] + 2]));
     }
     const double uv_area = 0.5 * std::fabs((uv[1].x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[1].y - uv[0].y) * (uv[2].x - uv[0].x));
     const double area3 = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
     if (area3 > 0.0 && !(uv_area > 1e-12 * double(width) * double(height)))
       return name + ": triangle " + std::to_string(t) + " (indices[" + std::to_string(3 * t) + ".." + std::to_string(3 * t + 2) +
-             "]) has zero area in lightmap UV space (but not in 3D): it would get no texels";
+             "]) has zero area in " + (target.placement ? "its page's" : "lightmap") +
+             " UV space (but not in 3D): it would get no texels";
   }
   if (mesh.materials) {
     for (std::size_t t = 0; t < mesh.triangle_count; ++t)
@@ -84,6 +105,8 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
                       const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
                       uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
                       size_t hl2_capacity, hemilight_bake_stats* stats);
+hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                            hemilight_bake_stats* stats);
 
 }  // namespace
 
@@ -106,9 +129,145 @@ hemilight_status hemilight_bake_lightmap_directional(const hemilight_bake_mesh* 
               valid, valid_capacity, sh_l1_rgb, sh_l1_capacity, hl2_rgb, hl2_capacity, stats);
 }
 
+hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                      hemilight_bake_stats* stats) {
+  return bake_scene(scene, options, stats);
+}
+
 }  // extern "C"
 
 namespace {
+
+// The checks of the options every bake entry shares, in the order hemilight_bake_lightmap has
+// always made them (after its size and capacity checks): the environment, the cache threshold,
+// the switches, the sky, the shadow-mask indices (mask: some index names a light).
+hemilight_status check_common_options(const char* fn, const hemilight_bake_options& o,
+                                      std::shared_ptr<const hemilight::cubemap>& environment, bool& mask) {
+  if (o.environment_rgb) {
+    if (o.environment_size < 1 || o.environment_size > hemilight::cubemap_max_size)
+      return invalid(fn, "options->environment_size " + std::to_string(o.environment_size) + " is out of range: 1.." +
+                             std::to_string(hemilight::cubemap_max_size) + " with an environment map");
+    hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
+    for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
+      const float v = o.environment_rgb[i];
+      if (!(v >= 0.0f && v <= hemilight::max_radiance))
+        return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
+                               "; radiance must be finite, >= 0 and at most 1e30");
+      faces.pixels[i] = v;
+    }
+    environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
+  } else if (o.environment_size != 0) {
+    return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
+                           " but environment_rgb is NULL (use 0 without an environment map)");
+  }
+  if (!(o.error_threshold >= hemilight::min_error_threshold && o.error_threshold <= 1.0f))
+    return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in [0.001, 1] (checked "
+                       "whatever use_cache is)");
+  for (const char* f : {"indirect_only", "use_cache"}) {
+    const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
+    if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
+  }
+  for (int c = 0; c < 3; ++c)
+    if (!(o.sky_radiance[c] >= 0.0f && o.sky_radiance[c] <= hemilight::max_radiance))
+      return invalid(fn, "options->sky_radiance[" + std::to_string(c) + "] = " + std::to_string(o.sky_radiance[c]) +
+                             "; it must be finite, >= 0 and at most 1e30");
+  mask = false;
+  for (int k = 0; k < 4; ++k) {
+    const int l = o.shadow_mask_lights[k];
+    if (l < -1 || (l >= 0 && std::size_t(l) >= o.light_count))
+      return invalid(fn, "options->shadow_mask_lights[" + std::to_string(k) + "] = " + std::to_string(l) +
+                             " is not -1 or a light index (light_count is " + std::to_string(o.light_count) + ")");
+    mask = mask || l >= 0;
+  }
+  return HEMILIGHT_OK;
+}
+
+// The meshes concatenated into one scene (indices offset by the vertices before them), each
+// checked in the caller's terms first. targets[m]: where mesh m's UVs go.
+struct gathered_scene {
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::uint32_t> indices;
+  std::vector<hemilight::material> materials;
+  bool any_normals = false;
+};
+
+hemilight_status gather_meshes(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
+                               const std::vector<uv_target>& targets, gathered_scene& g, const char* prefix = "") {
+  size_t total_vertices = 0, total_triangles = 0;
+  for (size_t m = 0; m < mesh_count; ++m) {
+    total_vertices += meshes[m].vertex_count;
+    total_triangles += meshes[m].triangle_count;
+    if (meshes[m].normals) g.any_normals = true;
+    if (total_vertices > hemilight::max_scene_elements || total_triangles > hemilight::max_scene_elements)
+      return hemilight::capi::set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY,
+                                        std::string(fn) + ": more than 2^31 - 1 vertices or triangles in total");
+  }
+  for (size_t m = 0; m < mesh_count; ++m) {
+    const hemilight_bake_mesh& mesh = meshes[m];
+    const std::string name = std::string(prefix) + "meshes[" + std::to_string(m) + "]";
+    const bool occluder = targets[m].occluder();
+    if (mesh.vertex_count > 0 && (!mesh.positions || (!mesh.lightmap_uvs && !occluder)))
+      return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
+    if (mesh.triangle_count > 0 && !mesh.indices)
+      return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
+    if (const std::string problem = check_mesh(mesh, name, targets[m]); !problem.empty()) return invalid(fn, problem);
+    const auto base = std::uint32_t(g.positions.size());
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+      g.positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
+      // An occluder's UVs are not read (it may have none).
+      g.uvs.push_back(mesh.lightmap_uvs && !occluder ? glm::vec2(mesh.lightmap_uvs[2 * v], mesh.lightmap_uvs[2 * v + 1])
+                                                     : glm::vec2(0.0f));
+      if (g.any_normals)
+        g.normals.push_back(mesh.normals ? glm::vec3(mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2])
+                                         : glm::vec3(0.0f));  // zero: the baker falls back to the face normal
+    }
+    for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) {
+      if (mesh.indices[i] >= mesh.vertex_count)
+        return invalid(fn, name + ".indices[" + std::to_string(i) + "] = " + std::to_string(mesh.indices[i]) +
+                               " is out of range: " + std::to_string(mesh.vertex_count) + " vertices");
+      g.indices.push_back(base + mesh.indices[i]);
+    }
+    for (size_t t = 0; t < mesh.triangle_count; ++t)
+      g.materials.push_back(to_material(mesh.materials ? mesh.materials[t] : mesh.material));
+  }
+  return HEMILIGHT_OK;
+}
+
+hemilight::bake_input input_of(const gathered_scene& g, const hemilight_bake_options& o) {
+  hemilight::bake_input in;
+  in.scene.positions = g.positions.data();
+  in.scene.vertex_count = g.positions.size();
+  in.scene.indices = g.indices.data();
+  in.scene.triangle_count = g.materials.size();
+  in.scene.materials = g.materials.data();
+  in.scene.lightmap_uvs = g.uvs.data();
+  in.scene.sky_radiance = glm::vec3(o.sky_radiance[0], o.sky_radiance[1], o.sky_radiance[2]);
+  in.normals = g.any_normals ? g.normals.data() : nullptr;
+  return in;
+}
+
+hemilight_bake_stats stats_of(const hemilight::bake_stats& s) {
+  hemilight_bake_stats st;
+  st.struct_size = sizeof st;
+  st.sampled_texels = s.sampled_texels;
+  st.invalid_texels = s.invalid_texels;
+  st.dilated_texels = s.dilated_texels;
+  st.overlapping_texels = s.overlapping_texels;
+  st.hemicubes = s.hemicubes;
+  st.records = s.records;
+  st.seconds = s.seconds;
+  return st;
+}
+
+// Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to a texel is not.
+bool result_finite(const hemilight::bake_result& r) {
+  const auto finite = [](const hemilight::image& img) { return all_finite(img.pixels.data(), img.pixels.size()); };
+  bool all_ok = finite(r.irradiance);
+  for (const hemilight::image& img : r.sh_l1) all_ok = all_ok && finite(img);
+  for (const hemilight::image& img : r.hl2) all_ok = all_ok && finite(img);
+  return all_ok;
+}
 
 hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
                       const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
@@ -140,42 +299,8 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       return invalid(fn, "hl2_capacity " + std::to_string(hl2_capacity) + " is below 9 x width x height = " +
                              std::to_string(9 * texels) + " floats (three RGB images)");
     std::shared_ptr<const hemilight::cubemap> environment;
-    if (o.environment_rgb) {
-      if (o.environment_size < 1 || o.environment_size > hemilight::cubemap_max_size)
-        return invalid(fn, "options->environment_size " + std::to_string(o.environment_size) + " is out of range: 1.." +
-                               std::to_string(hemilight::cubemap_max_size) + " with an environment map");
-      hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
-      for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
-        const float v = o.environment_rgb[i];
-        if (!(v >= 0.0f && v <= hemilight::max_radiance))
-          return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
-                                 "; radiance must be finite, >= 0 and at most 1e30");
-        faces.pixels[i] = v;
-      }
-      environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
-    } else if (o.environment_size != 0) {
-      return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
-                             " but environment_rgb is NULL (use 0 without an environment map)");
-    }
-    if (!(o.error_threshold >= hemilight::min_error_threshold && o.error_threshold <= 1.0f))
-      return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in [0.001, 1] (checked "
-                         "whatever use_cache is)");
-    for (const char* f : {"indirect_only", "use_cache"}) {
-      const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
-      if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
-    }
-    for (int c = 0; c < 3; ++c)
-      if (!(o.sky_radiance[c] >= 0.0f && o.sky_radiance[c] <= hemilight::max_radiance))
-        return invalid(fn, "options->sky_radiance[" + std::to_string(c) + "] = " + std::to_string(o.sky_radiance[c]) +
-                               "; it must be finite, >= 0 and at most 1e30");
     bool mask = false;
-    for (int k = 0; k < 4; ++k) {
-      const int l = o.shadow_mask_lights[k];
-      if (l < -1 || (l >= 0 && std::size_t(l) >= o.light_count))
-        return invalid(fn, "options->shadow_mask_lights[" + std::to_string(k) + "] = " + std::to_string(l) +
-                               " is not -1 or a light index (light_count is " + std::to_string(o.light_count) + ")");
-      mask = mask || l >= 0;
-    }
+    if (const hemilight_status st = check_common_options(fn, o, environment, mask); st != HEMILIGHT_OK) return st;
     if (mask && !o.shadow_mask_rgba)
       return invalid(fn, "options->shadow_mask_lights names a light but options->shadow_mask_rgba is NULL");
     if (mask && o.shadow_mask_capacity < 4 * texels)
@@ -185,55 +310,14 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
     if (lights_status != HEMILIGHT_OK) return lights_status;
 
-    // Concatenate the meshes (indices offset by the vertices before them).
-    std::vector<glm::vec3> positions, normals;
-    std::vector<glm::vec2> uvs;
-    std::vector<std::uint32_t> indices;
-    std::vector<hemilight::material> materials;
-    bool any_normals = false;
-    size_t total_vertices = 0, total_triangles = 0;
-    for (size_t m = 0; m < mesh_count; ++m) {
-      total_vertices += meshes[m].vertex_count;
-      total_triangles += meshes[m].triangle_count;
-      if (meshes[m].normals) any_normals = true;
-      if (total_vertices > hemilight::max_scene_elements || total_triangles > hemilight::max_scene_elements)
-        return hemilight::capi::set_error(HEMILIGHT_ERROR_OUT_OF_MEMORY,
-                                          std::string(fn) + ": more than 2^31 - 1 vertices or triangles in total");
-    }
-    for (size_t m = 0; m < mesh_count; ++m) {
-      const hemilight_bake_mesh& mesh = meshes[m];
-      const std::string name = "meshes[" + std::to_string(m) + "]";
-      if (mesh.vertex_count > 0 && (!mesh.positions || !mesh.lightmap_uvs))
-        return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
-      if (mesh.triangle_count > 0 && !mesh.indices)
-        return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
-      if (const std::string problem = check_mesh(mesh, name, o.width, o.height); !problem.empty()) return invalid(fn, problem);
-      const auto base = std::uint32_t(positions.size());
-      for (size_t v = 0; v < mesh.vertex_count; ++v) {
-        positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
-        uvs.emplace_back(mesh.lightmap_uvs[2 * v], mesh.lightmap_uvs[2 * v + 1]);
-        if (any_normals)
-          normals.push_back(mesh.normals ? glm::vec3(mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2])
-                                         : glm::vec3(0.0f));  // zero: the baker falls back to the face normal
-      }
-      for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) {
-        if (mesh.indices[i] >= mesh.vertex_count)
-          return invalid(fn, name + ".indices[" + std::to_string(i) + "] = " + std::to_string(mesh.indices[i]) +
-                                 " is out of range: " + std::to_string(mesh.vertex_count) + " vertices");
-        indices.push_back(base + mesh.indices[i]);
-      }
-      for (size_t t = 0; t < mesh.triangle_count; ++t)
-        materials.push_back(to_material(mesh.materials ? mesh.materials[t] : mesh.material));
-    }
-    hemilight::bake_input in;
-    in.scene.positions = positions.data();
-    in.scene.vertex_count = positions.size();
-    in.scene.indices = indices.data();
-    in.scene.triangle_count = materials.size();
-    in.scene.materials = materials.data();
-    in.scene.lightmap_uvs = uvs.data();
-    in.scene.sky_radiance = glm::vec3(o.sky_radiance[0], o.sky_radiance[1], o.sky_radiance[2]);
-    in.normals = any_normals ? normals.data() : nullptr;
+    gathered_scene g;
+    uv_target target;
+    target.width = o.width;
+    target.height = o.height;
+    if (const hemilight_status st = gather_meshes(fn, meshes, mesh_count, std::vector<uv_target>(mesh_count, target), g);
+        st != HEMILIGHT_OK)
+      return st;
+    const hemilight::bake_input in = input_of(g, o);
     const hemilight::bake_options bo =
         hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), sh_l1_rgb != nullptr, hl2_rgb != nullptr);
     hemilight::bake_result r;
@@ -242,12 +326,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     } catch (const hemilight::error& e) {
       return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
     }
-    // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to a texel is not.
-    const auto finite = [](const hemilight::image& img) { return all_finite(img.pixels.data(), img.pixels.size()); };
-    bool all_ok = finite(r.irradiance);
-    for (const hemilight::image& img : r.sh_l1) all_ok = all_ok && finite(img);
-    for (const hemilight::image& img : r.hl2) all_ok = all_ok && finite(img);
-    if (!all_ok) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
+    if (!result_finite(r)) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
     std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
     if (mask) std::copy(r.shadow_mask.pixels.begin(), r.shadow_mask.pixels.end(), o.shadow_mask_rgba);
     if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
@@ -255,18 +334,156 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
       for (std::size_t k = 0; k < 4; ++k) std::copy(r.sh_l1[k].pixels.begin(), r.sh_l1[k].pixels.end(), sh_l1_rgb + 3 * texels * k);
     if (hl2_rgb)
       for (std::size_t k = 0; k < 3; ++k) std::copy(r.hl2[k].pixels.begin(), r.hl2[k].pixels.end(), hl2_rgb + 3 * texels * k);
-    if (stats) {
-      hemilight_bake_stats st;
-      st.struct_size = sizeof st;
-      st.sampled_texels = r.stats.sampled_texels;
-      st.invalid_texels = r.stats.invalid_texels;
-      st.dilated_texels = r.stats.dilated_texels;
-      st.overlapping_texels = r.stats.overlapping_texels;
-      st.hemicubes = r.stats.hemicubes;
-      st.records = r.stats.records;
-      st.seconds = r.stats.seconds;
-      hemilight::capi::write_sized(st, stats);
+    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
+    return HEMILIGHT_OK;
+  });
+}
+
+// Checks a page's optional material image: every value in [0, hi].
+std::string check_page_image(const float* rgb, std::size_t texels, const std::string& name, float hi, const char* range) {
+  if (!rgb) return {};
+  for (std::size_t i = 0; i < 3 * texels; ++i)
+    if (!(rgb[i] >= 0.0f && rgb[i] <= hi))
+      return name + "[" + std::to_string(i) + "] (texel " + std::to_string(i / 3) + ") = " + std::to_string(rgb[i]) +
+             "; it must be " + range;
+  return {};
+}
+
+hemilight::image image_of(const float* rgb, int width, int height) {
+  if (!rgb) return {};
+  hemilight::image img = hemilight::image::make(width, height, 3);
+  std::copy(rgb, rgb + img.pixels.size(), img.pixels.begin());
+  return img;
+}
+
+hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                            hemilight_bake_stats* stats) {
+  const char* fn = "hemilight_bake_scene";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL (use hemilight_bake_scene_desc_init)");
+    hemilight_bake_scene_desc sd = hemilight::capi::default_bake_scene_desc();
+    if (const std::string problem = hemilight::capi::read_sized(scene, sd); !problem.empty()) return invalid(fn, problem);
+    if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
+    hemilight_bake_options o = hemilight::capi::default_bake_options();
+    if (const std::string problem = hemilight::capi::read_sized(options, o); !problem.empty()) return invalid(fn, problem);
+    if (stats)
+      if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
+    if (sd.mesh_count == 0) return invalid(fn, "scene->mesh_count is 0: there is nothing to bake");
+    if (!sd.meshes) return invalid(fn, "scene->meshes is NULL");
+    if (!sd.placements) return invalid(fn, "scene->placements is NULL (one per mesh)");
+    if (sd.page_count == 0) return invalid(fn, "scene->page_count is 0: a scene bake needs at least one page");
+    if (!sd.pages) return invalid(fn, "scene->pages is NULL");
+    if (sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION && sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE)
+      return invalid(fn, "scene->occluder_radiance is " + std::to_string(sd.occluder_radiance) +
+                             "; it must be HEMILIGHT_OCCLUDER_EMISSION (0) or HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE (1)");
+    std::shared_ptr<const hemilight::cubemap> environment;
+    bool mask = false;
+    if (const hemilight_status st = check_common_options(fn, o, environment, mask); st != HEMILIGHT_OK) return st;
+    bool want_sh = false, want_hl2 = false;
+    for (size_t p = 0; p < sd.page_count; ++p) {
+      const hemilight_bake_page& page = sd.pages[p];
+      const std::string name = "scene->pages[" + std::to_string(p) + "]";
+      if (page.width < 1 || page.width > hemilight::max_lightmap_size || page.height < 1 || page.height > hemilight::max_lightmap_size)
+        return invalid(fn, name + ": width x height = " + std::to_string(page.width) + " x " + std::to_string(page.height) +
+                               " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
+      const size_t texels = size_t(page.width) * size_t(page.height);
+      if (!page.irradiance_rgb) return invalid(fn, name + ".irradiance_rgb is NULL");
+      if (page.irradiance_capacity < 3 * texels)
+        return invalid(fn, name + ".irradiance_capacity " + std::to_string(page.irradiance_capacity) +
+                               " is below 3 x width x height = " + std::to_string(3 * texels) + " floats");
+      if (page.valid && page.valid_capacity < texels)
+        return invalid(fn, name + ".valid_capacity " + std::to_string(page.valid_capacity) + " is below width x height = " +
+                               std::to_string(texels));
+      if (page.sh_l1_rgb && page.sh_l1_capacity < 12 * texels)
+        return invalid(fn, name + ".sh_l1_capacity " + std::to_string(page.sh_l1_capacity) + " is below 12 x width x height = " +
+                               std::to_string(12 * texels) + " floats (four RGB images)");
+      if (page.hl2_rgb && page.hl2_capacity < 9 * texels)
+        return invalid(fn, name + ".hl2_capacity " + std::to_string(page.hl2_capacity) + " is below 9 x width x height = " +
+                               std::to_string(9 * texels) + " floats (three RGB images)");
+      if (mask && !page.shadow_mask_rgba)
+        return invalid(fn, "options->shadow_mask_lights names a light but " + name + ".shadow_mask_rgba is NULL");
+      if (mask && page.shadow_mask_capacity < 4 * texels)
+        return invalid(fn, name + ".shadow_mask_capacity " + std::to_string(page.shadow_mask_capacity) +
+                               " is below 4 x width x height = " + std::to_string(4 * texels) + " floats");
+      if (std::string e = check_page_image(page.albedo_rgb, texels, name + ".albedo_rgb", 1.0f, "in [0, 1]"); !e.empty())
+        return invalid(fn, e);
+      if (std::string e = check_page_image(page.emission_rgb, texels, name + ".emission_rgb", hemilight::max_radiance,
+                                           "finite, >= 0 and at most 1e30");
+          !e.empty())
+        return invalid(fn, e);
+      want_sh = want_sh || page.sh_l1_rgb;
+      want_hl2 = want_hl2 || page.hl2_rgb;
     }
+    std::vector<hemilight::light> lights;
+    const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
+    if (lights_status != HEMILIGHT_OK) return lights_status;
+
+    std::vector<uv_target> targets(sd.mesh_count);
+    for (size_t m = 0; m < sd.mesh_count; ++m) {
+      const hemilight_bake_placement& pl = sd.placements[m];
+      const std::string name = "scene->placements[" + std::to_string(m) + "]";
+      if (pl.page < -1 || (pl.page >= 0 && size_t(pl.page) >= sd.page_count))
+        return invalid(fn, name + ".page = " + std::to_string(pl.page) + " is not -1 (occluder only) or a page index (page_count " +
+                               std::to_string(sd.page_count) + ")");
+      for (int c = 0; c < 2; ++c)
+        if (!std::isfinite(pl.uv_scale[c]) || !std::isfinite(pl.uv_offset[c]))
+          return invalid(fn, name + ".uv_scale or uv_offset is not finite");
+      targets[m].placement = &pl;
+      if (pl.page >= 0) {
+        targets[m].width = sd.pages[pl.page].width;
+        targets[m].height = sd.pages[pl.page].height;
+      }
+    }
+    gathered_scene g;
+    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, g, "scene->"); st != HEMILIGHT_OK) return st;
+
+    hemilight::scene_bake_input in;
+    in.geometry = input_of(g, o);
+    in.occluders = sd.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION ? hemilight::occluder_radiance::emission
+                                                                        : hemilight::occluder_radiance::emission_plus_mean_bounce;
+    for (size_t p = 0; p < sd.page_count; ++p) {
+      const hemilight_bake_page& page = sd.pages[p];
+      hemilight::lightmap_page lp;
+      lp.width = page.width;
+      lp.height = page.height;
+      lp.albedo = image_of(page.albedo_rgb, page.width, page.height);
+      lp.emission = image_of(page.emission_rgb, page.width, page.height);
+      in.pages.push_back(std::move(lp));
+    }
+    std::size_t first = 0;
+    for (size_t m = 0; m < sd.mesh_count; ++m) {
+      hemilight::bake_mesh bm;
+      bm.first_triangle = first;
+      bm.triangle_count = sd.meshes[m].triangle_count;
+      bm.page = sd.placements[m].page;
+      bm.uv_scale = glm::vec2(sd.placements[m].uv_scale[0], sd.placements[m].uv_scale[1]);
+      bm.uv_offset = glm::vec2(sd.placements[m].uv_offset[0], sd.placements[m].uv_offset[1]);
+      in.meshes.push_back(bm);
+      first += bm.triangle_count;
+    }
+    const hemilight::bake_options bo = hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
+    hemilight::scene_bake_result r;
+    try {
+      r = hemilight::bake_scene(in, bo);
+    } catch (const hemilight::error& e) {
+      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
+    }
+    for (const hemilight::bake_result& page : r.pages)
+      if (!result_finite(page)) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
+    for (size_t p = 0; p < sd.page_count; ++p) {
+      const hemilight_bake_page& page = sd.pages[p];
+      const hemilight::bake_result& pr = r.pages[p];
+      const size_t texels = size_t(page.width) * size_t(page.height);
+      std::copy(pr.irradiance.pixels.begin(), pr.irradiance.pixels.end(), page.irradiance_rgb);
+      if (mask) std::copy(pr.shadow_mask.pixels.begin(), pr.shadow_mask.pixels.end(), page.shadow_mask_rgba);
+      if (page.valid) std::copy(pr.valid.begin(), pr.valid.end(), page.valid);
+      if (page.sh_l1_rgb)
+        for (std::size_t k = 0; k < 4; ++k)
+          std::copy(pr.sh_l1[k].pixels.begin(), pr.sh_l1[k].pixels.end(), page.sh_l1_rgb + 3 * texels * k);
+      if (page.hl2_rgb)
+        for (std::size_t k = 0; k < 3; ++k) std::copy(pr.hl2[k].pixels.begin(), pr.hl2[k].pixels.end(), page.hl2_rgb + 3 * texels * k);
+    }
+    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
     return HEMILIGHT_OK;
   });
 }

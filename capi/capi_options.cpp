@@ -266,3 +266,40 @@ void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_
 }
 
 }  // extern "C"
+
+// ---- hemilight_bake_scene_desc (a growable struct like the options above) ------------------------
+
+namespace hemilight::capi {
+namespace {
+
+#define HEMILIGHT_SPAN(T, f) span { offsetof(T, f), sizeof(static_cast<T*>(nullptr)->f) }
+const span bake_scene_desc_fields[] = {
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, struct_size), HEMILIGHT_SPAN(hemilight_bake_scene_desc, meshes),
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, mesh_count), HEMILIGHT_SPAN(hemilight_bake_scene_desc, placements),
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, pages), HEMILIGHT_SPAN(hemilight_bake_scene_desc, page_count),
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, occluder_radiance)};
+#undef HEMILIGHT_SPAN
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_scene_desc) == 56, "hemilight_bake_scene_desc changed: see above");
+
+}  // namespace
+
+hemilight_bake_scene_desc default_bake_scene_desc() {
+  hemilight_bake_scene_desc d = zeroed<hemilight_bake_scene_desc>();
+  d.struct_size = sizeof d;
+  d.occluder_radiance = HEMILIGHT_OCCLUDER_EMISSION;
+  return d;
+}
+
+std::string read_sized(const hemilight_bake_scene_desc* in, hemilight_bake_scene_desc& out) {
+  const std::string problem = size_problem("scene", "hemilight_bake_scene_desc_init", in->struct_size, sizeof out);
+  if (!problem.empty()) return problem;
+  copy_fields(bake_scene_desc_fields, in, &out, in->struct_size);
+  return {};
+}
+
+}  // namespace hemilight::capi
+
+extern "C" void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* scene, size_t struct_size) {
+  hemilight::capi::init_sized(scene, struct_size, hemilight::capi::default_bake_scene_desc(),
+                              hemilight::capi::bake_scene_desc_fields);
+}

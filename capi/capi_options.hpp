@@ -43,3 +43,12 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
                     bool output_sh_l1, bool output_hl2);
 
 }  // namespace hemilight::capi
+
+namespace hemilight::capi {
+
+/// hemilight_bake_scene_desc: the defaults (all NULL and 0, emission-only occluders), and the
+/// caller's fields within its struct_size over them (returns "" or what is wrong with struct_size).
+hemilight_bake_scene_desc default_bake_scene_desc();
+std::string read_sized(const hemilight_bake_scene_desc* in, hemilight_bake_scene_desc& out);
+
+}  // namespace hemilight::capi

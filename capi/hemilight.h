@@ -23,8 +23,8 @@
  *     creation unless a function says otherwise.
  *
  * Structs that grow (what stays compatible)
- *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options and
- *     hemilight_bake_stats begin with size_t struct_size. Their _init functions are inline (below)
+ *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
+ *     hemilight_bake_stats and hemilight_bake_scene_desc begin with size_t struct_size. Their _init functions are inline (below)
  *     and record the sizeof the program was compiled with; call one before use.
  *   - A later minor version only appends fields to them, each new field starting at or after the
  *     previous version's sizeof. The library reads the fields that lie within the caller's
@@ -34,7 +34,7 @@
  *   - A struct_size below sizeof(size_t) (not initialised) or above what the library knows (a
  *     program built against a newer header than the library) is refused with INVALID_ARGUMENT.
  *   - Structs passed in arrays (hemilight_bake_mesh, hemilight_bake_material, hemilight_light,
- *     hemilight_irradiance) and every function signature stay as they are for an SOVERSION; new
+ *     hemilight_irradiance, hemilight_bake_placement, hemilight_bake_page) and every function signature stay as they are for an SOVERSION; new
  *     data would come through new functions or arrays. The SOVERSION changes only when that
  *     promise is broken.
  */
@@ -659,6 +659,84 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_sample(const float* chain, int 
                                                         const float direction[3], float lod,
                                                         hemilight_cube_sampling sampling, int apply_fixup,
                                                         float rgb[3]);
+
+/* ---- scene bakes: lightmap pages, occluder-only meshes, per-texel materials ----------------------
+ * hemilight_bake_scene bakes many meshes into several lightmap pages at once (include/hemilight/
+ * bake.hpp, bake_scene; docs/bake.md, "Pages and occluders"). All pages go through the same
+ * passes, so light bounces between meshes of different pages; dilation stays inside each page. */
+
+/* Where mesh i of a scene bake goes (placements[i] for meshes[i]). */
+typedef struct hemilight_bake_placement {
+  int page;           /* index into the pages, or -1: occluder only (blocks hemicubes and shadow rays,
+                         gets no texels, lightmap_uvs may be NULL; hemicubes see it with
+                         hemilight_bake_scene_desc::occluder_radiance) */
+  float uv_scale[2];  /* page UV = lightmap_uv * uv_scale + uv_offset (per component, in float):
+                         Unity's lightmapScaleOffset (x, y, z, w) is scale (x, y), offset (z, w).
+                         Finite; every page UV must lie in [0, 1]. */
+  float uv_offset[2];
+} hemilight_bake_placement;
+
+/* One lightmap page: its size, optional per-texel materials (inputs) and its outputs (written only
+ * when the whole bake succeeds). Texel (x, y) of every image is at index (y width + x) times its
+ * channel count, row 0 first, as for hemilight_bake_lightmap. */
+typedef struct hemilight_bake_page {
+  int width, height;            /* texels, each 1..8192 */
+  const float* albedo_rgb;      /* NULL, or 3 width height floats in [0, 1]: per-texel albedo used for the
+                                   bounces instead of the owner triangle's */
+  const float* emission_rgb;    /* NULL, or 3 width height floats in [0, 1e30]: per-texel emitted radiance
+                                   instead of the triangle's (the first pass then sees it through a
+                                   bilinear radiance texture) */
+  float* irradiance_rgb;        /* required: the irradiance, at least 3 width height floats */
+  size_t irradiance_capacity;   /* floats at irradiance_rgb */
+  uint8_t* valid;               /* NULL, or width height bytes: as hemilight_bake_lightmap's valid */
+  size_t valid_capacity;
+  float* sh_l1_rgb;             /* NULL, or 12 width height floats: as hemilight_bake_lightmap_directional */
+  size_t sh_l1_capacity;
+  float* hl2_rgb;               /* NULL, or 9 width height floats: as hemilight_bake_lightmap_directional */
+  size_t hl2_capacity;
+  float* shadow_mask_rgba;      /* 4 width height floats when options->shadow_mask_lights names a light, else
+                                   ignored (options->shadow_mask_rgba is not used by scene bakes) */
+  size_t shadow_mask_capacity;
+} hemilight_bake_page;
+
+/* What hemicubes see of occluder-only meshes (hemilight_bake_scene_desc::occluder_radiance). */
+#define HEMILIGHT_OCCLUDER_EMISSION 0                 /* their emission only: they reflect nothing */
+#define HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE 1 /* + albedo x the previous pass's mean irradiance / pi */
+
+/* A scene to bake; fill with hemilight_bake_scene_desc_init, then set the arrays. */
+typedef struct hemilight_bake_scene_desc {
+  size_t struct_size;                          /* set by hemilight_bake_scene_desc_init ("Structs that grow") */
+  const hemilight_bake_mesh* meshes;           /* mesh_count meshes (as for hemilight_bake_lightmap) */
+  size_t mesh_count;
+  const hemilight_bake_placement* placements;  /* mesh_count placements, one per mesh */
+  const hemilight_bake_page* pages;            /* page_count pages; their output buffers are written */
+  size_t page_count;
+  int occluder_radiance;                       /* HEMILIGHT_OCCLUDER_* (default HEMILIGHT_OCCLUDER_EMISSION) */
+} hemilight_bake_scene_desc;
+
+/* As hemilight_cache_options_init_sized, for scene descriptions (all NULL and 0, emission-only occluders). */
+HEMILIGHT_API void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* scene, size_t struct_size);
+static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* scene) {
+  hemilight_bake_scene_desc_init_sized(scene, sizeof *scene);
+}
+
+/* Bakes every page of a scene in one bake (hemilight_bake_lightmap's pipeline over all pages).
+ * options: as for hemilight_bake_lightmap, except that width and height are ignored (the pages
+ * give the sizes) and the shadow mask goes to each page's shadow_mask_rgba. The directional maps
+ * are computed when any page asks for them and written to the pages that do. stats (may be NULL):
+ * the whole bake. One page holding every mesh with scale (1, 1) and offset (0, 0) gives bitwise
+ * what hemilight_bake_lightmap gives.
+ * Errors (nothing written; the message names the function and the mesh, page or placement by
+ * index, and the index within it): INVALID_ARGUMENT for NULL scene/options, a bad struct_size,
+ * mesh_count or page_count 0, NULL meshes/placements/pages, a page size out of range, a NULL
+ * irradiance_rgb or a capacity too small, an albedo or emission value out of range
+ * ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or non-finite
+ * scale/offset, a page UV outside [0, 1] ("meshes[2].lightmap_uvs[9] (vertex 4, v) = 0.9 maps to
+ * 1.3 in page 1"), a triangle with no area in its page, everything hemilight_bake_lightmap rejects
+ * in the meshes and options, no texel sampled in any page; OUT_OF_MEMORY, CANCELLED as there.
+ * Cost: as hemilight_bake_lightmap over the sum of the pages' texels. */
+HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                                    hemilight_bake_stats* stats);
 
 #ifdef __cplusplus
 }

@@ -20,11 +20,16 @@
 // grid probes are at the cell centres, x fastest, then y, then z. Drop probes whose
 // backface_fraction is above ~0.1 (inside geometry).
 //
-// Models: read with assimp (triangulated, node transforms applied, normals generated when
-// missing). Lightmap UVs are the mesh's UV channel 1 if it has one, else channel 0; they must lie
-// in [0, 1] and give every triangle a nonzero UV area. Material: diffuse colour (Kd) = albedo
-// (clamped to [0, 1]), emissive colour (Ke) = emitted radiance, two-sided flag. All meshes share
-// one lightmap. The sky (constant radiance) is --sky.
+// Models (model_import.hpp): read with assimp, every node's meshes with its transform (instances
+// included), normals generated when missing. Lightmap UVs are UV channel 1 (glTF TEXCOORD_1;
+// --lightmap-uv 0 for files with one UV set, like OBJ): a model with meshes lacking it fails with
+// all of them named. They must lie in [0, 1] and give every triangle a nonzero UV area. Material:
+// base colour (glTF baseColorFactor x baseColorTexture, or Kd x map_Kd) = albedo (clamped to
+// [0, 1]), emissive colour x emissive texture = emitted radiance, two-sided flag; textures are
+// decoded by stb_image and averaged over each lightmap texel's footprint into per-page albedo and
+// emission images (bake_scene). A texture that cannot be read is an error. All meshes share one
+// lightmap page, except instances: instance k of a mesh is baked into page k (NAME_pageK_*).
+// The sky (constant radiance) is --sky.
 //
 // Lights (lights.hpp): --sun and --point (repeatable) add lights; a model's own punctual and area
 // lights (glTF KHR_lights_punctual, FBX, Collada: whatever assimp imports as aiLight) are baked
@@ -46,10 +51,9 @@
 #include "hemilight/probes.hpp"
 #include "hemilight/reference_scenes.hpp"
 
-#include <assimp/Importer.hpp>
-#include <assimp/material.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
+#include "model_import.hpp"
+#include "preview.hpp"
+
 #include <png.h>
 
 #include <algorithm>
@@ -71,8 +75,8 @@ namespace {
 const char* usage =
     "usage: hemilight_bake [MODEL] [options]\n"
     "  With no MODEL: bakes the built-in hexagon room (lit by the sky through a window) and the\n"
-    "  Cornell box. With MODEL (OBJ or another format assimp reads): bakes its lightmap UVs\n"
-    "  (UV channel 1 if present, else 0; they must lie in [0, 1]).\n"
+    "  Cornell box. With MODEL (glTF, FBX, OBJ or another format assimp reads): bakes its\n"
+    "  lightmap UVs (UV channel 1, see --lightmap-uv; they must lie in [0, 1]) with its textures.\n"
     "options:\n"
     "  --size N           lightmap width and height in texels, 1..8192 (default 256)\n"
     "  --resolution N     hemicube resolution, even, 2..4096 (default 64)\n"
@@ -93,6 +97,12 @@ const char* usage =
     "  --probes P         also write NAME_probes.json: SH9 light probes (probes.hpp) that see the\n"
     "                     baked surfaces, at the centres of an AxBxC grid over the scene's bounds\n"
     "                     (P like 8x4x8) or at the points of a text file (x y z per line, # comments)\n"
+    "  --preview [CAMERA] also write NAME_preview.png: the baked scene rendered (lightmap x albedo +\n"
+    "                     emission, bilinear) from CAMERA = EX,EY,EZ,TX,TY,TZ[,FOV] (eye, target, field\n"
+    "                     of view in degrees, (0, 90], default 60) or a view chosen from the scene's\n"
+    "                     bounds; built-in scenes always get one\n"
+    "  --lightmap-uv C    the model's UV channel holding the lightmap UVs, 0..7 (default 1: glTF's\n"
+    "                     TEXCOORD_1; OBJ files have only channel 0)\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -110,6 +120,10 @@ struct settings {
   bake_options options;
   glm::vec3 sky{1.0f};
   bool quiet = false, shadow_mask = false;
+  unsigned lightmap_uv = 1;  // --lightmap-uv: the model's UV channel holding the lightmap UVs
+  bool preview = false;      // --preview: a rendered picture of each baked model (built-in scenes: always)
+  bool has_camera = false;   // --preview EX,EY,EZ,TX,TY,TZ[,FOV]
+  preview::camera camera;
   std::string probes;  // --probes: "AxBxC" or a file of points; empty: none
 };
 
@@ -214,6 +228,22 @@ settings parse(int argc, char** argv) {
       s.shadow_mask = true;
     } else if (a == "--probes") {
       s.probes = value();
+    } else if (a == "--preview") {
+      s.preview = true;
+      // An optional camera: the next argument if it reads as one (a model path does not).
+      if (i + 1 < argc && argv[i + 1][0] != '-') {
+        preview::camera cam;
+        if (preview::parse_camera(argv[i + 1], cam)) {
+          s.camera = cam;
+          s.has_camera = true;
+          ++i;
+        } else if (std::strchr(argv[i + 1], ',')) {
+          fail(std::string("--preview ") + argv[i + 1] + " is invalid: the camera is EX,EY,EZ,TX,TY,TZ[,FOV] with FOV in (0, 90] "
+               "degrees and the eye away from the target", 2);
+        }
+      }
+    } else if (a == "--lightmap-uv") {
+      s.lightmap_uv = unsigned(parse_int("--lightmap-uv", value(), 0, 7));
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -291,104 +321,49 @@ void write_probes_json(const std::string& path, const std::vector<glm::vec3>& p,
   if (std::fclose(f) != 0) fail("cannot write '" + path + "'");
 }
 
-// A model as the baker needs it (arrays owned here).
-struct model {
+// A model as bake_scene needs it: the imported meshes concatenated (arrays owned here), each a
+// mesh of the scene bake on the page of its instance (model_import.hpp).
+struct scene_arrays {
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> uvs;
   std::vector<std::uint32_t> indices;
   std::vector<material> materials;
-  std::vector<light> lights;
 };
 
-// A model's lights as lights.hpp's (see the top of this file for the mapping).
-std::vector<light> model_lights(const aiScene* sc, const std::string& path) {
-  std::vector<light> out;
-  for (unsigned i = 0; i < sc->mNumLights; ++i) {
-    const aiLight& a = *sc->mLights[i];
-    light l;
-    l.color = glm::max(glm::vec3(a.mColorDiffuse.r, a.mColorDiffuse.g, a.mColorDiffuse.b), glm::vec3(0.0f));
-    l.position = {a.mPosition.x, a.mPosition.y, a.mPosition.z};
-    l.direction = {a.mDirection.x, a.mDirection.y, a.mDirection.z};
-    switch (a.mType) {
-      case aiLightSource_DIRECTIONAL: l.type = light_type::directional; break;
-      case aiLightSource_POINT: l.type = light_type::point; break;
-      case aiLightSource_SPOT:
-        l.type = light_type::spot;
-        l.spot_outer = std::clamp(0.5f * a.mAngleOuterCone, 0.0f, 1.5707963f);
-        l.spot_inner = std::clamp(0.5f * a.mAngleInnerCone, 0.0f, l.spot_outer);
-        break;
-      case aiLightSource_AREA:
-        l.type = light_type::rect;
-        l.tangent = {a.mUp.x, a.mUp.y, a.mUp.z};
-        l.width = a.mSize.x;
-        l.height = a.mSize.y;
-        break;
-      default:
-        std::fprintf(stderr, "hemilight_bake: '%s' light %u ('%s') is of a type that cannot be baked; skipped\n", path.c_str(), i,
-                     a.mName.C_Str());
-        continue;
-    }
-    out.push_back(l);
+scene_bake_input model_scene(const model_import::model& m, const settings& s, scene_arrays& a) {
+  scene_bake_input in;
+  for (const model_import::mesh& me : m.meshes) {
+    bake_mesh bm;
+    bm.first_triangle = a.indices.size() / 3;
+    bm.triangle_count = me.indices.size() / 3;
+    bm.page = int(me.instance);
+    in.meshes.push_back(bm);
+    const auto base = std::uint32_t(a.positions.size());
+    a.positions.insert(a.positions.end(), me.positions.begin(), me.positions.end());
+    a.normals.insert(a.normals.end(), me.normals.begin(), me.normals.end());
+    a.uvs.insert(a.uvs.end(), me.lightmap_uvs.begin(), me.lightmap_uvs.end());
+    for (std::uint32_t i : me.indices) a.indices.push_back(base + i);
+    const material flat = m.materials[me.material].flat(m.textures);
+    a.materials.insert(a.materials.end(), me.indices.size() / 3, flat);
   }
-  return out;
-}
-
-model load_model(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail("cannot read '" + path + "': no such file");
-  Assimp::Importer importer;
-  const aiScene* sc = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_GenNormals |
-                                                  aiProcess_SortByPType);
-  if (!sc || (sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !sc->mRootNode)
-    fail("cannot read '" + path + "': " + importer.GetErrorString());
-  model m;
-  for (unsigned mi = 0; mi < sc->mNumMeshes; ++mi) {
-    const aiMesh* mesh = sc->mMeshes[mi];
-    if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;  // points and lines: nothing to light
-    const std::string name = "'" + path + "' mesh " + std::to_string(mi) + " ('" + mesh->mName.C_Str() + "')";
-    const unsigned channel = mesh->HasTextureCoords(1) ? 1u : 0u;
-    if (!mesh->HasTextureCoords(channel)) fail(name + " has no texture coordinates to use as lightmap UVs");
-    material mat;
-    if (mesh->mMaterialIndex < sc->mNumMaterials) {
-      const aiMaterial* am = sc->mMaterials[mesh->mMaterialIndex];
-      aiColor3D c(0.8f, 0.8f, 0.8f);
-      am->Get(AI_MATKEY_COLOR_DIFFUSE, c);
-      mat.albedo = glm::clamp(glm::vec3(c.r, c.g, c.b), 0.0f, 1.0f);
-      aiColor3D e(0.0f, 0.0f, 0.0f);
-      am->Get(AI_MATKEY_COLOR_EMISSIVE, e);
-      mat.emission = glm::max(glm::vec3(e.r, e.g, e.b), glm::vec3(0.0f));
-      int two = 0;
-      am->Get(AI_MATKEY_TWOSIDED, two);
-      mat.two_sided = two != 0;
-    }
-    const auto base = std::uint32_t(m.positions.size());
-    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-      const aiVector3D& p = mesh->mVertices[v];
-      const aiVector3D& t = mesh->mTextureCoords[channel][v];
-      if (!(t.x >= 0.0f && t.x <= 1.0f && t.y >= 0.0f && t.y <= 1.0f))
-        fail(name + " vertex " + std::to_string(v) + ": lightmap UV (" + std::to_string(t.x) + ", " + std::to_string(t.y) +
-             ") is outside [0, 1]");
-      m.positions.emplace_back(p.x, p.y, p.z);
-      m.uvs.emplace_back(t.x, t.y);
-      m.normals.push_back(mesh->HasNormals() ? glm::vec3(mesh->mNormals[v].x, mesh->mNormals[v].y, mesh->mNormals[v].z)
-                                             : glm::vec3(0.0f));
-    }
-    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-      const aiFace& face = mesh->mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      const glm::vec2 a = m.uvs[base + face.mIndices[0]], b = m.uvs[base + face.mIndices[1]], c = m.uvs[base + face.mIndices[2]];
-      const glm::vec3 pa = m.positions[base + face.mIndices[0]], pb = m.positions[base + face.mIndices[1]],
-                      pc = m.positions[base + face.mIndices[2]];
-      const float uv_area = std::fabs((b - a).x * (c - a).y - (b - a).y * (c - a).x);
-      if (uv_area == 0.0f && glm::length(glm::cross(pb - pa, pc - pa)) > 0.0f)
-        fail(name + " triangle " + std::to_string(f) + " has zero area in lightmap UV space");
-      for (int k = 0; k < 3; ++k) m.indices.push_back(base + face.mIndices[k]);
-      m.materials.push_back(mat);
-    }
+  in.geometry.scene.positions = a.positions.data();
+  in.geometry.scene.vertex_count = a.positions.size();
+  in.geometry.scene.indices = a.indices.data();
+  in.geometry.scene.triangle_count = a.indices.size() / 3;
+  in.geometry.scene.materials = a.materials.data();
+  in.geometry.scene.lightmap_uvs = a.uvs.data();
+  in.geometry.scene.sky_radiance = s.sky;
+  in.geometry.normals = a.normals.data();
+  for (int p = 0; p < m.pages; ++p) {
+    lightmap_page page;
+    page.width = s.options.width;
+    page.height = s.options.height;
+    model_import::page_images images = model_import::bake_page_materials(m, p, page.width, page.height);
+    page.albedo = std::move(images.albedo);
+    page.emission = std::move(images.emission);
+    in.pages.push_back(std::move(page));
   }
-  if (m.indices.empty()) fail("'" + path + "' has no triangles");
-  m.lights = model_lights(sc, path);
-  return m;
+  return in;
 }
 
 // The preview: exposure, Reinhard, sRGB, 8-bit PNG through libpng's simplified API.
@@ -447,43 +422,65 @@ struct progress_bar {
   }
 };
 
-void bake_and_write(const std::string& name, const bake_input& in, const settings& s, const std::vector<light>& scene_lights) {
+void bake_and_write(const std::string& name, const scene_bake_input& in, const settings& s, const std::vector<light>& scene_lights) {
   bake_options o = s.options;
   o.lights.insert(o.lights.end(), scene_lights.begin(), scene_lights.end());
   if (s.shadow_mask)
     for (std::size_t c = 0; c < 4 && c < o.lights.size(); ++c) o.shadow_mask_lights[c] = int(c);
+  if (!s.probes.empty() && in.pages.size() > 1)
+    fail("--probes needs a model baked into one lightmap page; '" + s.model + "' has instanced meshes (" +
+         std::to_string(in.pages.size()) + " pages)", 2);
   progress_bar bar;
   bar.label = name;
   bar.quiet = s.quiet;
   o.progress = [&bar](float f) { return bar(f); };
-  const bake_result r = bake_lightmap(in, o);
+  const scene_bake_result sr = bake_scene(in, o);
   if (bar_open) std::fprintf(stderr, "\n");
   bar_open = false;
+  // Page 0 keeps the names of a one-lightmap bake (NAME_irradiance.exr ...); page p > 0 is NAME_pageP_*.
   const std::string base = s.out + "/" + name;
-  const std::vector<std::string> written = write_bake_exrs(r, base);
-  write_png_preview(base + "_irradiance.png", r);
-  const bake_stats& st = r.stats;
-  std::printf("%s: %zu triangles, %d x %d lightmap, N = %d, %d bounce%s%s, %d threads\n", name.c_str(), in.scene.triangle_count,
-              o.width, o.height, o.resolution, o.bounces, o.bounces > 1 ? "s" : "", o.indirect_only ? " (indirect only)" : "",
-              resolve_thread_count(o.thread_count));
+  const auto page_base = [&](std::size_t p) { return p == 0 ? base : base + "_page" + std::to_string(p); };
+  std::string suffixes;
+  for (std::size_t p = 0; p < sr.pages.size(); ++p) {
+    const std::vector<std::string> written = write_bake_exrs(sr.pages[p], page_base(p));
+    write_png_preview(page_base(p) + "_irradiance.png", sr.pages[p]);
+    if (p == 0)
+      for (const std::string& w : written) suffixes += w.substr(base.size() + 1) + ",";
+  }
+  std::string preview_line;
+  if (s.preview || s.model.empty()) {
+    const std::vector<image> radiance = preview::page_radiance(in, sr);
+    const preview::camera cam = s.has_camera ? s.camera : preview::default_camera(in, radiance);
+    preview::write_png(base + "_preview.png", preview::render(in, radiance, cam, 512));
+    char line[256];
+    std::snprintf(line, sizeof line, "  preview from (%.3g, %.3g, %.3g) towards (%.3g, %.3g, %.3g), %.3g degrees: %s_preview.png\n",
+                  double(cam.eye.x), double(cam.eye.y), double(cam.eye.z), double(cam.target.x), double(cam.target.y),
+                  double(cam.target.z), double(cam.fov_degrees), base.c_str());
+    preview_line = line;
+  }
+  const bake_stats& st = sr.stats;
+  std::printf("%s: %zu triangles, %zu page%s of %d x %d, N = %d, %d bounce%s%s, %d threads\n", name.c_str(),
+              in.geometry.scene.triangle_count, sr.pages.size(), sr.pages.size() > 1 ? "s" : "", o.width, o.height, o.resolution,
+              o.bounces, o.bounces > 1 ? "s" : "", o.indirect_only ? " (indirect only)" : "", resolve_thread_count(o.thread_count));
+  const bool textured = std::any_of(in.pages.begin(), in.pages.end(), [](const lightmap_page& p) { return p.albedo.width > 0 || p.emission.width > 0; });
+  if (textured) std::printf("  per-texel albedo/emission from the model's textures\n");
   std::printf("  texels: %zu sampled of %zu covered, %zu invalid (inside geometry), %zu dilated, %zu overlapping\n",
               st.sampled_texels, st.covered_texels, st.invalid_texels, st.dilated_texels, st.overlapping_texels);
   for (std::size_t p = 0; p < st.passes.size(); ++p)
     std::printf("  pass %zu: %zu hemicubes (%.1f%% of sampled texels), %zu records, %.2f s\n", p + 1, st.passes[p].hemicubes,
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
-  std::string suffixes;
-  for (const std::string& w : written) suffixes += w.substr(base.size() + 1) + ",";
   if (!o.lights.empty())
     std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
-  std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}\n", st.seconds, st.coverage_seconds, base.c_str(),
-              suffixes.c_str());
+  std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}%s\n", st.seconds, st.coverage_seconds, base.c_str(),
+              suffixes.c_str(), sr.pages.size() > 1 ? (" and the same for pages 1.." + std::to_string(sr.pages.size() - 1) + " (" + base + "_pageP_*)").c_str() : "");
+  std::fputs(preview_line.c_str(), stdout);
   if (s.probes.empty()) return;
   // Probes that see the baked surfaces (emission + albedo E / pi), the sky and the lights.
   const auto t0 = std::chrono::steady_clock::now();
-  const std::shared_ptr<const scene> sc = scene::create(in.scene);
+  const std::shared_ptr<const scene> sc = scene::create(in.geometry.scene);
   int grid[3] = {0, 0, 0};
   const std::vector<glm::vec3> points = probe_positions(s.probes, sc->bounds_lo(), sc->bounds_hi(), grid);
-  const image texture = bake_radiance_texture(in, o, r);
+  const image texture = bake_radiance_texture(in.geometry, o, sr.pages[0]);
   const radiance_texture view(texture);
   probe_options po;
   po.resolution = o.resolution;
@@ -515,7 +512,8 @@ void run(const settings& s) {
 
 void run_scenes(const settings& s) {
   if (s.model.empty()) {
-    // Built-in scenes: chart UVs generated for the lightmap size (2 texels of padding).
+    // Built-in scenes: chart UVs generated for the lightmap size (2 texels of padding); one page,
+    // one mesh (bitwise what bake_lightmap gives).
     const struct {
       const char* name;
       lit_scene scene;
@@ -526,26 +524,34 @@ void run_scenes(const settings& s) {
     for (const auto& sc : scenes) {
       scene_mesh m = sc.scene.mesh;
       generate_lightmap_uvs(m, std::max(8, s.options.width), std::max(8, s.options.width) >= 16 ? 2 : 0);
-      bake_input in;
-      in.scene = m.desc();
+      scene_bake_input in;
+      in.geometry.scene = m.desc();
+      lightmap_page page;
+      page.width = s.options.width;
+      page.height = s.options.height;
+      in.pages.push_back(page);
+      bake_mesh all;
+      all.triangle_count = m.triangle_count();
+      all.page = 0;
+      in.meshes.push_back(all);
       bake_and_write(sc.name, in, s, sc.scene.lights);
     }
     return;
   }
   if (s.options.width < 1 || s.options.width > max_lightmap_size) fail("--size is out of range");
-  model m = load_model(s.model);
-  bake_input in;
-  in.scene.positions = m.positions.data();
-  in.scene.vertex_count = m.positions.size();
-  in.scene.indices = m.indices.data();
-  in.scene.triangle_count = m.indices.size() / 3;
-  in.scene.materials = m.materials.data();
-  in.scene.lightmap_uvs = m.uvs.data();
-  in.scene.sky_radiance = s.sky;
-  in.normals = m.normals.data();
+  model_import::model m;
+  try {
+    m = model_import::import_model(s.model, s.lightmap_uv);
+  } catch (const std::runtime_error& e) {
+    fail(e.what());
+  }
+  scene_arrays arrays;
+  const scene_bake_input in = model_scene(m, s, arrays);
   std::string name = std::filesystem::path(s.model).stem().string();
   if (name.empty()) name = "model";
   if (!m.lights.empty()) std::printf("%s: %zu light%s from the model\n", name.c_str(), m.lights.size(), m.lights.size() > 1 ? "s" : "");
+  if (m.pages > 1)
+    std::printf("%s: instanced meshes: instance k of each mesh is baked into page k (%d pages)\n", name.c_str(), m.pages);
   bake_and_write(name, in, s, m.lights);
 }
 

@@ -42,23 +42,23 @@ expect_fail() {  # expect_fail WORDS... -- ARGS...
 }
 
 # The sky (1, 1, 1) over an unoccluded up-facing quad gives E = pi everywhere.
-expect_ok quad.obj --size 16 --resolution 16 --bounces 1 --out res
+expect_ok quad.obj --lightmap-uv 0 --size 16 --resolution 16 --bounces 1 --out res
 for f in res/quad_irradiance.exr res/quad_mask.exr res/quad_irradiance.png; do
   [ -s "$f" ] || { echo "FAIL: $f not written"; fails=$((fails + 1)); }
 done
 grep -q "256 sampled" ok.log || { echo "FAIL: expected 256 sampled texels:"; cat ok.log; fails=$((fails + 1)); }
 "$bake" --help | grep -q "usage: hemilight_bake" || { echo "FAIL: --help"; fails=$((fails + 1)); }
 
-expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --directional both --out dir
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --directional both --out dir
 for f in dir/quad_sh_l1_0.exr dir/quad_sh_l1_3.exr dir/quad_hl2_0.exr dir/quad_hl2_2.exr; do
   [ -s "$f" ] || { echo "FAIL: $f not written"; fails=$((fails + 1)); }
 done
-expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --directional hl2 --out hl2only
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --directional hl2 --out hl2only
 [ -e hl2only/quad_sh_l1_0.exr ] && { echo "FAIL: --directional hl2 wrote SH maps"; fails=$((fails + 1)); }
 [ -s hl2only/quad_hl2_1.exr ] || { echo "FAIL: --directional hl2 wrote no HL2 maps"; fails=$((fails + 1)); }
 
 # Lights: --sun and --point add lights, --shadow-mask writes their visibility.
-expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --sun 0.3,-1,0.2,5 --point 0.5,1,0.5,2,0.05 --shadow-mask --out lit
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --sun 0.3,-1,0.2,5 --point 0.5,1,0.5,2,0.05 --shadow-mask --out lit
 grep -q "2 lights: direct light" ok.log || { echo "FAIL: expected 2 lights:"; cat ok.log; fails=$((fails + 1)); }
 [ -s lit/quad_shadow_mask.exr ] || { echo "FAIL: lit/quad_shadow_mask.exr not written"; fails=$((fails + 1)); }
 
@@ -66,8 +66,8 @@ grep -q "2 lights: direct light" ok.log || { echo "FAIL: expected 2 lights:"; ca
 # under the uniform sky (radiance 1): c_0 lies between Y00 (4 pi - Omega) (a black floor) and
 # Y00 4 pi (a white one), Omega = 4 asin(1/2) = 2 pi / 3 the floor's solid angle from there.
 printf '# x y z\n0.5 0.5 0.5\n\n0.2 1 0.8\n' > probes.txt
-expect_ok quad.obj --size 8 --resolution 16 --bounces 2 --probes probes.txt --out probes
-expect_ok quad.obj --size 8 --resolution 16 --bounces 1 --probes 2x1x3 --out grid
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 2 --probes probes.txt --out probes
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --probes 2x1x3 --out grid
 python3 - <<'PY' || fails=$((fails + 1))
 import json, math
 d = json.load(open('probes/quad_probes.json'))
@@ -82,11 +82,11 @@ g = json.load(open('grid/quad_probes.json'))
 assert g['grid'] == [2, 1, 3] and len(g['probes']) == 6 and g['bounds']['max'] == [1, 0, 1], g['grid']
 assert all(abs(a - b) < 1e-6 for a, b in zip(g['probes'][1]['position'], [0.75, 0, 1 / 6])), g['probes'][1]['position']
 PY
-expect_fail "--probes 0x1x1" "grid at most" -- quad.obj --probes 0x1x1
-expect_fail "--probes nofile.txt" "cannot be read" -- quad.obj --probes nofile.txt
+expect_fail "--probes 0x1x1" "grid at most" -- quad.obj --lightmap-uv 0 --probes 0x1x1
+expect_fail "--probes nofile.txt" "cannot be read" -- quad.obj --lightmap-uv 0 --probes nofile.txt
 printf '0.5 0.5\n' > short.txt
-expect_fail "short.txt: line 1" -- quad.obj --probes short.txt
-expect_fail "--indirect-only" -- quad.obj --probes 1x1x1 --indirect-only
+expect_fail "short.txt: line 1" -- quad.obj --lightmap-uv 0 --probes short.txt
+expect_fail "--indirect-only" -- quad.obj --lightmap-uv 0 --probes 1x1x1 --indirect-only
 
 # A glTF 2.0 quad (the same floor) with a KHR_lights_punctual point light on a node at
 # (0.5, 1, 0.5): the model's own light is baked.
@@ -109,27 +109,46 @@ gltf = {
 }
 open('lamp.gltf', 'w').write(json.dumps(gltf))
 PY
-expect_ok lamp.gltf --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --out gltf
+expect_ok lamp.gltf --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --out gltf
 grep -q "1 light from the model" ok.log || { echo "FAIL: the glTF's light was not read:"; cat ok.log; fails=$((fails + 1)); }
 
-expect_fail "--sun 1,2" "DX,DY,DZ,E" -- quad.obj --sun 1,2
-expect_fail "--point 0,0,0,x" "X,Y,Z,I" -- quad.obj --point 0,0,0,x
-expect_fail "lights\[0\].direction is zero" -- quad.obj --sun 0,0,0,1
+expect_fail "--sun 1,2" "DX,DY,DZ,E" -- quad.obj --lightmap-uv 0 --sun 1,2
+expect_fail "--point 0,0,0,x" "X,Y,Z,I" -- quad.obj --lightmap-uv 0 --point 0,0,0,x
+expect_fail "lights\[0\].direction is zero" -- quad.obj --lightmap-uv 0 --sun 0,0,0,1
 expect_fail "missing.obj" "no such file" -- missing.obj
-expect_fail "--directional sideways" "sh, hl2 or both" -- quad.obj --directional sideways
-expect_fail "nosky.exr" "no such file" -- quad.obj --environment nosky.exr
+expect_fail "--directional sideways" "sh, hl2 or both" -- quad.obj --lightmap-uv 0 --directional sideways
+expect_fail "nosky.exr" "no such file" -- quad.obj --lightmap-uv 0 --environment nosky.exr
 printf 'not an exr' > bad.exr
-expect_fail "bad.exr" -- quad.obj --environment bad.exr
-expect_fail "no texture coordinates" -- nouv.obj
-expect_fail "outside \[0, 1\]" -- outside.obj
-expect_fail "zero area in lightmap UV space" -- flat.obj
-expect_fail "--size 0" -- quad.obj --size 0
-expect_fail "--size 1000000" -- quad.obj --size 1000000
-expect_fail "--resolution 7" -- quad.obj --resolution 7
-expect_fail "--bounces 0" -- quad.obj --bounces 0
-expect_fail "--error 2" -- quad.obj --error 2
-expect_fail "unknown option --frobnicate" -- quad.obj --frobnicate
-expect_fail "--size needs a value" -- quad.obj --size
+expect_fail "bad.exr" -- quad.obj --lightmap-uv 0 --environment bad.exr
+expect_fail "no lightmap UVs (UV channel 0)" "mesh 0" -- nouv.obj --lightmap-uv 0
+expect_fail "outside \[0, 1\]" -- outside.obj --lightmap-uv 0
+expect_fail "zero area in lightmap UV space" -- flat.obj --lightmap-uv 0
+# Previews: --preview renders the baked model (default camera, or eye,target,fov); a bad camera
+# is a usage error.
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --preview --out pv
+[ -s pv/quad_preview.png ] || { echo "FAIL: pv/quad_preview.png not written"; fails=$((fails + 1)); }
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --preview 0.5,2,0.5,0.5,0,0.5,50 --out pv2
+grep -q "preview from (0.5, 2, 0.5) towards (0.5, 0, 0.5), 50 degrees" ok.log || { echo "FAIL: camera not used:"; cat ok.log; fails=$((fails + 1)); }
+[ -e pv2/quad_irradiance.png ] && [ -s pv2/quad_preview.png ] || { echo "FAIL: pv2 outputs"; fails=$((fails + 1)); }
+expect_fail "--preview 1,1,1,1,1,1" "EX,EY,EZ,TX,TY,TZ" -- quad.obj --lightmap-uv 0 --preview 1,1,1,1,1,1
+expect_fail "--preview 0,1,0,0,0,0,150" -- quad.obj --lightmap-uv 0 --preview 0,1,0,0,0,0,150
+# Lightmap UVs come from UV channel 1 by default: an OBJ has only channel 0, named with its mesh.
+expect_fail "no lightmap UVs (UV channel 1)" "mesh 0" "--lightmap-uv 0" -- quad.obj
+# A texture that cannot be read is an error naming the material and the file.
+printf 'newmtl wood\nKd 1 1 1\nmap_Kd missing_wood.png\n' > wood.mtl
+{ echo 'mtllib wood.mtl'; echo 'usemtl wood'; cat quad.obj; } > wood.obj
+expect_fail "material" "wood" "missing_wood.png" "cannot be read" -- wood.obj --lightmap-uv 0
+# A model without triangles.
+printf 'v 0 0 0\nv 1 0 0\nl 1 2\n' > lines.obj
+expect_fail "lines.obj" -- lines.obj --lightmap-uv 0
+expect_fail "--lightmap-uv 9" -- quad.obj --lightmap-uv 9
+expect_fail "--size 0" -- quad.obj --lightmap-uv 0 --size 0
+expect_fail "--size 1000000" -- quad.obj --lightmap-uv 0 --size 1000000
+expect_fail "--resolution 7" -- quad.obj --lightmap-uv 0 --resolution 7
+expect_fail "--bounces 0" -- quad.obj --lightmap-uv 0 --bounces 0
+expect_fail "--error 2" -- quad.obj --lightmap-uv 0 --error 2
+expect_fail "unknown option --frobnicate" -- quad.obj --lightmap-uv 0 --frobnicate
+expect_fail "--size needs a value" -- quad.obj --lightmap-uv 0 --size
 
 [ $fails -eq 0 ] && echo "all bake CLI checks passed"
 exit $fails

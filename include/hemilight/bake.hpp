@@ -81,9 +81,11 @@
 
 namespace hemilight {
 
-/// Largest lightmap width or height bake_lightmap accepts. Peak memory is about 210 bytes per
-/// sampled texel (measured at 2048^2 and 4096^2 with every texel sampled, one bounce: 0.9 and
-/// 3.5 GiB; docs/bake.md, "Scaling"), so 8192^2 needs about 14 GiB; larger maps are refused with
+/// Largest lightmap width or height bake_lightmap accepts. The per-sample state is kept for
+/// covered texels only: peak memory is about 32 bytes per texel (the result's images and masks)
+/// plus, per sampled texel, about 124 bytes on a flat quad at N = 8 and up to about 210 bytes on
+/// a heightfield at N = 64 with more cache records (docs/bake.md, "Scaling" and "Memory"), so a
+/// fully sampled 8192^2 needs up to about 14 GiB; larger maps are refused with
 /// error(invalid_argument).
 inline constexpr int max_lightmap_size = 8192;
 
@@ -208,6 +210,98 @@ struct bake_input {
 /// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): about
 /// hemicubes x (20-100 us at N = 64) / threads.
 bake_result bake_lightmap(const bake_input& input, const bake_options& options);
+
+// ---- scenes: many meshes, several lightmap pages ---------------------------------------------
+
+/// One lightmap page of a scene bake (bake_scene): its size and optional per-texel materials.
+struct lightmap_page {
+  int width = 256, height = 256;  ///< texels, each in [1, max_lightmap_size]
+  /// Optional per-texel albedo: width x height, 3 channels, each value in
+  /// [0, 1], indexed like the page's texels. Used for the bounces instead of the owner triangle's
+  /// albedo. Empty (width 0): the triangles' albedo.
+  image albedo;
+  /// Optional per-texel emitted radiance: width x height, 3 channels, each value in
+  /// [0, max_radiance]. Used instead of the owner triangle's emission, from the first pass on
+  /// (which then renders through a radiance texture, bilinear like the bounces: sharp emission
+  /// edges inside a texel are blurred over one texel). Empty: the triangles' emission.
+  image emission;
+};
+
+/// One mesh of a scene bake: a range of the scene's triangles and where its lightmap UVs go.
+///
+/// UV convention (Unity's lightmapScaleOffset): the mesh's lightmap UV (scene_desc::lightmap_uvs)
+/// maps to page UV  uv' = uv * uv_scale + uv_offset  (componentwise, in float), and uv' is read
+/// with bake.hpp's texel convention in the page: texel (x, y) of a W x H page has its centre at
+/// ((x + 0.5) / W, (y + 0.5) / H). Every uv' must lie in [0, 1]. Unity's lightmapScaleOffset
+/// (x, y, z, w) is uv_scale = (x, y), uv_offset = (z, w); upload the page's rows in memory order
+/// (row 0 first, as for bake_lightmap) and the engine's uv' addresses the texel baked for it.
+struct bake_mesh {
+  std::size_t first_triangle = 0;  ///< its triangles: [first_triangle, first_triangle + triangle_count)
+  std::size_t triangle_count = 0;
+  /// Index of its page in scene_bake_input::pages, or -1: an occluder only. An occluder blocks
+  /// hemicubes and shadow rays and gets no texels; hemicubes see it with the radiance given by
+  /// scene_bake_input::occluders.
+  int page = -1;
+  glm::vec2 uv_scale{1.0f};   ///< finite
+  glm::vec2 uv_offset{0.0f};  ///< finite
+};
+
+/// What occluder-only meshes send to the hemicubes.
+enum class occluder_radiance {
+  /// Their emission alone: they reflect nothing (black to the bounces). The default: it never
+  /// adds light that is not there; an occluder near baked surfaces darkens them by what it would
+  /// have reflected (docs/bake.md, "Pages and occluders", measures it).
+  emission,
+  /// Their emission plus albedo x the previous pass's mean irradiance over all sampled texels
+  /// / pi: a coarse estimate of what they reflect (one value per material for the whole scene).
+  emission_plus_mean_bounce,
+};
+
+/// A scene for bake_scene: the geometry (all meshes' triangles in one scene_desc, with per-vertex
+/// lightmap UVs that may lie outside [0, 1] before the meshes' scale and offset), its pages and
+/// its meshes.
+struct scene_bake_input {
+  bake_input geometry;              ///< positions, indices, materials, lightmap UVs, sky, normals
+  std::vector<lightmap_page> pages; ///< at least one
+  /// Meshes in triangle order: meshes[0] starts at triangle 0, each starts where the previous one
+  /// ends, the last ends at the scene's triangle count. A vertex used by several meshes is
+  /// duplicated internally (each mesh maps it with its own scale and offset).
+  std::vector<bake_mesh> meshes;
+  occluder_radiance occluders = occluder_radiance::emission;
+};
+
+/// What bake_scene returns: one bake_result per page (its irradiance, coverage, valid, sampled,
+/// directional maps and shadow mask at the page's size; its stats hold the page's texel counts:
+/// texels, covered, sampled, invalid, overlapping, dilated; the rest 0) and the whole bake's
+/// statistics.
+struct scene_bake_result {
+  std::vector<bake_result> pages;
+  bake_stats stats;
+};
+
+/// Bakes every page of a scene in one bake: all pages' samples go through the same passes, so
+/// light bounces between meshes of different pages (each pass's radiance texture holds all
+/// pages), and occluder-only meshes shadow them. Per page the result is what bake_lightmap would
+/// give for the page's meshes with the other pages' meshes present (to within float rounding of
+/// the radiance lookups and the near plane, which scales with the scene's size): the samples of
+/// a page are computed in its own texel grid, dilation (options.dilation, invalid samples) stays
+/// inside each page, and charts of different pages never bleed into each other, neither in the
+/// outputs nor in the radiance textures (each page's border behaves as clamp-to-edge).
+/// options.width and height are ignored (the pages give the sizes); everything else as
+/// bake_lightmap.
+///
+/// Errors (hemilight::error(invalid_argument) naming the problem in the caller's terms; nothing
+/// returned): no pages; a page size out of range ("bake_scene: pages[1]: size 0 x 64 ...");
+/// an albedo or emission image of the wrong size or channel count, or a value out of range
+/// ("pages[0].albedo (3, 7) = 1.5 is outside [0, 1]"); meshes not covering the triangles in order;
+/// a page index out of range ("meshes[2].page = 5 is not -1 or a page index (3 pages)"); a
+/// non-finite scale or offset; a UV mapped outside the page ("meshes[2] (page 1):
+/// lightmap_uvs[17] * uv_scale + uv_offset = (1.25, 0.5) is outside [0, 1]"); a triangle with
+/// 3D area but no area in its page ("meshes[2] triangle 4 (scene triangle 40) ..."); bad
+/// geometry as bake_lightmap reports it (except that raw UVs may lie outside [0, 1]); no texel
+/// sampled in any page; bad options as bake_lightmap. cancelled: the progress callback.
+/// Cost: as bake_lightmap over the sum of the pages' texels, plus copies of the vertices.
+scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& options);
 
 /// The samples of a lightmap (step 1 of the pipeline, before the offset), per texel, row-major.
 struct lightmap_samples {

@@ -1,0 +1,96 @@
+// model_import.hpp — models for the command-line baker (hemilight_bake): glTF 2.0, FBX, OBJ and
+// whatever else assimp reads, as the meshes, materials, textures and lights of a scene bake
+// (bake.hpp, bake_scene). Part of the examples, not of the library.
+//
+// What is read:
+//   - Every mesh of every node, with the node's world transform (instances included: a mesh that
+//     several nodes use is one `mesh` per node). Normals by the inverse transpose; a mirroring
+//     transform (negative determinant) flips the triangles' winding so that front faces stay front.
+//   - Lightmap UVs from UV channel `lightmap_channel` (1 by default: glTF's TEXCOORD_1). Every mesh
+//     without that channel is named in one error.
+//   - Materials: base colour (glTF baseColorFactor, else the diffuse colour Kd) times its texture
+//     (glTF baseColorTexture, else the diffuse texture map_Kd), emissive colour (emissiveFactor /
+//     Ke) times its texture, two-sided. Textures are decoded by stb_image (Debian's libstb-dev):
+//     files next to the model or embedded (glb, data URIs); 8-bit values are sRGB and converted to
+//     linear. A texture that cannot be read is an error (not a warning: a bake with a wrong
+//     albedo is worse than none).
+//   - Lights (aiLight), transformed by the node of the same name (assimp's convention).
+// Every error is one line naming the file and the mesh, material or texture (std::runtime_error).
+#pragma once
+
+#include "hemilight/bake.hpp"
+#include "hemilight/lights.hpp"
+
+#include <string>
+#include <vector>
+
+namespace hemilight::model_import {
+
+/// A decoded texture: linear RGB, row 0 = the first row of the file (the top of the picture).
+struct texture {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> texels;
+  std::string source;  ///< file path or "embedded texture N"
+
+  /// The texel under uv (assimp's convention: v grows upwards, so row = (1 - v) height), with
+  /// repeat wrapping (glTF's default). Nearest: averaging over a footprint is done by the caller.
+  glm::vec3 lookup(glm::vec2 uv) const noexcept;
+  /// The mean of all texels.
+  glm::vec3 mean() const noexcept;
+};
+
+/// A material as the baker uses it.
+struct material {
+  std::string name;
+  glm::vec3 base_color{0.8f};  ///< factor (linear), multiplied by the texture where there is one
+  glm::vec3 emissive{0.0f};    ///< factor (linear radiance), multiplied by the texture where there is one
+  bool two_sided = false;
+  int base_color_texture = -1, emissive_texture = -1;  ///< index into model::textures, or -1
+  unsigned base_color_uv = 0, emissive_uv = 0;         ///< UV channel of each texture
+
+  /// The per-triangle material: albedo = base colour x texture mean (clamped to [0, 1]),
+  /// emission = emissive x texture mean. What hemicubes see where no per-texel image is used.
+  hemilight::material flat(const std::vector<texture>& textures) const;
+};
+
+/// One instance of one of the file's meshes, in world space.
+struct mesh {
+  std::string name;           ///< "mesh 2 ('Chair') at node 'Chair.001'"
+  unsigned source_mesh = 0;   ///< index of the file's mesh
+  unsigned instance = 0;      ///< 0 for the first node that uses the mesh, 1 for the second, ...
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> lightmap_uvs;
+  std::vector<std::vector<glm::vec2>> uv_channels;  ///< every UV channel the mesh has (for textures)
+  std::vector<std::uint32_t> indices;
+  unsigned material = 0;      ///< index into model::materials
+};
+
+struct model {
+  std::vector<mesh> meshes;
+  std::vector<material> materials;
+  std::vector<texture> textures;
+  std::vector<light> lights;
+  /// Lightmap pages: 1 + the largest instance index (instance k of every mesh goes to page k, so
+  /// that instances, which share their lightmap UVs, never share texels).
+  int pages = 1;
+};
+
+/// Reads a model file. Throws std::runtime_error with one line naming the file and what is wrong:
+/// no such file, assimp's error, no meshes with triangles, meshes without UV channel
+/// lightmap_channel (all of them named), a texture that cannot be read. Cost: assimp's import
+/// plus one pass over the vertices and the textures' texels.
+model import_model(const std::string& path, unsigned lightmap_channel = 1);
+
+/// The per-texel albedo and emission of one lightmap page (width x height, the page's texel
+/// convention: bake.hpp), each texel the area-weighted mean, over the parts of the page's
+/// triangles inside it, of base colour x texture (emissive x texture): the texture is averaged
+/// over the texel's footprint by supersampling it (2..16 points per axis, more where a lightmap
+/// texel covers more texture texels). Albedo clamped to [0, 1]. Texels no triangle covers are 0.
+/// Both images are empty when no material of the page's meshes has a texture (the triangles'
+/// flat values are then exact). Cost: O(covered texels x supersamples).
+struct page_images {
+  image albedo, emission;
+};
+page_images bake_page_materials(const model& m, int page, int width, int height);
+
+}  // namespace hemilight::model_import

@@ -1,0 +1,322 @@
+// Tests of the command-line baker's model importer (examples/model_import.hpp) on a glTF 2.0 file
+// this test writes itself: two meshes (one used by two nodes: an instance), a node transform, a
+// PNG base colour texture (written with stb_image_write) and an emissive factor. Checks the
+// scene that reaches the baker: world-space positions, the lightmap UVs of TEXCOORD_1 in glTF's
+// convention, instances on their own pages, materials and the per-texel albedo averaged over
+// each lightmap texel's footprint, and the errors for a missing texture and missing lightmap UVs.
+#include "model_import.hpp"
+
+#include "test_support.hpp"
+
+#include <catch2/catch.hpp>
+#include <stb_image_write.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace hemilight;
+
+namespace {
+
+std::string base64(const std::vector<unsigned char>& d) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < d.size(); i += 3) {
+    const unsigned v = unsigned(d[i]) << 16 | (i + 1 < d.size() ? unsigned(d[i + 1]) << 8 : 0u) | (i + 2 < d.size() ? d[i + 2] : 0u);
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += i + 1 < d.size() ? t[(v >> 6) & 63] : '=';
+    out += i + 2 < d.size() ? t[v & 63] : '=';
+  }
+  return out;
+}
+
+template <class T>
+void put(std::vector<unsigned char>& buf, std::initializer_list<T> values) {
+  for (T v : values) {
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof v);
+    buf.insert(buf.end(), b, b + sizeof v);
+  }
+}
+
+// The floor: a unit quad at y = 0 facing up; texture UVs cover the texture, lightmap UVs
+// (TEXCOORD_1, glTF's v-down convention) the left half of the page. The wall: a unit quad at
+// z = 0 facing +z, lightmap UVs in the right half, no texture.
+struct written_model {
+  std::string path;
+};
+
+// Writes the model into its own directory under the test scratch directory (tests run in parallel).
+written_model write_model(const std::string& name, bool with_texture_file, bool with_texcoord1) {
+  const std::string dir = std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name;
+  std::filesystem::create_directories(dir);
+  std::filesystem::remove(dir + "/checker.png");
+  // The texture: 8 x 8, left half black, right half white (sRGB 0 and 255: linear 0 and 1).
+  std::vector<unsigned char> png(8 * 8 * 3);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) png[std::size_t(3 * (8 * y + x) + c)] = x < 4 ? 0 : 255;
+  if (with_texture_file) REQUIRE(stbi_write_png((dir + "/checker.png").c_str(), 8, 8, 3, png.data(), 8 * 3) != 0);
+  std::vector<unsigned char> buf;
+  // floor: positions, normals, texcoord0, texcoord1 (4 vertices), indices (6)
+  put<float>(buf, {0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0});  // 0: 48 bytes
+  put<float>(buf, {0, 0, 0, 1, 1, 1, 1, 0});              // 48: texcoord0 (32): u = 2 x lightmap u
+  put<float>(buf, {0, 0, 0, 1, 0.5f, 1, 0.5f, 0});        // 80: texcoord1 (32): u in [0, 0.5]
+  put<std::uint16_t>(buf, {0, 1, 2, 0, 2, 3});            // 112: 12 bytes
+  // wall: positions, texcoord1, indices
+  put<float>(buf, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});  // 124: 48
+  put<float>(buf, {0.5f, 0, 1, 0, 1, 1, 0.5f, 1});        // 172: 32: u in [0.5, 1]
+  put<std::uint16_t>(buf, {0, 1, 2, 0, 2, 3});            // 204: 12
+  const std::string uri = "data:application/octet-stream;base64," + base64(buf);
+  const std::string floor_attrs = with_texcoord1 ? R"({"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2})" : R"({"POSITION": 0, "TEXCOORD_0": 1})";
+  const std::string gltf = R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0, 1, 2]}],
+  "nodes": [
+    {"name": "floor", "mesh": 0, "translation": [10, 0, 0], "scale": [2, 2, 2]},
+    {"name": "wall", "mesh": 1},
+    {"name": "wall_copy", "mesh": 1, "translation": [0, 0, 5]}
+  ],
+  "meshes": [
+    {"name": "Floor", "primitives": [{"attributes": )" + floor_attrs + R"(, "indices": 3, "material": 0}]},
+    {"name": "Wall", "primitives": [{"attributes": {"POSITION": 4, "TEXCOORD_0": 5, "TEXCOORD_1": 5}, "indices": 6, "material": 1}]}
+  ],
+  "materials": [
+    {"name": "Checker", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 1, 1, 1], "baseColorTexture": {"index": 0}}},
+    {"name": "Glow", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.3, 0.4, 1]}, "emissiveFactor": [1, 0.5, 0], "doubleSided": true}
+  ],
+  "textures": [{"source": 0}],
+  "images": [{"uri": "checker.png"}],
+  "buffers": [{"byteLength": )" + std::to_string(buf.size()) + R"(, "uri": ")" + uri + R"("}],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+    {"buffer": 0, "byteOffset": 80, "byteLength": 32}, {"buffer": 0, "byteOffset": 112, "byteLength": 12},
+    {"buffer": 0, "byteOffset": 124, "byteLength": 48}, {"buffer": 0, "byteOffset": 172, "byteLength": 32},
+    {"buffer": 0, "byteOffset": 204, "byteLength": 12}
+  ],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
+    {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+    {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+    {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"},
+    {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 5, "componentType": 5126, "count": 4, "type": "VEC2"},
+    {"bufferView": 6, "componentType": 5123, "count": 6, "type": "SCALAR"}
+  ]
+})";
+  written_model w;
+  w.path = dir + "/two_meshes.gltf";
+  std::ofstream(w.path) << gltf;
+  return w;
+}
+
+}  // namespace
+
+TEST_CASE("Model import: a glTF with two meshes, an instance, a transform and a texture reaches the baker as written", "[model_import]") {
+  const written_model w = write_model("import_gltf", true, true);
+  const model_import::model m = model_import::import_model(w.path);
+  REQUIRE(m.meshes.size() == 3);  // floor, wall, wall_copy
+  REQUIRE(m.pages == 2);          // the wall's second instance on page 1
+  const model_import::mesh* floor = nullptr;
+  std::vector<const model_import::mesh*> walls;
+  for (const model_import::mesh& me : m.meshes) {
+    if (me.name.find("'Floor'") != std::string::npos) floor = &me;
+    if (me.name.find("'Wall'") != std::string::npos) walls.push_back(&me);
+  }
+  REQUIRE(floor);
+  REQUIRE(walls.size() == 2);
+  CHECK(floor->name.find("node 'floor'") != std::string::npos);
+  CHECK(floor->instance == 0);
+  CHECK(walls[0]->instance + walls[1]->instance == 1);  // one on page 0, one on page 1
+  // The node transform: x -> 2 x + 10, z -> 2 z (exact in float).
+  REQUIRE(floor->positions.size() == 4);
+  CHECK(floor->positions[2] == glm::vec3(12.0f, 0.0f, 2.0f));
+  // The copy moved by (0, 0, 5).
+  const model_import::mesh* copy = walls[0]->instance == 1 ? walls[0] : walls[1];
+  CHECK(copy->name.find("node 'wall_copy'") != std::string::npos);
+  CHECK(copy->positions[2] == glm::vec3(1.0f, 1.0f, 5.0f));
+  // Lightmap UVs are TEXCOORD_1 as the file stores them (glTF's v-down convention).
+  REQUIRE(floor->lightmap_uvs.size() == 4);
+  CHECK(floor->lightmap_uvs[1] == glm::vec2(0.0f, 1.0f));
+  CHECK(floor->lightmap_uvs[2] == glm::vec2(0.5f, 1.0f));
+  // Normals follow the transform (a uniform scale: still +y).
+  CHECK(glm::length(glm::normalize(floor->normals[0]) - glm::vec3(0, 1, 0)) < 1e-6f);
+  // Materials: factors, the texture (decoded, sRGB 0 / 255 -> linear 0 / 1), emission, two-sided.
+  REQUIRE(m.textures.size() == 1);
+  CHECK(m.textures[0].width == 8);
+  const model_import::material& checker = m.materials[floor->material];
+  CHECK(checker.name == "Checker");
+  CHECK(checker.base_color == glm::vec3(0.5f, 1.0f, 1.0f));
+  CHECK(checker.base_color_texture == 0);
+  const material flat = checker.flat(m.textures);  // factor x texture mean (half black, half white)
+  CHECK(flat.albedo == glm::vec3(0.25f, 0.5f, 0.5f));
+  const model_import::material& glow = m.materials[walls[0]->material];
+  CHECK(glow.emissive == glm::vec3(1.0f, 0.5f, 0.0f));
+  CHECK(glow.two_sided);
+  CHECK(glow.flat(m.textures).albedo == glm::vec3(0.2f, 0.3f, 0.4f));
+
+  // Per-texel albedo of page 0 (16 x 8): the floor covers columns 0..7 with texture u = 2 x
+  // lightmap u, so texel x sees exactly texture column x: black for x < 4, factor x white for
+  // 4..7; the wall's columns 8..15 get its factor. Exact: every supersample of a texel reads the
+  // same texture texel, and 0 and 1 are exact in sRGB decoding.
+  const model_import::page_images img = model_import::bake_page_materials(m, 0, 16, 8);
+  REQUIRE(img.albedo.width == 16);
+  CHECK(img.emission.width == 0);  // no emissive texture: the triangles' emission is exact
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) {
+      const glm::vec3 a(img.albedo.at(x, y)[0], img.albedo.at(x, y)[1], img.albedo.at(x, y)[2]);
+      const glm::vec3 want = x < 4 ? glm::vec3(0.0f) : x < 8 ? glm::vec3(0.5f, 1.0f, 1.0f) : glm::vec3(0.2f, 0.3f, 0.4f);
+      INFO("texel (" << x << ", " << y << ")");
+      CHECK(glm::length(a - want) < 1e-6f);
+    }
+  // Page 1 holds only the untextured wall copy: no images.
+  CHECK(model_import::bake_page_materials(m, 1, 16, 8).albedo.width == 0);
+}
+
+TEST_CASE("Model import: a missing texture and meshes without lightmap UVs are one-line errors naming them", "[model_import]") {
+  {
+    const written_model w = write_model("import_no_texture", false, true);
+    try {
+      model_import::import_model(w.path);
+      FAIL("no error for the missing texture");
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      INFO(what);
+      CHECK(what.find("material 0 ('Checker')") != std::string::npos);
+      CHECK(what.find("checker.png' cannot be read") != std::string::npos);
+      CHECK(what.find('\n') == std::string::npos);
+    }
+  }
+  {
+    const written_model w = write_model("import_no_uv1", true, false);
+    try {
+      model_import::import_model(w.path);
+      FAIL("no error for the floor without TEXCOORD_1");
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      INFO(what);
+      CHECK(what.find("1 mesh has no lightmap UVs (UV channel 1): mesh 0 ('Floor')") != std::string::npos);
+    }
+  }
+  try {
+    model_import::import_model(std::string(HEMILIGHT_TEST_TMPDIR) + "/no_such_model.gltf");
+    FAIL("no error for a missing file");
+  } catch (const std::runtime_error& e) {
+    CHECK(std::string(e.what()).find("no such file") != std::string::npos);
+  }
+}
+
+// ---- previews (examples/preview.hpp) ---------------------------------------------------------------
+
+#include "preview.hpp"
+
+namespace {
+
+// Two floor quads under a uniform sky (E = pi at every texel, so radiance = albedo exactly), one
+// per page (the second page narrower, placed by scale and offset).
+struct two_floors {
+  scene_mesh mesh;
+  scene_bake_input in;
+  two_floors() {
+    material a, b;
+    a.albedo = glm::vec3(0.5f);
+    b.albedo = glm::vec3(0.25f);
+    mesh.add_quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}, a);
+    mesh.add_quad({1.5f, 0, 0}, {1.5f, 0, 1}, {2.5f, 0, 1}, {2.5f, 0, 0}, b);
+    // Quad 1 fills its page; quad 2's UVs are in [2, 3] x [0, 1], offset by -2 into its page.
+    mesh.lightmap_uvs = {{0, 0}, {0, 1}, {1, 1}, {1, 0}, {2, 0}, {2, 1}, {3, 1}, {3, 0}};
+    in.geometry.scene = mesh.desc();
+    in.geometry.scene.sky_radiance = glm::vec3(1.0f);
+    lightmap_page p0, p1;
+    p0.width = p0.height = 16;
+    p1.width = 8;
+    p1.height = 12;
+    in.pages = {p0, p1};
+    bake_mesh m0, m1;
+    m0.triangle_count = 2;
+    m0.page = 0;
+    m1.first_triangle = 2;
+    m1.triangle_count = 2;
+    m1.page = 1;
+    m1.uv_offset = glm::vec2(-2.0f, 0.0f);
+    in.meshes = {m0, m1};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Preview: every pixel shows lightmap x albedo exactly where the bake is uniform, across pages, or the sky", "[preview]") {
+  const two_floors s;
+  bake_options o;
+  o.resolution = 16;
+  o.bounces = 2;
+  o.thread_count = 2;
+  const scene_bake_result r = bake_scene(s.in, o);
+  const std::vector<image> radiance = preview::page_radiance(s.in, r);
+  preview::camera cam;
+  cam.eye = {1.25f, 2.0f, 0.5f};
+  cam.target = {1.25f, 0.0f, 0.5f};
+  cam.fov_degrees = 80.0f;
+  const image pic = preview::render(s.in, radiance, cam, 64);
+  REQUIRE(pic.width == 64);
+  int a = 0, b = 0, sky = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float v = pic.at(x, y)[0];
+      // Up-facing floors see only the sky: E = pi (float sums of exact hemicube weights, 1e-4
+      // relative), radiance = albedo E / pi. Any bleeding between pages or black at a page's
+      // border would show as another value.
+      if (std::fabs(v - 0.5f) < 1e-4f) ++a;
+      else if (std::fabs(v - 0.25f) < 1e-4f) ++b;
+      else if (v == 1.0f) ++sky;
+      else FAIL_CHECK("pixel (" << x << ", " << y << ") = " << v);
+    }
+  CHECK(a > 300);
+  CHECK(b > 300);
+  CHECK(sky > 300);
+  // Looking straight down (-y) with +z at the top of the picture, +x points left (right =
+  // forward x up = -x): the first floor (x < 1) is on the right.
+  CHECK(std::fabs(pic.at(44, 32)[0] - 0.5f) < 1e-4f);
+  CHECK(std::fabs(pic.at(20, 32)[0] - 0.25f) < 1e-4f);
+}
+
+TEST_CASE("Preview: the default camera sees a closed room from inside and cameras are checked", "[preview]") {
+  scene_mesh room;
+  material grey;
+  grey.albedo = glm::vec3(0.5f);
+  room.add_box({0, 0, 0}, {4, 3, 5}, grey, true);
+  generate_lightmap_uvs(room, 32, 2);
+  scene_bake_input in;
+  in.geometry.scene = room.desc();
+  lightmap_page page;
+  page.width = page.height = 32;
+  in.pages = {page};
+  bake_mesh all;
+  all.triangle_count = room.triangle_count();
+  all.page = 0;
+  in.meshes = {all};
+  const std::vector<image> radiance(1, image::make(32, 32, 3, 1.0f));
+  const preview::camera cam = preview::default_camera(in, radiance);
+  // Inside the room's bounds (from outside every wall shows its back).
+  for (int c = 0; c < 3; ++c) {
+    CHECK(cam.eye[c] > 0.0f);
+    CHECK(cam.eye[c] < (c == 0 ? 4.0f : c == 1 ? 3.0f : 5.0f));
+  }
+  preview::camera parsed;
+  CHECK(preview::parse_camera("1,2,3,4,5,6", parsed));
+  CHECK(parsed.fov_degrees == 60.0f);
+  CHECK(preview::parse_camera("1,2,3,4,5,6,45", parsed));
+  CHECK(parsed.fov_degrees == 45.0f);
+  CHECK_FALSE(preview::parse_camera("1,2,3,1,2,3", parsed));     // eye at the target
+  CHECK_FALSE(preview::parse_camera("1,2,3,4,5,6,120", parsed)); // wider than a hemicube face
+  CHECK_FALSE(preview::parse_camera("1,2,3,4,5", parsed));
+  CHECK_FALSE(preview::parse_camera("model.gltf", parsed));
+  test::require_error([&] { preview::render(in, radiance, cam, 8); }, status::invalid_argument, "size 8 is not in [16, 4096]");
+}
