@@ -1,6 +1,6 @@
 // Lights (lights.hpp) in bakes: cost, penumbra accuracy and the cache on the indirect part.
 //   usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K]
-//                       [--cornell-sizes 128,256,512] [--reference-cache DIR]
+//                       [--cornell-sizes 128,256,512] [--cornell-resolutions 64,256] [--reference-cache DIR]
 // Writes OUT_PREFIX_direct.csv, OUT_PREFIX_penumbra.csv and OUT_PREFIX_cornell.csv (a trailing
 // "_sweep.csv" or ".csv" is dropped from OUT_PREFIX: `bash benchmarks/run.sh lights` passes
 // docs/bench/lights_sweep.csv and gets docs/bench/lights_*.csv, drawn by plot_lights.py).
@@ -283,7 +283,8 @@ void write_reference(const std::string& file, const bake_result& ref) {
   std::fclose(f);
 }
 
-void cornell(const std::string& path, const std::vector<int>& sizes, const std::string& reference_cache) {
+void cornell(const std::string& path, const std::vector<int>& sizes, const std::vector<int>& resolutions,
+             const std::string& reference_cache) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
     std::fprintf(stderr, "cannot write %s\n", path.c_str());
@@ -318,7 +319,7 @@ void cornell(const std::string& path, const std::vector<int>& sizes, const std::
                   ref.stats.seconds, from_cache ? " (kept in the reference cache)" : "");
       std::fflush(stdout);
       o.use_cache = true;
-      for (const int n : {64, 256})
+      for (const int n : resolutions)
         for (const float a : {0.1f, 0.2f, 0.35f, 0.5f, 0.7f, 1.0f}) {
           o.resolution = n;
           o.cache.error_threshold = a;
@@ -339,7 +340,7 @@ void cornell(const std::string& path, const std::vector<int>& sizes, const std::
 
 int main(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K] [--cornell-sizes 128,256,512] [--reference-cache DIR]\n");
+    std::fprintf(stderr, "usage: sweep_lights OUT_PREFIX [--runs R] [--only direct,penumbra,cornell] [--penumbra-samples K] [--cornell-sizes 128,256,512] [--cornell-resolutions 64,256] [--reference-cache DIR]\n");
     return 2;
   }
   // run.sh passes docs/bench/lights_sweep.csv: the prefix is then docs/bench/lights.
@@ -352,7 +353,7 @@ int main(int argc, char** argv) {
   int runs = 3;
   std::string only = "direct,penumbra,cornell";
   direct_options tested;  // the defaults unless --penumbra-samples
-  std::vector<int> cornell_sizes = {128, 256, 512};
+  std::vector<int> cornell_sizes = {128, 256, 512}, cornell_resolutions = {64, 256};
   std::string reference_cache;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
@@ -360,10 +361,11 @@ int main(int argc, char** argv) {
     else if (a == "--only") only = argv[i + 1];
     else if (a == "--reference-cache") reference_cache = argv[i + 1];
     else if (a == "--penumbra-samples") tested.penumbra_samples = std::atoi(argv[i + 1]);
-    else if (a == "--cornell-sizes") {
-      cornell_sizes.clear();
-      std::stringstream list(argv[i + 1]);
-      for (std::string item; std::getline(list, item, ',');) cornell_sizes.push_back(std::max(16, std::atoi(item.c_str())));
+    else if (a == "--cornell-sizes" || a == "--cornell-resolutions") {
+      std::vector<int>& list = a == "--cornell-sizes" ? cornell_sizes : cornell_resolutions;
+      list.clear();
+      std::stringstream items(argv[i + 1]);
+      for (std::string item; std::getline(items, item, ',');) list.push_back(std::max(a == "--cornell-sizes" ? 16 : 2, std::atoi(item.c_str())));
     }
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
@@ -374,7 +376,7 @@ int main(int argc, char** argv) {
   std::printf("load average before: %s\n", load_average().c_str());
   if (wants("direct")) direct_target(prefix + "_direct.csv", runs);
   if (wants("penumbra")) penumbra(prefix + "_penumbra.csv", tested);
-  if (wants("cornell")) cornell(prefix + "_cornell.csv", cornell_sizes, reference_cache);
+  if (wants("cornell")) cornell(prefix + "_cornell.csv", cornell_sizes, cornell_resolutions, reference_cache);
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
 }
