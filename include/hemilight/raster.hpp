@@ -56,7 +56,7 @@
 //     up in vector registers (its three vertices and its normal moved to the local frame in one
 //     register per axis, the face tests, clip codes and the double-precision projection of the
 //     three vertices at once, the edge functions of small triangles in 32-bit lanes) with the
-//     same float and integer operations as the scalar path; triangles up to 64
+//     same float and integer operations as the scalar path; triangles up to 120
 //     texels across are scanned over their box eight texels at a time with 32-bit edge values,
 //     the coverage mask going straight into the depth test; longer spans are depth-tested eight
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
@@ -129,6 +129,16 @@ struct raster_options {
   /// Shared and immutable; build it with cubemap::from_image (which checks every value); the
   /// constructor throws error(invalid_argument) for an empty or inconsistent map.
   std::shared_ptr<const cubemap> sky = nullptr;
+  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that an edge of a
+  /// triangle crosses gets the exact area of the (projected, clipped) triangle within the texel
+  /// as a fraction of the texel, not the all-or-nothing sample at its centre; the triangles
+  /// sharing a texel are resolved front to back (each takes the smaller of its coverage and what
+  /// is left; the sky, or the triangle that covers the whole texel behind them, the rest), and
+  /// the texel's radiance is the blend. Texels inside a triangle are as without it. distance,
+  /// flags and seen_triangle() keep their meaning (what the texel centre sees: bit-identical to
+  /// a render without the option). Deterministic bit for bit, the same on every SIMD path.
+  /// Cost: about 1.3-2x a render without it (docs/bench/edge_cost.csv). Off by default.
+  bool edge_coverage = false;
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
@@ -242,7 +252,8 @@ class alignas(64) hemicube_rasterizer {
   struct face_setup;  // per (triangle, face) pair: the depth plane (raster.cpp)
   template <mode M>
   void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
-                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri);
+                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
+                  const double* exact = nullptr);
   struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
@@ -250,6 +261,31 @@ class alignas(64) hemicube_rasterizer {
   template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
+
+  // Exact edge coverage (raster_options::edge_coverage; raster.cpp, "Exact edge coverage").
+  struct edge_fragment {
+    std::uint32_t texel;  // hemicube texel index
+    float z;              // the triangle's 1/w at the texel centre (the depth test's value)
+    float coverage;       // exact area of the triangle within the texel / the texel's area, (0, 1)
+    std::uint32_t id;     // the draw's texel id (as in ids_)
+    std::uint32_t next;   // next fragment of the same texel (no_triangle = none)
+    bool centre;          // the triangle covers the texel centre (the point-sampled test)
+  };
+  void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
+                   const face_setup& fs, std::uint32_t draw);
+  void edge_resolve_centres();
+  void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
+  glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
+  bool edge_ = false;
+  std::vector<edge_fragment> fragments_;
+  std::vector<std::uint32_t> fragment_head_;    // per texel: first fragment (no_triangle = none)
+  std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
+  struct edge_group {
+    std::uint32_t texel;
+    float full_z;             // the nearest triangle covering the whole texel: 1/w (0 = none)
+    std::uint32_t full_id;    // and its id
+  };
+  std::vector<edge_group> edge_groups_;
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
