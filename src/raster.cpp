@@ -1156,9 +1156,10 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   // the coverage paths below then depth-test the texels it covers whole (see `bias`).
   const bool edge = M == mode::depth && edge_;
   if (edge) {
-    // Texels the box overlaps (not only those whose centre it holds), clamped to the face.
-    if (std::max<std::int64_t>(floor_sub(min_x), 0) > std::min<std::int64_t>(ceil_sub(max_x) - 1, n - 1) ||
-        std::max<std::int64_t>(floor_sub(min_y), 0) > std::min<std::int64_t>(ceil_sub(max_y) - 1, rows - 1))
+    // Texels the box overlaps (not only those whose centre it holds; grown by the snapping for
+    // the unsnapped triangle), clamped to the face.
+    if (std::max<std::int64_t>(floor_sub(min_x - 1), 0) > std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1) ||
+        std::max<std::int64_t>(floor_sub(min_y - 1), 0) > std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1))
       return;
     if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
     fs.prepare(face, texel_step_, first_centre_, rec);
@@ -1483,40 +1484,42 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
   }
   const std::int64_t min_y = std::min({py[0], py[1], py[2]}), max_y = std::max({py[0], py[1], py[2]});
   const std::int64_t min_x = std::min({px[0], px[1], px[2]}), max_x = std::max({px[0], px[1], px[2]});
-  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x), 0);
-  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x) - 1, n - 1);
-  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y), 0);
-  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y) - 1, rows - 1);
+  // Texels the box overlaps, grown by the snapping (half a unit) for the unsnapped triangle.
+  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
+  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
+  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
+  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
 
   // 0: no area in common, 1: partial (a fragment is added), 2: the whole texel.
   const auto classify = [&](std::int64_t c, std::int64_t r) -> int {
     const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
+    // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
+    // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
+    // snapped edges (exact integers) decide which texels the coverage paths draw whole and
+    // which centres are covered (as without the option). The two differ by less than 1/512
+    // texel. Two triangles sharing an edge clip it from the same unsnapped endpoints, so
+    // between them they miss no part of a texel.
     double f0[3], gx[3], gy[3];
-    unsigned clip = 0;
-    std::int64_t centre[3];
-    for (int k = 0; k < 3; ++k) {
-      // E_k at the texel's (x0, y0) corner and its steps across the texel.
-      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
-      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
-      const std::int64_t lo = e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0);
-      const std::int64_t hi = e + std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0);
-      if (hi <= 0) return 0;
-      if (lo < 0) clip |= 1u << k;
-      centre[k] = e + (sx + sy) / 2 - tie[k];  // exact: sx, sy are multiples of 256
-    }
-    if (!clip) return 2;
-    // A partial texel: its covered part is measured against the unsnapped edges (the snapped ones
-    // decide only which texels are whole or partial; the difference is below 1/512 texel), so
-    // slivers a fraction of a texel wide keep their width. Two triangles sharing an edge clip
-    // it from the same unsnapped endpoints.
+    bool outside = false;
     for (int k = 0; k < 3; ++k) {
       const int b = k == 2 ? 0 : k + 1;
       const double edx = exact[b] - exact[k], edy = exact[3 + b] - exact[3 + k];
       f0[k] = edx * (static_cast<double>(y0) - exact[3 + k]) - edy * (static_cast<double>(x0) - exact[k]);
       gx[k] = -edy * static_cast<double>(sub_one);
       gy[k] = edx * static_cast<double>(sub_one);
+      outside = outside || f0[k] + std::max(gx[k], 0.0) + std::max(gy[k], 0.0) <= 0.0;
     }
-    clip = 7u;
+    // The snapped edge functions at the texel's (x0, y0) corner and their steps across it.
+    bool whole = true, centre = true;
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
+      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
+      whole = whole && e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0) >= 0;
+      centre = centre && e + (sx + sy) / 2 - tie[k] >= 0;  // exact: sx, sy are multiples of 256
+    }
+    if (whole) return 2;
+    if (outside && !centre) return 0;
+    const unsigned clip = 7u;
     // The integrator weights a texel by the projected solid angle over it; within the texel its
     // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
     // centre's, in texel units): the covered fraction of the texel's weight, to second order.
@@ -1526,8 +1529,9 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     const double q = 1.0 + u * u + v * v;
     const double wx = -4.0 * u / q * texel_step_;
     const double wy = (face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_;
-    const double area = square_part_inside(f0, gx, gy, clip, wx, wy);
-    if (!(area > 0.0)) return 0;
+    const double area = outside ? 0.0 : square_part_inside(f0, gx, gy, clip, wx, wy);
+    // (A covered centre always makes a fragment, for the centre's resolve, even of no area.)
+    if (!(area > 0.0) && !centre) return 0;
     edge_fragment fr;
     fr.texel = static_cast<std::uint32_t>(face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n) +
                                           static_cast<std::size_t>(c));
@@ -1535,9 +1539,9 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     const float z = zrow + fs.dzdx * static_cast<float>(c);
     fr.z = z > FLT_MIN ? z : FLT_MIN;
-    fr.coverage = static_cast<float>(std::min(area, 1.0));
+    fr.coverage = static_cast<float>(std::min(std::max(area, 0.0), 1.0));
     fr.id = draw;
-    fr.centre = centre[0] >= 0 && centre[1] >= 0 && centre[2] >= 0;
+    fr.centre = centre;
     std::uint32_t& head = fragment_head_[fr.texel];
     if (head == no_triangle) fragment_texels_.push_back(fr.texel);
     fr.next = head;
