@@ -1490,8 +1490,21 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
   const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
   const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
 
+  // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
+  // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
+  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
+  for (int k = 0; k < 3; ++k) {
+    const int b = k == 2 ? 0 : k + 1;
+    edx[k] = exact[b] - exact[k];
+    edy[k] = exact[3 + b] - exact[3 + k];
+    gx[k] = -edy[k] * static_cast<double>(sub_one);
+    gy[k] = edx[k] * static_cast<double>(sub_one);
+    gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
+    gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
+  }
   // 0: no area in common, 1: partial (a fragment is added), 2: the whole texel.
   const auto classify = [&](std::int64_t c, std::int64_t r) -> int {
+    ++stats_.edge_texels_tested;
     const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
@@ -1499,15 +1512,13 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     // which centres are covered (as without the option). The two differ by less than 1/512
     // texel. Two triangles sharing an edge clip it from the same unsnapped endpoints, so
     // between them they miss no part of a texel.
-    double f0[3], gx[3], gy[3];
+    double f0[3];
     bool outside = false;
+    unsigned clip = 0;  // the unsnapped edges that cut the texel
     for (int k = 0; k < 3; ++k) {
-      const int b = k == 2 ? 0 : k + 1;
-      const double edx = exact[b] - exact[k], edy = exact[3 + b] - exact[3 + k];
-      f0[k] = edx * (static_cast<double>(y0) - exact[3 + k]) - edy * (static_cast<double>(x0) - exact[k]);
-      gx[k] = -edy * static_cast<double>(sub_one);
-      gy[k] = edx * static_cast<double>(sub_one);
-      outside = outside || f0[k] + std::max(gx[k], 0.0) + std::max(gy[k], 0.0) <= 0.0;
+      f0[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) - edy[k] * (static_cast<double>(x0) - exact[k]);
+      outside = outside || f0[k] + gx_hi[k] <= 0.0;
+      if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
     }
     // The snapped edge functions at the texel's (x0, y0) corner and their steps across it.
     bool whole = true, centre = true;
@@ -1519,7 +1530,7 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     }
     if (whole) return 2;
     if (outside && !centre) return 0;
-    const unsigned clip = 7u;
+
     // The integrator weights a texel by the projected solid angle over it; within the texel its
     // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
     // centre's, in texel units): the covered fraction of the texel's weight, to second order.
@@ -1547,6 +1558,7 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     fr.next = head;
     head = static_cast<std::uint32_t>(fragments_.size());
     fragments_.push_back(fr);
+    ++stats_.edge_fragments;
     return 1;
   };
 

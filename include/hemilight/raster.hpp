@@ -154,6 +154,8 @@ struct raster_statistics {
   std::size_t spans = 0;               ///< row spans written by the span paths (not by the SIMD
                                        ///< small-triangle paths, which have no spans)
   std::size_t fragments = 0;           ///< texels depth-tested (or counted) by the span paths
+  std::size_t edge_texels_tested = 0;  ///< edge coverage: texels classified by the partial-texel pass
+  std::size_t edge_fragments = 0;      ///< edge coverage: partial (triangle, texel) fragments kept
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
