@@ -1604,7 +1604,7 @@ void hemicube_rasterizer::edge_resolve_centres() {
   for (const std::uint32_t t : fragment_texels_) {
     const float full_z = depth_[t];
     const std::uint32_t full_id = full_z > 0.0f ? ids_[t] : 0u;
-    edge_groups_.push_back({t, full_z, full_id});
+    edge_groups_.push_back({t, full_z, full_id, 0.0f});
     float best_z = full_z;
     std::uint32_t best_id = full_id;
     for (std::uint32_t f = fragment_head_[t]; f != no_triangle; f = fragments_[f].next) {
@@ -1617,6 +1617,7 @@ void hemicube_rasterizer::edge_resolve_centres() {
     }
     depth_[t] = best_z;
     ids_[t] = best_id;
+    edge_groups_.back().centre_z = best_z;
   }
 }
 
@@ -1672,15 +1673,23 @@ void hemicube_rasterizer::edge_blend(hemicube_buffer& out, const frame& basis, c
       order[j] = f;
     }
     glm::vec3 sum(0.0f);
-    float left = 1.0f;
+    float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share
     for (const std::uint32_t f : order) {
       const edge_fragment& fr = fragments_[f];
       if (g.full_z > 0.0f && (fr.z < g.full_z || (fr.z == g.full_z && draw_of(fr.id) > draw_of(g.full_id)))) break;
       const float share = std::min(fr.coverage, left);
+      if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
       sum += share * fragment_radiance(fr.id, g.texel, fr.z, texture);
       left -= share;
       if (!(left > 0.0f)) break;
     }
+    // The texel's distance: along the centre's direction to the plane of the nearest triangle
+    // with a share of it (not necessarily the one the centre sees; the flags stay the centre's).
+    // The translation gradient's walls move with the nearer texel's distance: a blended texel
+    // at an occluding edge must carry the occluder's distance, or half the edge's radiance step
+    // would move with the surface behind; and one whose centre sees nothing must not be at +inf
+    // (a wall between two texels at +inf contributes nothing).
+    if (nearest > 0.0f && nearest > g.centre_z) out.distance[g.texel] = lengths_[g.texel] / nearest;
     if (left > 0.0f) {
       glm::vec3 rest;
       if (g.full_z > 0.0f)

@@ -1024,13 +1024,12 @@ TEST_CASE("raster: with exact edge coverage, triangles sharing edges sum to one 
   CHECK(worst <= 4e-6);
 }
 
-TEST_CASE("raster: exact edge coverage keeps the texel centres' distance, flags and triangle, bitwise on every path", "[raster]") {
-  // distance, flags and seen_triangle() are documented as what the texel centre sees: bit for
-  // bit what a render without the option gives. The blended radiance must be the same bits on
+TEST_CASE("raster: exact edge coverage keeps the texel centres' flags and triangle, bitwise on every path", "[raster]") {
+  // flags and seen_triangle() are documented as what the texel centre sees: bit for bit what a
+  // render without the option gives; the distance is the centre's, or nearer where a nearer
+  // triangle covers part of the texel (never farther). The buffers must be the same bits on
   // every SIMD path and in repeated renders (deterministic resolve), and differ from point
-  // sampling only on texels an edge crosses (a texel whose radiance changed has a neighbour, in
-  // its face, that sees another triangle or its centre sees another shade: checked loosely as
-  // "at most a third of the texels changed").
+  // sampling only on texels an edge crosses (checked loosely: at most a third of the texels).
   std::mt19937 rng(37);
   const scene_mesh scenes[] = {cornell_box(), hexagon_room(2), sky_and_occluders(), fan_box(rng, {-1, -1, -1}, {1, 1, 1})};
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
@@ -1054,15 +1053,18 @@ TEST_CASE("raster: exact edge coverage keeps the texel centres' distance, flags 
       ra.render(p, f, n, ba);
       re.render(p, f, n, again);
       INFO("N = " << n);
-      CHECK(std::memcmp(be.distance.data(), bp.distance.data(), be.distance.size() * sizeof(float)) == 0);
       CHECK(be.flags == bp.flags);
-      std::size_t same_triangle = 0, changed = 0;
+      std::size_t same_triangle = 0, changed = 0, nearer = 0, farther = 0;  // nearer: reported only
       for (std::size_t i = 0; i < be.texel_count(); ++i) {
         same_triangle += re.seen_triangle(i) == rp.seen_triangle(i) ? 1u : 0u;
-        changed += be.radiance_at(i) != bp.radiance_at(i) ? 1u : 0u;
+        changed += be.radiance_at(i) != bp.radiance_at(i) || be.distance[i] != bp.distance[i] ? 1u : 0u;
+        nearer += be.distance[i] < bp.distance[i] ? 1u : 0u;
+        farther += !(be.distance[i] <= bp.distance[i]) ? 1u : 0u;  // (NaN counts as farther)
       }
       CHECK(same_triangle == be.texel_count());
       CHECK(changed * 3 <= be.texel_count());
+      CHECK(farther == 0);
+      INFO("texels with a nearer partial triangle: " << nearer);
       for (const hemicube_buffer* other : {&bs, &b2, &ba, &again}) {
         CHECK(std::memcmp(other->radiance.data(), be.radiance.data(), be.radiance.size() * sizeof(float)) == 0);
         CHECK(std::memcmp(other->distance.data(), be.distance.data(), be.distance.size() * sizeof(float)) == 0);

@@ -134,10 +134,13 @@ struct raster_options {
   /// as a fraction of the texel, not the all-or-nothing sample at its centre; the triangles
   /// sharing a texel are resolved front to back (each takes the smaller of its coverage and what
   /// is left; the sky, or the triangle that covers the whole texel behind them, the rest), and
-  /// the texel's radiance is the blend. Texels inside a triangle are as without it. distance,
-  /// flags and seen_triangle() keep their meaning (what the texel centre sees: bit-identical to
-  /// a render without the option). Deterministic bit for bit, the same on every SIMD path.
-  /// Cost: about 1.3-2x a render without it (docs/bench/edge_cost.csv). Off by default.
+  /// the texel's radiance is the blend. Texels inside a triangle are as without it. flags and
+  /// seen_triangle() keep their meaning (what the texel centre sees: bit-identical to a render
+  /// without the option); a blended texel's distance is to the plane of the nearest triangle
+  /// with a share of it (along the centre's direction), which is the centre's distance unless a
+  /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
+  /// path. Cost: 12-33x a render + integration without it at N = 64 (docs/raster.md), so off by
+  /// default.
   bool edge_coverage = false;
 };
 
@@ -286,6 +289,7 @@ class alignas(64) hemicube_rasterizer {
     std::uint32_t texel;
     float full_z;             // the nearest triangle covering the whole texel: 1/w (0 = none)
     std::uint32_t full_id;    // and its id
+    float centre_z;           // 1/w of what the texel centre sees (0 = nothing)
   };
   std::vector<edge_group> edge_groups_;
 
