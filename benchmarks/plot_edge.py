@@ -68,7 +68,7 @@ for j, n in enumerate(cns):
 ax.axhline(1.5, color="k", lw=0.6, ls=":")
 ax.set_xticks([i + 0.4 - width / 2 for i in range(len(scenes))])
 ax.set_xticklabels(scenes, fontsize=7, rotation=15)
-ax.set_ylabel("time with edge coverage / without (median of paired rounds)")
+ax.set_ylabel("time ratio, edge / point (median of rounds)")
 ax.set_title("cost: render + integrate per hemicube", fontsize=8)
 ax.legend(fontsize=7)
 

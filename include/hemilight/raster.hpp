@@ -139,7 +139,7 @@ struct raster_options {
   /// without the option); a blended texel's distance is to the plane of the nearest triangle
   /// with a share of it (along the centre's direction), which is the centre's distance unless a
   /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost: 12-33x a render + integration without it at N = 64 (docs/raster.md), so off by
+  /// path. Cost: 12-36x a render + integration without it at N = 64 (docs/raster.md), so off by
   /// default.
   bool edge_coverage = false;
 };
@@ -202,7 +202,7 @@ class alignas(64) hemicube_rasterizer {
   /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
   /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
   /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
-  /// raster_options::edge_coverage add O(partial texels): 12-33x in all at N = 64.
+  /// raster_options::edge_coverage add O(partial texels): 12-36x in all at N = 64.
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
