@@ -116,6 +116,13 @@ for n in "${names[@]}"; do
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
     continue
   fi
+  if [ "$n" = edge ]; then
+    # Exact edge coverage against point sampling: accuracy and paired-round cost (docs/raster.md).
+    echo "== sweep_edge"
+    "$build/benchmarks/sweep_edge" docs/bench/edge_accuracy.csv docs/bench/edge_cost.csv 5
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge.py docs/bench
+    continue
+  fi
   if [ -x "$build/benchmarks/bench_$n" ]; then
     echo "== bench_$n"
     "$build/benchmarks/bench_$n" --benchmark_repetitions="${REPETITIONS:-5}" \

@@ -999,6 +999,7 @@ bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& s
     so.resolution = o.resolution;
     so.roll = true;
     so.raster.sky = o.environment;
+    so.raster.edge_coverage = o.edge_coverage;
     so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
     so.hl2_cone = pass_directional && o.output_hl2;
     if (pass > 0 || layout.textured_first_pass) {

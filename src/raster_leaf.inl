@@ -200,12 +200,18 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
     const __m256i max_x = _mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]);
     const __m256i min_y = _mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]);
     const __m256i max_y = _mm256_max_epi32(_mm256_max_epi32(Y[0], Y[1]), Y[2]);
-    // Lanes over 64 texels across go to draw_fixed's exact 64-bit paths.
+    // Lanes over 120 texels across go to draw_fixed's exact 64-bit paths.
     const __m256i limit = _mm256_set1_epi32(static_cast<int>(avx2_extent));
     const unsigned big = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(
                              _mm256_or_si256(_mm256_cmpgt_epi32(_mm256_sub_epi32(max_x, min_x), limit),
                                              _mm256_cmpgt_epi32(_mm256_sub_epi32(max_y, min_y), limit))))) &
                          todo & ~clipped;
+    // With edge coverage every lane goes through raster_face (which keeps the unsnapped
+    // projected vertices for the partial texels; draw_fixed has those and the whole-texel bias),
+    // with a draw of its own per face (see bind).
+    const unsigned via_face = M == mode::depth && edge_ ? todo : clipped;
+    if (M == mode::depth && edge_)
+      for (unsigned m = todo; m; m &= m - 1) draw[__builtin_ctz(m)] = 0;
     // Texels whose centre (k + 1/2) lies in the box, clamped to the face (ceil_sub, floor_sub).
     const __m256i halfi = _mm256_set1_epi32(static_cast<int>(sub_half));
     const __m256i x_begin = _mm256_max_epi32(
@@ -296,7 +302,7 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
       const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
       const unsigned bit = 1u << j;
       const scene::triangle& tri = tris[j];
-      if (clipped & bit) {
+      if (via_face & bit) {
         draw_record& r = record(j);
         const glm::vec3 local[3] = {r.v0, glm::vec3(axis[0][j][1], axis[1][j][1], axis[2][j][1]),
                                     glm::vec3(axis[0][j][2], axis[1][j][2], axis[2][j][2])};

@@ -128,6 +128,7 @@ struct bake_options {
   /// axes, OpenGL face table) instead of scene_desc::sky_radiance. Build it with
   /// cubemap::from_image (which checks every value). null: the constant sky.
   std::shared_ptr<const cubemap> environment;
+  bool edge_coverage = false;  ///< hemicubes with exact edge coverage (raster_options::edge_coverage; docs/raster.md)
   /// Analytic lights (lights.hpp): direct light at every sample, added to every pass (step 3b at
   /// the top of this header). Checked as validate_lights does ("bake_lightmap: lights[2].radius
   /// = -1 is negative"). Cost: per sample and light one shadow ray (hard) or 12 (soft), 264 in a

@@ -56,7 +56,7 @@
 //     up in vector registers (its three vertices and its normal moved to the local frame in one
 //     register per axis, the face tests, clip codes and the double-precision projection of the
 //     three vertices at once, the edge functions of small triangles in 32-bit lanes) with the
-//     same float and integer operations as the scalar path; triangles up to 64
+//     same float and integer operations as the scalar path; triangles up to 120
 //     texels across are scanned over their box eight texels at a time with 32-bit edge values,
 //     the coverage mask going straight into the depth test; longer spans are depth-tested eight
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
@@ -129,6 +129,19 @@ struct raster_options {
   /// Shared and immutable; build it with cubemap::from_image (which checks every value); the
   /// constructor throws error(invalid_argument) for an empty or inconsistent map.
   std::shared_ptr<const cubemap> sky = nullptr;
+  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that an edge of a
+  /// triangle crosses gets the exact area of the (projected, clipped) triangle within the texel
+  /// as a fraction of the texel, not the all-or-nothing sample at its centre; the triangles
+  /// sharing a texel are resolved front to back (each takes the smaller of its coverage and what
+  /// is left; the sky, or the triangle that covers the whole texel behind them, the rest), and
+  /// the texel's radiance is the blend. Texels inside a triangle are as without it. flags and
+  /// seen_triangle() keep their meaning (what the texel centre sees: bit-identical to a render
+  /// without the option); a blended texel's distance is to the plane of the nearest triangle
+  /// with a share of it (along the centre's direction), which is the centre's distance unless a
+  /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
+  /// path. Cost: 12-36x a render + integration without it at N = 64 (docs/raster.md), so off by
+  /// default.
+  bool edge_coverage = false;
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
@@ -144,13 +157,17 @@ struct raster_statistics {
   std::size_t spans = 0;               ///< row spans written by the span paths (not by the SIMD
                                        ///< small-triangle paths, which have no spans)
   std::size_t fragments = 0;           ///< texels depth-tested (or counted) by the span paths
+  std::size_t edge_texels_tested = 0;  ///< edge coverage: texels classified by the partial-texel pass
+  std::size_t edge_fragments = 0;      ///< edge coverage: partial (triangle, texel) fragments kept
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
 /// direction tables, plus 8 bytes per triangle drawn (~70 with a texture) and 16 bytes per distinct
-/// emission of the scene; kept between renders and grown on demand.
+/// emission of the scene; kept between renders and grown on demand. With edge coverage, 4 more
+/// bytes per texel and 24 per partial (triangle, texel) fragment (~3,000 per hemicube of the
+/// Cornell box at N = 64, about one per texel in tessellated rooms).
 /// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
 /// must not share a line, or the counters one writes slow down the members the other reads.
 class alignas(64) hemicube_rasterizer {
@@ -184,7 +201,8 @@ class alignas(64) hemicube_rasterizer {
   /// below 1e-3, (t x b) . n > 0); N odd or outside [2, 4096]; an invalid texture.
   /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
   /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
-  /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle).
+  /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
+  /// raster_options::edge_coverage add O(partial texels): 12-36x in all at N = 64.
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
@@ -242,7 +260,8 @@ class alignas(64) hemicube_rasterizer {
   struct face_setup;  // per (triangle, face) pair: the depth plane (raster.cpp)
   template <mode M>
   void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
-                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri);
+                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
+                  const double* exact = nullptr);
   struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
@@ -250,6 +269,32 @@ class alignas(64) hemicube_rasterizer {
   template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
+
+  // Exact edge coverage (raster_options::edge_coverage; raster.cpp, "Exact edge coverage").
+  struct edge_fragment {
+    std::uint32_t texel;  // hemicube texel index
+    float z;              // the triangle's 1/w at the texel centre (the depth test's value)
+    float coverage;       // the covered fraction of the texel's weight, [0, 1]
+    std::uint32_t id;     // the draw's texel id (as in ids_)
+    std::uint32_t next;   // next fragment of the same texel (no_triangle = none)
+    bool centre;          // the triangle covers the texel centre (the point-sampled test)
+  };
+  void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
+                   const face_setup& fs, std::uint32_t draw);
+  void edge_resolve_centres();
+  void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
+  glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
+  bool edge_ = false;
+  std::vector<edge_fragment> fragments_;
+  std::vector<std::uint32_t> fragment_head_;    // per texel: first fragment (no_triangle = none)
+  std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
+  struct edge_group {
+    std::uint32_t texel;
+    float full_z;             // the nearest triangle covering the whole texel: 1/w (0 = none)
+    std::uint32_t full_id;    // and its id
+    float centre_z;           // 1/w of what the texel centre sees (0 = nothing)
+  };
+  std::vector<edge_group> edge_groups_;
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
