@@ -20,6 +20,8 @@
 //                         texel of levels with fewer): lines "error,<level>,<max>,<rms>"
 //     --compare-dds PATH  instead of filtering, read PATH (an RGBA32F DDS cube map with mips, as
 //                         cmft writes it) as the job's output and print its errors as --errors
+//     --dds-scale S       multiply what --compare-dds reads by S (cmft's irradiance is E / pi: use
+//                         3.14159265)
 //     --per-level         radiance jobs: filter level by level (filter_cosine_power each) and
 //                         print one line per level (level in the job column)
 //
@@ -179,6 +181,7 @@ int main(int argc, char** argv) try {
   int size = 256, out_size = 0, threads = 0, exr_threads = 0, repeat = 1;
   bool half = false, per_level = false, errors = false;
   std::string compare;
+  double dds_scale = 1.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto next = [&]() -> std::string {
@@ -198,6 +201,7 @@ int main(int argc, char** argv) try {
     else if (a == "--per-level") per_level = true;
     else if (a == "--errors") errors = true;
     else if (a == "--compare-dds") compare = next();
+    else if (a == "--dds-scale") dds_scale = std::atof(next().c_str());
     else return usage();
   }
   if (repeat < 1) return usage();
@@ -222,7 +226,9 @@ int main(int argc, char** argv) try {
     return job == "radiance" ? cmft_power(l) : gloss_power(out_size, l);
   };
   if (!compare.empty()) {
-    const std::vector<cube_image> levels = read_dds_rgba32f(compare);
+    std::vector<cube_image> levels = read_dds_rgba32f(compare);
+    for (cube_image& c : levels)
+      for (float& v : c.pixels) v = static_cast<float>(v * dds_scale);
     for (std::size_t l = 0; l < levels.size(); ++l)
       print_errors(in.levels[0], levels[l], static_cast<int>(l), level_power(static_cast<int>(l)));
     return 0;
