@@ -37,6 +37,7 @@ rounds=${4:-3}
 work=${5:-/tmp/hemilight-cmft}
 run="$bench/benchmarks/cubemap_run"
 here=$(cd "$(dirname "$0")" && pwd)
+[ -x /usr/bin/time ] || { echo "cmft_compare.sh: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
 [ -x "$run" ] || { echo "cmft_compare.sh: $run is missing: build the cubemap_run target of $bench" >&2; exit 1; }
 [ -f "$src/src/cmft/cubemapfilter.cpp" ] || { echo "cmft_compare.sh: $src is not a cmft source tree" >&2; exit 1; }
 mkdir -p "$work" "$out"
