@@ -1,6 +1,7 @@
 // The cube-map part of the C ABI: validates every argument, runs the C++ functions of
 // hemilight/cubemap.hpp, and copies results to the caller only when everything succeeded.
 #include "capi_internal.hpp"
+#include "capi_options.hpp"
 
 #include "hemilight/cubemap.hpp"
 
@@ -150,6 +151,42 @@ hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int inp
       hemilight::filter_options o;
       o.fixup = mapping;
       out = hemilight::filter_irradiance(in, output_size, o);
+    }
+    std::copy(out.pixels.begin(), out.pixels.end(), output);
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_cubemap_irradiance(const float* input, int input_size, hemilight_edge_fixup fixup,
+                                              int output_size, const hemilight_cubemap_irradiance_options* options,
+                                              float* output) {
+  const char* fn = "hemilight_cubemap_irradiance";
+  return guarded(fn, [&] {
+    hemilight_status st = HEMILIGHT_OK;
+    const int fixup_value = enum_value(fixup);
+    if (!check_filter_args(fn, input, input_size, output, output_size, fixup_value, st)) return st;
+    hemilight_cubemap_irradiance_options o = hemilight::capi::default_cubemap_irradiance_options();
+    if (options) {
+      const std::string problem = hemilight::capi::read_sized(options, o);
+      if (!problem.empty()) return invalid(fn, problem);
+    }
+    const int method = enum_value(o.method);
+    if (method < HEMILIGHT_IRRADIANCE_FILTER || method > HEMILIGHT_IRRADIANCE_SH25)
+      return invalid(fn, "options->method is " + std::to_string(method) +
+                             "; it must be HEMILIGHT_IRRADIANCE_FILTER, _SH9 or _SH25");
+    if (method == HEMILIGHT_IRRADIANCE_FILTER && !check_cube_size(fn, "options->input_size", o.input_size, st)) return st;
+    const hemilight::cubemap in = load_input(fn, input, input_size);
+    const auto mapping = static_cast<hemilight::edge_fixup>(fixup_value);
+    const hemilight::filter_options fo = hemilight::capi::to_cpp(o, mapping);
+    hemilight::cube_image out;
+    if (method == HEMILIGHT_IRRADIANCE_SH9) {
+      out = hemilight::irradiance_from_sh9(hemilight::project_sh9(in.levels[0], fo.thread_count), output_size, mapping,
+                                           3, fo.thread_count);
+    } else if (method == HEMILIGHT_IRRADIANCE_SH25) {
+      out = hemilight::irradiance_from_sh25(hemilight::project_sh25(in.levels[0], fo.thread_count), output_size,
+                                            mapping, 3, fo.thread_count);
+    } else {
+      out = hemilight::filter_irradiance(in, output_size, fo);
     }
     std::copy(out.pixels.begin(), out.pixels.end(), output);
     return HEMILIGHT_OK;

@@ -49,6 +49,11 @@ const span bake_stats_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_stats, invalid_texels), HEMILIGHT_SPAN(hemilight_bake_stats, dilated_texels),
     HEMILIGHT_SPAN(hemilight_bake_stats, overlapping_texels), HEMILIGHT_SPAN(hemilight_bake_stats, hemicubes),
     HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds)};
+const span cubemap_irradiance_options_fields[] = {
+    HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, struct_size),
+    HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, method),
+    HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, input_size),
+    HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, thread_count)};
 #undef HEMILIGHT_SPAN
 
 // The sizes of this ABI's first layouts (x86-64 and every LP64 ABI). A struct that grows keeps
@@ -57,6 +62,8 @@ static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 96, "hemi
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 144, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_cubemap_irradiance_options) == 24,
+              "hemilight_cubemap_irradiance_options changed: see above");
 
 template <std::size_t K>
 void copy_fields(const span (&fields)[K], const void* from, void* to, std::size_t size) {
@@ -136,11 +143,26 @@ hemilight_bake_options default_bake_options() {
   return o;
 }
 
+hemilight_cubemap_irradiance_options default_cubemap_irradiance_options() {
+  hemilight_cubemap_irradiance_options o;
+  std::memset(&o, 0, sizeof o);
+  o.struct_size = sizeof o;
+  const filter_options d;
+  o.method = HEMILIGHT_IRRADIANCE_FILTER;
+  o.input_size = d.irradiance_input_size;
+  o.thread_count = d.thread_count;
+  return o;
+}
+
 std::string read_sized(const hemilight_cache_options* in, hemilight_cache_options& out) {
   return read(in, out, cache_options_fields, "hemilight_cache_options_init");
 }
 std::string read_sized(const hemilight_bake_options* in, hemilight_bake_options& out) {
   return read(in, out, bake_options_fields, "hemilight_bake_options_init");
+}
+
+std::string read_sized(const hemilight_cubemap_irradiance_options* in, hemilight_cubemap_irradiance_options& out) {
+  return read(in, out, cubemap_irradiance_options_fields, "hemilight_cubemap_irradiance_options_init");
 }
 
 std::string check_sized(const hemilight_cache_stats* stats) {
@@ -224,6 +246,14 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   return o;
 }
 
+filter_options to_cpp(const hemilight_cubemap_irradiance_options& c, edge_fixup mapping) {
+  filter_options o;
+  o.fixup = mapping;
+  o.irradiance_input_size = c.input_size;
+  o.thread_count = c.thread_count;
+  return o;
+}
+
 }  // namespace hemilight::capi
 
 namespace hemilight::capi {
@@ -263,6 +293,11 @@ void hemilight_cache_stats_init_sized(hemilight_cache_stats* stats, size_t struc
 
 void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_size) {
   hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_bake_stats>(), hemilight::capi::bake_stats_fields);
+}
+
+void hemilight_cubemap_irradiance_options_init_sized(hemilight_cubemap_irradiance_options* options, size_t struct_size) {
+  hemilight::capi::init_sized(options, struct_size, hemilight::capi::default_cubemap_irradiance_options(),
+                              hemilight::capi::cubemap_irradiance_options_fields);
 }
 
 }  // extern "C"

@@ -7,6 +7,7 @@
 
 #include "hemilight/bake.hpp"
 #include "hemilight/cache.hpp"
+#include "hemilight/cubemap.hpp"
 
 #include <memory>
 #include <string>
@@ -19,10 +20,12 @@ namespace hemilight::capi {
 /// struct_size ("options->struct_size is 0: ...").
 std::string read_sized(const hemilight_cache_options* in, hemilight_cache_options& out);
 std::string read_sized(const hemilight_bake_options* in, hemilight_bake_options& out);
+std::string read_sized(const hemilight_cubemap_irradiance_options* in, hemilight_cubemap_irradiance_options& out);
 
 /// The defaults, for the whole struct the library knows (struct_size = its sizeof).
 hemilight_cache_options default_cache_options();
 hemilight_bake_options default_bake_options();
+hemilight_cubemap_irradiance_options default_cubemap_irradiance_options();
 
 /// Checks stats->struct_size; returns "" or what is wrong.
 std::string check_sized(const hemilight_cache_stats* stats);
@@ -41,6 +44,10 @@ hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_optio
 /// converted (they need checks that name their elements) and the directional outputs asked for.
 bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubemap> environment, std::vector<light> lights,
                     bool output_sh_l1, bool output_hl2);
+
+/// The filter options of checked C cube-map irradiance options (method and input_size already
+/// validated; the method picks the C++ function, so it does not appear here).
+filter_options to_cpp(const hemilight_cubemap_irradiance_options& c, edge_fixup mapping);
 
 }  // namespace hemilight::capi
 

@@ -1210,4 +1210,130 @@ cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping
   return out;
 }
 
+// ---------------------------------------------------------------------------------------------
+// SH, bands 0-4
+
+namespace {
+
+// The 25 real SH basis functions at unit (x, y, z), in T (float for the projection's inner loop,
+// double for sh25_basis). Constants: sqrt((2l + 1)/(4 pi) (l - |m|)!/(l + |m|)!) times the
+// associated Legendre polynomial's factors, as in the usual tables (band 3 and 4 written out).
+template <class T>
+void sh25_basis_t(T x, T y, T z, T* b) noexcept {
+  const T x2 = x * x, y2 = y * y, z2 = z * z;
+  b[0] = T(0.28209479177387814);
+  b[1] = T(0.4886025119029199) * y;
+  b[2] = T(0.4886025119029199) * z;
+  b[3] = T(0.4886025119029199) * x;
+  b[4] = T(1.0925484305920792) * x * y;
+  b[5] = T(1.0925484305920792) * y * z;
+  b[6] = T(0.31539156525252005) * (T(3) * z2 - T(1));
+  b[7] = T(1.0925484305920792) * x * z;
+  b[8] = T(0.5462742152960396) * (x2 - y2);
+  b[9] = T(0.5900435899266435) * y * (T(3) * x2 - y2);
+  b[10] = T(2.890611442640554) * x * y * z;
+  b[11] = T(0.4570457994644658) * y * (T(5) * z2 - T(1));
+  b[12] = T(0.3731763325901154) * z * (T(5) * z2 - T(3));
+  b[13] = T(0.4570457994644658) * x * (T(5) * z2 - T(1));
+  b[14] = T(1.445305721320277) * z * (x2 - y2);
+  b[15] = T(0.5900435899266435) * x * (x2 - T(3) * y2);
+  b[16] = T(2.5033429417967046) * x * y * (x2 - y2);
+  b[17] = T(1.7701307697799304) * y * z * (T(3) * x2 - y2);
+  b[18] = T(0.9461746957575601) * x * y * (T(7) * z2 - T(1));
+  b[19] = T(0.6690465435572892) * y * z * (T(7) * z2 - T(3));
+  b[20] = T(0.10578554691520431) * (T(35) * z2 * z2 - T(30) * z2 + T(3));
+  b[21] = T(0.6690465435572892) * x * z * (T(7) * z2 - T(3));
+  b[22] = T(0.47308734787878004) * (x2 - y2) * (T(7) * z2 - T(1));
+  b[23] = T(1.7701307697799304) * x * z * (x2 - T(3) * y2);
+  b[24] = T(0.6258357354491761) * (x2 * (x2 - T(3) * y2) - y2 * (T(3) * x2 - y2));
+}
+
+// The clamped cosine's band factors A_l for bands 0-4, per coefficient.
+constexpr double sh25_band_factor(std::size_t k) noexcept {
+  return k < 1 ? pi : k < 4 ? 2.0 * pi / 3.0 : k < 9 ? pi / 4.0 : k < 16 ? 0.0 : -pi / 24.0;
+}
+
+}  // namespace
+
+std::array<double, 25> sh25_basis(const glm::dvec3& w) noexcept {
+  std::array<double, 25> b;
+  sh25_basis_t(w.x, w.y, w.z, b.data());
+  return b;
+}
+
+sh25 project_sh25(const cube_image& level, int thread_count) {
+  validate_level("project_sh25", level);
+  const int n = level.size;
+  const std::shared_ptr<const face_table> table = face_table::get(n);
+  const std::size_t rows = 6u * std::size_t(n), ch = std::size_t(level.channels);
+  std::vector<sh25> partial(rows);  // one partial sum per row, added in row order: deterministic
+  parallel_for(rows, thread_count, 8, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(n)), y = static_cast<int>(r % std::size_t(n));
+      const face_frame& fr = frame_of(f);
+      // Float sums within the row (at most 6688 terms of similar size), double across rows.
+      std::array<glm::vec4, 25> acc{};
+      float b[25];
+      for (int x = 0; x < n; ++x) {
+        const glm::vec4& t = table->texels[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+        const glm::vec3 w = fr.column * t.x + fr.row * t.y + fr.axis * t.z;
+        const float* p = level.at(f, x, y);
+        const glm::vec4 lw = glm::vec4(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f) * t.w;
+        sh25_basis_t(w.x, w.y, w.z, b);
+        for (std::size_t k = 0; k < 25; ++k) acc[k] += lw * b[k];
+      }
+      for (std::size_t k = 0; k < 25; ++k) partial[r].coefficients[k] = glm::dvec4(acc[k]);
+    }
+  });
+  sh25 total;
+  for (const sh25& s : partial)
+    for (std::size_t k = 0; k < 25; ++k) total.coefficients[k] += s.coefficients[k];
+  return total;
+}
+
+glm::dvec4 sh25_irradiance(const sh25& radiance, const glm::dvec3& n) noexcept {
+  double b[25];
+  sh25_basis_t(n.x, n.y, n.z, b);
+  glm::dvec4 e(0.0);
+  for (std::size_t k = 0; k < 25; ++k) e += radiance.coefficients[k] * (sh25_band_factor(k) * b[k]);
+  return e;
+}
+
+cube_image irradiance_from_sh25(const sh25& radiance, int size, edge_fixup mapping, int channels, int thread_count) {
+  check_output_size("irradiance_from_sh25", size);
+  if (channels != 3 && channels != 4)
+    throw_invalid_argument("irradiance_from_sh25: channels is " + std::to_string(channels) + "; it must be 3 or 4");
+  const int m = static_cast<int>(mapping);
+  if (m < 0 || m > 2) throw_invalid_argument("irradiance_from_sh25: mapping " + std::to_string(m) + " is not 0, 1 or 2");
+  cube_image out = cube_image::make(size, channels);
+  const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
+  // Band factors folded into the coefficients; band 3 (A_3 = 0) is skipped.
+  std::array<glm::vec4, 25> k;
+  for (std::size_t j = 0; j < 25; ++j) k[j] = glm::vec4(radiance.coefficients[j] * sh25_band_factor(j));
+  std::vector<float> coord(static_cast<std::size_t>(size));
+  for (int i = 0; i < size; ++i) coord[std::size_t(i)] = static_cast<float>(cubemap_texel_coordinate(size, i, mapping));
+  parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+    float b[25];
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
+      const face_frame& fr = frame_of(f);
+      const glm::vec3 row_point = fr.axis + coord[std::size_t(y)] * fr.row;
+      for (int x = 0; x < size; ++x) {
+        const glm::vec3 p3 = row_point + coord[std::size_t(x)] * fr.column;
+        const glm::vec3 nn = p3 / std::sqrt(glm::dot(p3, p3));
+        sh25_basis_t(nn.x, nn.y, nn.z, b);
+        glm::vec4 e(0.0f);
+        for (std::size_t j = 0; j < 9; ++j) e += k[j] * b[j];
+        for (std::size_t j = 16; j < 25; ++j) e += k[j] * b[j];
+        float* p = out.at(f, x, y);
+        p[0] = e.x;
+        p[1] = e.y;
+        p[2] = e.z;
+        if (ch == 4) p[3] = static_cast<float>(static_cast<double>(e.w) / pi);  // alpha: the mean, not scaled
+      }
+    }
+  });
+  return out;
+}
+
 }  // namespace hemilight

@@ -5,6 +5,7 @@
 #include "hemilight.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -199,6 +200,98 @@ static void test_sample(void) {
   CHECK(rgb[0] == -1.0f);
 }
 
+static void test_irradiance_methods(void) {
+  /* L(w) = 1 + 0.5 w_z lies in SH bands 0-1: E(n) = pi + (pi / 3) n_z exactly (the hemisphere
+   * integrals of cos and of w_z cos). SH9 and SH25 reproduce it up to the texel-centre quadrature
+   * over 16^2 texels, which leaves O(h^2) of L in band 4 (band 2 cancels by the cube's symmetry;
+   * measured 1e-7 with SH9, 1.9e-4 with SH25: tolerance 5e-4); the filter clips texels at the horizon by their centres on the 16^2 mip
+   * (O(h^2) too: tolerance 2e-3). */
+  const int n = 16, m = 4;
+  float* in = malloc(sizeof(float) * cube_floats(n));
+  float* out = malloc(sizeof(float) * cube_floats(m));
+  float* again = malloc(sizeof(float) * cube_floats(m));
+  const double tolerance[3] = {2e-3, 5e-4, 5e-4};
+  hemilight_cubemap_irradiance_options o;
+  int face, x, y, k, method;
+  float d[3];
+  for (face = 0; face < 6; ++face)
+    for (y = 0; y < n; ++y)
+      for (x = 0; x < n; ++x) {
+        hemilight_cubemap_texel_direction(n, face, x, y, HEMILIGHT_EDGE_FIXUP_NONE, d);
+        for (k = 0; k < 3; ++k) in[((size_t)(face * n + y) * n + x) * 3 + k] = 1.0f + 0.5f * d[2];
+      }
+  hemilight_cubemap_irradiance_options_init(&o);
+  CHECK(o.struct_size == sizeof o && o.method == HEMILIGHT_IRRADIANCE_FILTER && o.input_size == 16 &&
+        o.thread_count == 0);
+  for (method = HEMILIGHT_IRRADIANCE_FILTER; method <= HEMILIGHT_IRRADIANCE_SH25; ++method) {
+    double worst = 0;
+    o.method = (hemilight_irradiance_method)method;
+    o.thread_count = 1;
+    CHECK(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_WARP, m, &o, out) == HEMILIGHT_OK);
+    for (face = 0; face < 6; ++face)
+      for (y = 0; y < m; ++y)
+        for (x = 0; x < m; ++x) {
+          const float* e = out + ((size_t)(face * m + y) * m + x) * 3;
+          hemilight_cubemap_texel_direction(m, face, x, y, HEMILIGHT_EDGE_FIXUP_WARP, d);
+          for (k = 0; k < 3; ++k) {
+            const double exact = pi + pi / 3 * d[2], err = fabs(e[k] / exact - 1);
+            if (err > worst) worst = err;
+          }
+        }
+    if (!(worst < tolerance[method])) printf("  method %d: max relative error %g\n", method, worst);
+    CHECK(worst < tolerance[method]);
+    o.thread_count = 2; /* bitwise the same for any thread count */
+    CHECK(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_WARP, m, &o, again) == HEMILIGHT_OK);
+    CHECK(memcmp(out, again, sizeof(float) * cube_floats(m)) == 0);
+  }
+  /* NULL options: the defaults (the filter), the same as the old entry's use_sh = 0 */
+  CHECK(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, NULL, out) == HEMILIGHT_OK);
+  CHECK(hemilight_cubemap_filter_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, 0, again) == HEMILIGHT_OK);
+  CHECK(memcmp(out, again, sizeof(float) * cube_floats(m)) == 0);
+  /* an older caller's struct (without input_size and thread_count) takes their defaults */
+  hemilight_cubemap_irradiance_options_init(&o);
+  o.method = HEMILIGHT_IRRADIANCE_SH9;
+  o.input_size = -5; /* past the older struct_size: not read */
+  o.struct_size = offsetof(hemilight_cubemap_irradiance_options, input_size);
+  CHECK(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, out) == HEMILIGHT_OK);
+  CHECK(hemilight_cubemap_filter_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, 1, again) == HEMILIGHT_OK);
+  CHECK(memcmp(out, again, sizeof(float) * cube_floats(m)) == 0);
+
+  /* bad arguments: status, message, and the output untouched */
+  out[0] = -3.0f;
+  hemilight_cubemap_irradiance_options_init(&o);
+  o.method = (hemilight_irradiance_method)7;
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "options->method is 7");
+  hemilight_cubemap_irradiance_options_init(&o);
+  o.input_size = 0;
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "options->input_size 0");
+  o.method = HEMILIGHT_IRRADIANCE_SH25; /* input_size is ignored by the SH methods */
+  CHECK(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, again) == HEMILIGHT_OK);
+  hemilight_cubemap_irradiance_options_init(&o);
+  o.struct_size = 0;
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_cubemap_irradiance_options_init");
+  o.struct_size = sizeof o + 8;
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, &o, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "newer hemilight.h");
+  CHECK_FAILS(hemilight_cubemap_irradiance(NULL, n, HEMILIGHT_EDGE_FIXUP_NONE, m, NULL, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "input is NULL");
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, 6689, NULL, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "output_size 6689");
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, (hemilight_edge_fixup)5, m, NULL, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "fixup 5");
+  in[40] = (float)INFINITY;
+  CHECK_FAILS(hemilight_cubemap_irradiance(in, n, HEMILIGHT_EDGE_FIXUP_NONE, m, NULL, out),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "input value 40");
+  CHECK(out[0] == -3.0f);
+  hemilight_cubemap_irradiance_options_init_sized(NULL, sizeof o); /* ignored */
+  free(in);
+  free(out);
+  free(again);
+}
+
 static void test_exr_round_trip(const char* dir) {
   /* EXR cube-map load/save of the C ABI with a filtered map; corrupt files through the loader */
   char path[1024], bad[1024];
@@ -234,6 +327,7 @@ int main(int argc, char** argv) {
   test_texel_direction();
   test_fixup_lookup();
   test_filters();
+  test_irradiance_methods();
   test_sample();
   test_exr_round_trip(dir);
   printf("%d passed, %d failed\n", passed, failed);

@@ -191,3 +191,26 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   CHECK(std::memcmp(&to.seconds, &untouched.seconds, sizeof to.seconds) == 0);
   CHECK(std::memcmp(&to.invalid_samples, &untouched.invalid_samples, sizeof to.invalid_samples) == 0);
 }
+
+TEST_CASE("C ABI options: cube-map irradiance options reach the C++ side, defaults are the C++ defaults", "[capi]") {
+  hemilight_cubemap_irradiance_options c = capi::default_cubemap_irradiance_options();
+  const filter_options d;
+  const filter_options o = capi::to_cpp(c, edge_fixup::none);
+  CHECK(c.method == HEMILIGHT_IRRADIANCE_FILTER);
+  CHECK(o.irradiance_input_size == d.irradiance_input_size);
+  CHECK(o.thread_count == d.thread_count);
+  c.input_size = 48;
+  c.thread_count = 3;
+  const filter_options m = capi::to_cpp(c, edge_fixup::warp);
+  CHECK(m.irradiance_input_size == 48);
+  CHECK(m.thread_count == 3);
+  CHECK(m.fixup == edge_fixup::warp);
+  // an older layout without input_size and thread_count: their defaults
+  c.method = HEMILIGHT_IRRADIANCE_SH25;
+  c.struct_size = offsetof(hemilight_cubemap_irradiance_options, input_size);
+  hemilight_cubemap_irradiance_options read = capi::default_cubemap_irradiance_options();
+  CHECK(capi::read_sized(&c, read).empty());
+  CHECK(read.method == HEMILIGHT_IRRADIANCE_SH25);
+  CHECK(read.input_size == d.irradiance_input_size);
+  CHECK(read.thread_count == d.thread_count);
+}

@@ -287,4 +287,39 @@ glm::dvec4 sh9_irradiance(const sh9& radiance, const glm::dvec3& n) noexcept;
 cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping, int channels = 3,
                                int thread_count = 0);
 
+// ---------------------------------------------------------------------------------------------
+// Spherical harmonics (bands 0-4)
+// ---------------------------------------------------------------------------------------------
+
+/// Twenty-five SH coefficients per channel (real SH, bands 0-4, band after band, m = -l..l within
+/// a band; the first nine are sh9's). Channels in .xyzw.
+struct sh25 {
+  std::array<glm::dvec4, 25> coefficients{};
+};
+
+/// The 25 real SH basis functions of bands 0-4 at a unit direction (the first nine as
+/// sh9_basis; band 3 and 4 in the usual Cartesian forms, e.g. Y_4,0 = 3/(16 sqrt(pi))
+/// (35 z^4 - 30 z^2 + 3)). Cost: ~60 flops.
+std::array<double, 25> sh25_basis(const glm::dvec3& w) noexcept;
+
+/// Projects a cube-map level on SH bands 0-4 with exact texel solid angles (directions at texel
+/// centres). Deterministic for any thread count. Errors: error(invalid_argument) for an
+/// inconsistent or non-finite image. Cost: 6 n^2 * ~100 flops (256: ~5 ms on one core).
+sh25 project_sh25(const cube_image& level, int thread_count = 0);
+
+/// Irradiance at unit normal n from SH radiance of bands 0-4: sum A_l L_lm Y_lm(n), A_0 = pi,
+/// A_1 = 2 pi / 3, A_2 = pi / 4, A_3 = 0, A_4 = -pi / 24 (the clamped cosine's band factors;
+/// Ramamoorthi and Hanrahan 2001). What cmft's "bands 0-4" irradiance computes. The truncation
+/// error is smaller than sh9's but still large for a small bright source: for a point source the
+/// result near the terminator rings (docs/cubemap.md has the measured error on the test sky).
+/// Cost: ~100 flops.
+glm::dvec4 sh25_irradiance(const sh25& radiance, const glm::dvec3& n) noexcept;
+
+/// A cube map of size `size` whose texels (directions from `mapping`) hold sh25_irradiance
+/// (alpha, with 4 channels: the cosine-weighted mean, not scaled by pi). channels: 3 or 4.
+/// Throws error(invalid_argument) for a bad size, channel count or mapping. Cost: ~100 flops per
+/// texel.
+cube_image irradiance_from_sh25(const sh25& radiance, int size, edge_fixup mapping, int channels = 3,
+                                int thread_count = 0);
+
 }  // namespace hemilight
