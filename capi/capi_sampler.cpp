@@ -7,10 +7,14 @@
 #include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
 
+#include "hemilight/memory.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <memory>
 #include <cmath>
+#include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -111,6 +115,50 @@ namespace {
 
 const char* const overflow_message = "the irradiance overflows float (a light too intense or too close to the point?)";
 
+// The per-thread context of hemilight_sample_irradiance, registered so that
+// hemilight_release_tables can free the contexts of every thread not inside a call.
+struct thread_context;
+
+struct context_registry {
+  std::mutex mutex;
+  std::set<thread_context*> contexts;
+};
+
+// Never destroyed: threads may end (and unregister) after static destructors ran.
+context_registry& registry() {
+  static context_registry* const instance = new context_registry;
+  return *instance;
+}
+
+struct thread_context {
+  std::mutex in_use;  // held by the owning thread during a call, and by a release freeing it
+  hemilight::capi::point_sampler sampler;
+  thread_context() {
+    context_registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.contexts.insert(this);
+  }
+  ~thread_context() {
+    context_registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.contexts.erase(this);
+  }
+  thread_context(const thread_context&) = delete;
+  thread_context& operator=(const thread_context&) = delete;
+};
+
+// Frees the contexts of every thread that is not inside hemilight_sample_irradiance (a thread
+// inside a call keeps its context; it is freed by a later release).
+void release_thread_contexts() noexcept {
+  context_registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  for (thread_context* c : r.contexts) {
+    if (!c->in_use.try_lock()) continue;
+    c->sampler = hemilight::capi::point_sampler{};
+    c->in_use.unlock();
+  }
+}
+
 using hemilight::capi::check_point;
 using hemilight::capi::check_resolution;
 using hemilight::capi::guarded;
@@ -131,10 +179,13 @@ hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const
     // The context is kept per thread between calls (tables, scratch) up to cached_resolution,
     // bound to the call's scene for the call only: no thread keeps a released scene alive.
     // Above it, a context for this call alone (its tables are then a small part of the render).
+    // hemilight_release_tables frees the kept contexts of threads not inside a call.
     constexpr int cached_resolution = 512;
-    thread_local hemilight::capi::point_sampler cached;
+    thread_local thread_context cached;
     hemilight::capi::point_sampler own;
-    hemilight::capi::point_sampler& context = resolution <= cached_resolution ? cached : own;
+    std::unique_lock<std::mutex> in_use;
+    if (resolution <= cached_resolution) in_use = std::unique_lock<std::mutex>(cached.in_use);
+    hemilight::capi::point_sampler& context = resolution <= cached_resolution ? cached.sampler : own;
     struct unbind_after {
       hemilight::capi::point_sampler& c;
       ~unbind_after() {
@@ -225,6 +276,17 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
     std::copy(results.begin(), results.end(), out);
     return HEMILIGHT_OK;
   });
+}
+
+void hemilight_set_table_budget(size_t bytes) { hemilight::set_table_budget(bytes); }
+
+size_t hemilight_table_budget(void) { return hemilight::table_budget(); }
+
+size_t hemilight_table_bytes(void) { return hemilight::table_cache_stats().retained_bytes; }
+
+void hemilight_release_tables(void) {
+  release_thread_contexts();  // first: the contexts hold references to tables
+  hemilight::release_tables();
 }
 
 }  // extern "C"

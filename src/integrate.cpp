@@ -2,6 +2,8 @@
 // passes (texels, walls) that reduce a hemicube buffer. See integrate.hpp and docs/integration.md.
 #include "hemilight/integrate.hpp"
 
+#include "table_cache.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -174,19 +176,18 @@ integration_table::integration_table(int n) : n_(n) {
 
 std::shared_ptr<const integration_table> integration_table::get(int n) {
   if (!is_valid_hemicube_resolution(n)) return std::make_shared<const integration_table>(n);  // throws
-  struct slot {
-    std::shared_ptr<const integration_table> strong;
-    std::weak_ptr<const integration_table> weak;
-  };
-  static std::mutex mutex;
-  static std::map<int, slot> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  slot& entry = cache[n];
-  if (auto alive = entry.weak.lock()) return alive;
-  auto table = std::make_shared<const integration_table>(n);
-  entry.weak = table;
-  if (n <= 512) entry.strong = table;
-  return table;
+  // Kept in the process's table cache (table_cache.hpp: LRU within the budget of memory.hpp).
+  return detail::cached_table<integration_table>(
+      detail::table_kind::integration, n, [n] { return std::make_shared<const integration_table>(n); },
+      [](const integration_table& t) {
+        std::size_t bytes = detail::vector_bytes(t.border_walls) + detail::vector_bytes(t.extrapolation_neighbours);
+        for (const std::vector<float>* v :
+             {&t.vx, &t.vy, &t.vz, &t.simple_x, &t.simple_y, &t.hl2[0], &t.hl2[1], &t.hl2[2], &t.solid_angle,
+              &t.right_great_arc_x, &t.right_great_arc_y, &t.up_great_arc_x, &t.up_great_arc_y, &t.right_classified_x,
+              &t.right_classified_y, &t.up_classified_x, &t.up_classified_y})
+          bytes += detail::vector_bytes(*v);
+        return bytes;
+      });
 }
 
 hemicube_integrator::hemicube_integrator(int resolution, const integrate_options& options)

@@ -8,6 +8,8 @@
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
 
+#include "table_cache.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -74,15 +76,11 @@ class sh9_texel_table {
   std::size_t texels() const noexcept { return texels_; }
   const float* weights(int k) const noexcept { return weights_.data() + std::size_t(k) * texels_; }
 
-  // The shared table of resolution N (cached up to N = 512, as hemicube_table).
+  // The shared table of resolution N, in the process's table cache (table_cache.hpp).
   static std::shared_ptr<const sh9_texel_table> get(int n) {
-    static std::mutex m;
-    static std::map<int, std::shared_ptr<const sh9_texel_table>> cache;
-    if (n > 512) return std::make_shared<const sh9_texel_table>(n);
-    std::lock_guard<std::mutex> lock(m);
-    auto& slot = cache[n];
-    if (!slot) slot = std::make_shared<const sh9_texel_table>(n);
-    return slot;
+    return detail::cached_table<sh9_texel_table>(
+        detail::table_kind::sh9_texel, n, [n] { return std::make_shared<const sh9_texel_table>(n); },
+        [](const sh9_texel_table& t) { return detail::vector_bytes(t.weights_); });
   }
 
  private:
