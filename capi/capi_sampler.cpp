@@ -257,11 +257,15 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
         return check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i);
     // Step 2: the points on the workers, one context each, into a buffer of our own (each
     // point's result depends on that point alone: the same for any thread count).
-    const int workers = hemilight::resolve_thread_count(thread_count);
-    std::vector<hemilight::capi::point_sampler> contexts(static_cast<std::size_t>(workers));
+    // Contexts are made by the workers on their first chunk: only workers that run allocate (at
+    // most min(thread_count, chunks of 16 points), as parallel_for starts no more).
+    constexpr std::size_t grain = 16;
+    const std::size_t workers =
+        std::min(static_cast<std::size_t>(hemilight::resolve_thread_count(thread_count)), (count + grain - 1) / grain);
+    std::vector<hemilight::capi::point_sampler> contexts(workers);
     std::vector<hemilight_irradiance> results(count);
     std::atomic<std::size_t> first_bad{count};  // the lowest index whose result overflowed
-    hemilight::parallel_for(count, workers, 16, [&](int worker, std::size_t b, std::size_t e) {
+    hemilight::parallel_for(count, static_cast<int>(workers), grain, [&](int worker, std::size_t b, std::size_t e) {
       hemilight::capi::point_sampler& c = contexts[std::size_t(worker)];
       if (!c.raster) c.prepare(*scene, resolution);
       for (std::size_t i = b; i < e; ++i)
