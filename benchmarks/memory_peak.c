@@ -4,6 +4,7 @@
  *
  *   memory_peak ENTRY N [threads] [count]
  *     ENTRY sample   hemilight_sample_irradiance, `count` points on the calling thread
+ *           sweep    hemilight_sample_irradiance once at every even N' from N to `count`
  *           sampler  hemilight_sampler_create + `count` points, then the sampler released
  *           batch    hemilight_sample_irradiance_batch, `count` points on `threads` threads
  *           cache    hemilight_cache_irradiance of a count x count grid (defaults)
@@ -86,6 +87,11 @@ int main(int argc, char** argv) {
     hemilight_irradiance r;
     for (i = 0; i < count; ++i)
       if (hemilight_sample_irradiance(s, pos + 3 * i, nor + 3 * i, n, &r) != HEMILIGHT_OK) fail(entry);
+  } else if (strcmp(entry, "sweep") == 0) {
+    hemilight_irradiance r;
+    int m;
+    for (m = n; m <= (int)count; m += 2)
+      if (hemilight_sample_irradiance(s, pos, nor, m, &r) != HEMILIGHT_OK) fail(entry);
   } else if (strcmp(entry, "sampler") == 0) {
     hemilight_irradiance r;
     hemilight_sampler* sm = NULL;
@@ -103,7 +109,10 @@ int main(int argc, char** argv) {
     o.resolution = n;
     o.thread_count = threads;
     out = (float*)malloc(3 * count * count * sizeof(float));
-    if (hemilight_cache_irradiance(s, pos, nor, count * count, &o, out, NULL) != HEMILIGHT_OK) fail(entry);
+    hemilight_cache_stats st;
+    hemilight_cache_stats_init(&st);
+    if (hemilight_cache_irradiance(s, pos, nor, count * count, &o, out, &st) != HEMILIGHT_OK) fail(entry);
+    fprintf(stderr, "records=%lu hemicubes=%lu\n", (unsigned long)st.records, (unsigned long)st.hemicubes);
   } else if (strcmp(entry, "probes") == 0) {
     out = (float*)malloc(27 * count * sizeof(float));
     for (i = 0; i < count; ++i) pos[3 * i + 2] = 1.0f;

@@ -9,6 +9,10 @@
 
 #include "hemilight/memory.hpp"
 
+#if defined(__GLIBC__)
+#include <malloc.h>  // malloc_trim
+#endif
+
 #include <algorithm>
 #include <atomic>
 #include <memory>
@@ -291,6 +295,11 @@ size_t hemilight_table_bytes(void) { return hemilight::table_cache_stats().retai
 void hemilight_release_tables(void) {
   release_thread_contexts();  // first: the contexts hold references to tables
   hemilight::release_tables();
+#if defined(__GLIBC__)
+  // Tables and scratch of a few MB each sit below glibc's mmap threshold: freed, they stay in
+  // the heap's free lists. Hand them back to the system.
+  malloc_trim(0);
+#endif
 }
 
 }  // extern "C"

@@ -254,7 +254,7 @@ typedef struct hemilight_irradiance {
  * normal, a zero normal, N odd or outside [2, 4096].
  * Cost: one hemicube (Cornell box, N = 64: about 25 us on one core, docs/capi.md). Each thread
  * keeps a context for the last N it used up to N = 512 (scratch and a reference to its tables:
- * about 366 N^2 bytes, 1.5 MiB at N = 64, 96 MiB at N = 512; hemilight_release_tables frees it)
+ * 342 N^2 bytes, 1.3 MiB at N = 64, 86 MiB at N = 512; hemilight_release_tables frees it)
  * between calls, but no reference to the scene; the first call on a thread for a new N builds it
  * (~5 ms at N = 64). Above N = 512 every call makes its own context (the tables come from the
  * table cache while they fit its budget).
@@ -668,9 +668,9 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_sample(const float* chain, int 
  * least recently used ones within a byte budget (default 256 MiB: every table of two hemicube
  * resolutions up to 512). A table in use by a sampler, a call or another thread is never freed
  * under it. Besides the cache, each thread that called hemilight_sample_irradiance with N <= 512
- * keeps one context for its last N: about 53 bytes per hemicube texel of scratch plus a reference
- * to that N's integrator weights (69 bytes per texel), i.e. about 366 N^2 bytes (96 MiB at
- * N = 512, 1.5 MiB at N = 64). docs/reliability.md ("Memory") gives every entry's peak. */
+ * keeps one context for its last N: 45 bytes per hemicube texel (3 N^2) of scratch plus a
+ * reference to that N's integrator weights (69 bytes per texel), 342 N^2 bytes in all (86 MiB at
+ * N = 512, 1.3 MiB at N = 64). docs/reliability.md ("Memory") gives every entry's peak. */
 
 /* Sets the table cache's budget in bytes (0: keep no table between calls) and frees least
  * recently used tables until the kept ones fit. Never fails; thread-safe. Cost: O(tables kept). */
@@ -685,7 +685,8 @@ HEMILIGHT_API size_t hemilight_table_bytes(void);
 
 /* Frees what hemilight keeps between calls: every table in the cache (the budget is unchanged)
  * and the per-thread context of hemilight_sample_irradiance of every thread not inside a call at
- * that moment (a thread inside a call keeps its context until a later release or its exit).
+ * that moment (a thread inside a call keeps its context until a later release or its exit), then
+ * (with glibc) returns the freed heap memory to the system (malloc_trim).
  * Tables used by live samplers (hemilight_sampler_create) stay until those are released. Later
  * calls rebuild what they need, with bitwise the same results. Never fails; thread-safe.
  * Cost: O(tables kept + threads). */
