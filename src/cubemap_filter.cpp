@@ -11,8 +11,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
-#include <map>
-#include <mutex>
 #include <string>
 
 #if defined(__SSE2__)

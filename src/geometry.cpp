@@ -3,8 +3,6 @@
 #include "table_cache.hpp"
 
 #include <algorithm>
-#include <map>
-#include <mutex>
 #include <string>
 #include <thread>
 

@@ -10,8 +10,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <map>
-#include <mutex>
 #include <string>
 #include <type_traits>
 

@@ -12,8 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <mutex>
 #include <string>
 
 namespace hemilight {
