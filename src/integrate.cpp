@@ -21,6 +21,23 @@
 #define HEMILIGHT_INTEGRATE_AVX2 0
 #endif
 
+// AVX2 and default clones of the hot sums, picked at load time (an ifunc). Not under
+// ThreadSanitizer: the instrumented resolver would run before the sanitizer's runtime is set up
+// and crash the loader (the TSan build then runs the default clone).
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define HEMILIGHT_TSAN_BUILD 1
+#endif
+#endif
+#if defined(__SANITIZE_THREAD__)
+#define HEMILIGHT_TSAN_BUILD 1
+#endif
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__)) && !defined(HEMILIGHT_TSAN_BUILD)
+#define HEMILIGHT_TARGET_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#else
+#define HEMILIGHT_TARGET_CLONES_AVX2
+#endif
+
 namespace hemilight {
 
 namespace {
@@ -277,9 +294,7 @@ void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t st
                                         (nb[i] & after_bit) != 0);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void wall_sums_given_float(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
                            const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
   wall_sums_impl<float, true>(r, g, b, wall_inv, cx, cy, step, end, cap, acc);
@@ -373,33 +388,25 @@ inline __attribute__((always_inline)) void vector_sums_impl(const float* r, cons
 // The float kernel is compiled twice where the compiler can dispatch at load time (GCC/Clang on
 // x86-64 Linux: an AVX2 clone and the portable SSE2 default, picked by the CPU); the two give the
 // same sums up to the order of float additions inside a block.
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void directional_sums_float(const float* r, const float* g, const float* b, const float* omega, const float* h0,
                             const float* h1, const float* h2, std::size_t count, double* d) {
   directional_sums_impl<float>(r, g, b, omega, h0, h1, h2, count, d);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void wall_sums_float(const float* r, const float* g, const float* b, const float* inv, const float* cx, const float* cy,
                      std::size_t step, std::size_t end, float cap, double* acc) {
   wall_sums_impl<float>(r, g, b, inv, cx, cy, step, end, cap, acc);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void vector_sums_float(const float* r, const float* g, const float* b, const float* vx, const float* vy, std::size_t count,
                        double* phi) {
   vector_sums_impl<float>(r, g, b, vx, vy, count, phi);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 float texel_sums_float(const float* r, const float* g, const float* b, const float* dist, const std::uint8_t* flags,
                        const float* vz, float* inv, std::size_t count, double* s1) {
   return texel_sums_impl<float>(r, g, b, dist, flags, vz, inv, count, s1);
