@@ -320,7 +320,7 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight
  * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
  * Cost: 2 hemicubes and their projections per probe plus the lights' shadow rays (Cornell box,
  * N = 64: ~7k probes/s per core, 14k on two; docs/probes.md); tables of 36 N^2 floats per N,
- * kept up to N = 512. */
+ * kept between calls within the table budget (hemilight_set_table_budget). */
 HEMILIGHT_API hemilight_status hemilight_sample_probes(const hemilight_scene* scene, const float* positions, size_t count,
                                                        int resolution, int thread_count, float* sh9_rgb);
 

@@ -328,7 +328,10 @@ inline __attribute__((always_inline)) float texel_sums_impl(const float* r, cons
     const Inner sums[6] = {e0, e1, e2, pt, hs, bk};
     for (int k = 0; k < 6; ++k) s1[k] += double(sums[k]);
   }
-  return min_d;
+  // OpenMP starts each lane of a min reduction at the largest float (Clang does; GCC uses +inf),
+  // so a hemicube of misses only (all +inf) gives FLT_MAX there. No hit is that far (coordinates
+  // are at most 1e18): FLT_MAX means nothing was hit.
+  return min_d >= std::numeric_limits<float>::max() ? std::numeric_limits<float>::infinity() : min_d;
 }
 
 // The sums of the directional outputs not shared with E and g_r: per channel, L_i times the

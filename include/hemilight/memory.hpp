@@ -24,7 +24,7 @@ namespace hemilight {
 /// The default budget of the table cache: 256 MiB. It retains every table of two resolutions up
 /// to N = 512 at once (one sampler, cache and probe set at N = 512 needs about 106 MiB of tables),
 /// so common use never rebuilds a table, while a process that used many resolutions keeps at
-/// most this much (without a budget, N = 402..512 kept 2.45 GB).
+/// most this much (the tables of N = 402..512 alone add up to 2.45 GB).
 inline constexpr std::size_t default_table_budget = std::size_t(256) << 20;
 
 /// Sets the table cache's byte budget (0: retain nothing; tables then live only while held) and
