@@ -30,7 +30,7 @@ class table_lru {
                                   const std::function<std::shared_ptr<const void>(std::size_t&)>& build) {
     const key k{static_cast<int>(kind), n};
     std::shared_ptr<std::mutex> building;
-    {
+    {  // Step 1: a live table (retained, or held by someone) is shared.
       std::lock_guard<std::mutex> lock(mutex_);
       entry& e = entries_[k];
       if (std::shared_ptr<const void> found = find_locked(e)) return found;
@@ -44,8 +44,9 @@ class table_lru {
       entry& e = entries_[k];
       if (std::shared_ptr<const void> found = find_locked(e)) return found;
     }
+    // Step 3: build outside the cache's lock (other keys go on), then retain and evict.
     std::size_t bytes = 0;
-    std::shared_ptr<const void> table = build(bytes);  // outside the cache's lock: other keys go on
+    std::shared_ptr<const void> table = build(bytes);
     std::lock_guard<std::mutex> lock(mutex_);
     ++builds_;
     entry& e = entries_[k];
