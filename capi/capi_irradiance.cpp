@@ -65,6 +65,13 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
                              "or HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS (2)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     const hemilight::cache_options o = hemilight::capi::to_cpp(full);
+    // Every option before the sampler builds its tables (up to GBs at N = 4096); the message as
+    // cache_irradiance's own check gives it below.
+    try {
+      hemilight::validate_cache_options(o, "cache_irradiance");
+    } catch (const hemilight::error& e) {
+      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
+    }
     hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
     so.raster.sky = scene->sky;
     const hemilight::irradiance_sampler sampler =

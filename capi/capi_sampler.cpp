@@ -7,10 +7,18 @@
 #include "hemilight/lights.hpp"
 #include "hemilight/parallel.hpp"
 
+#include "hemilight/memory.hpp"
+
+#if defined(__GLIBC__)
+#include <malloc.h>  // malloc_trim
+#endif
+
 #include <algorithm>
 #include <atomic>
 #include <memory>
 #include <cmath>
+#include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -111,6 +119,50 @@ namespace {
 
 const char* const overflow_message = "the irradiance overflows float (a light too intense or too close to the point?)";
 
+// The per-thread context of hemilight_sample_irradiance, registered so that
+// hemilight_release_tables can free the contexts of every thread not inside a call.
+struct thread_context;
+
+struct context_registry {
+  std::mutex mutex;
+  std::set<thread_context*> contexts;
+};
+
+// Never destroyed: threads may end (and unregister) after static destructors ran.
+context_registry& registry() {
+  static context_registry* const instance = new context_registry;
+  return *instance;
+}
+
+struct thread_context {
+  std::mutex in_use;  // held by the owning thread during a call, and by a release freeing it
+  hemilight::capi::point_sampler sampler;
+  thread_context() {
+    context_registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.contexts.insert(this);
+  }
+  ~thread_context() {
+    context_registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.contexts.erase(this);
+  }
+  thread_context(const thread_context&) = delete;
+  thread_context& operator=(const thread_context&) = delete;
+};
+
+// Frees the contexts of every thread that is not inside hemilight_sample_irradiance (a thread
+// inside a call keeps its context; it is freed by a later release).
+void release_thread_contexts() noexcept {
+  context_registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  for (thread_context* c : r.contexts) {
+    if (!c->in_use.try_lock()) continue;
+    c->sampler = hemilight::capi::point_sampler{};
+    c->in_use.unlock();
+  }
+}
+
 using hemilight::capi::check_point;
 using hemilight::capi::check_resolution;
 using hemilight::capi::guarded;
@@ -131,10 +183,13 @@ hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const
     // The context is kept per thread between calls (tables, scratch) up to cached_resolution,
     // bound to the call's scene for the call only: no thread keeps a released scene alive.
     // Above it, a context for this call alone (its tables are then a small part of the render).
+    // hemilight_release_tables frees the kept contexts of threads not inside a call.
     constexpr int cached_resolution = 512;
-    thread_local hemilight::capi::point_sampler cached;
+    thread_local thread_context cached;
     hemilight::capi::point_sampler own;
-    hemilight::capi::point_sampler& context = resolution <= cached_resolution ? cached : own;
+    std::unique_lock<std::mutex> in_use;
+    if (resolution <= cached_resolution) in_use = std::unique_lock<std::mutex>(cached.in_use);
+    hemilight::capi::point_sampler& context = resolution <= cached_resolution ? cached.sampler : own;
     struct unbind_after {
       hemilight::capi::point_sampler& c;
       ~unbind_after() {
@@ -206,11 +261,15 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
         return check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i);
     // Step 2: the points on the workers, one context each, into a buffer of our own (each
     // point's result depends on that point alone: the same for any thread count).
-    const int workers = hemilight::resolve_thread_count(thread_count);
-    std::vector<hemilight::capi::point_sampler> contexts(static_cast<std::size_t>(workers));
+    // Contexts are made by the workers on their first chunk: only workers that run allocate (at
+    // most min(thread_count, chunks of 16 points), as parallel_for starts no more).
+    constexpr std::size_t grain = 16;
+    const std::size_t workers =
+        std::min(static_cast<std::size_t>(hemilight::resolve_thread_count(thread_count)), (count + grain - 1) / grain);
+    std::vector<hemilight::capi::point_sampler> contexts(workers);
     std::vector<hemilight_irradiance> results(count);
     std::atomic<std::size_t> first_bad{count};  // the lowest index whose result overflowed
-    hemilight::parallel_for(count, workers, 16, [&](int worker, std::size_t b, std::size_t e) {
+    hemilight::parallel_for(count, static_cast<int>(workers), grain, [&](int worker, std::size_t b, std::size_t e) {
       hemilight::capi::point_sampler& c = contexts[std::size_t(worker)];
       if (!c.raster) c.prepare(*scene, resolution);
       for (std::size_t i = b; i < e; ++i)
@@ -225,6 +284,22 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
     std::copy(results.begin(), results.end(), out);
     return HEMILIGHT_OK;
   });
+}
+
+void hemilight_set_table_budget(size_t bytes) { hemilight::set_table_budget(bytes); }
+
+size_t hemilight_table_budget(void) { return hemilight::table_budget(); }
+
+size_t hemilight_table_bytes(void) { return hemilight::table_cache_stats().retained_bytes; }
+
+void hemilight_release_tables(void) {
+  release_thread_contexts();  // first: the contexts hold references to tables
+  hemilight::release_tables();
+#if defined(__GLIBC__)
+  // Tables and scratch of a few MB each sit below glibc's mmap threshold: freed, they stay in
+  // the heap's free lists. Hand them back to the system.
+  malloc_trim(0);
+#endif
 }
 
 }  // extern "C"

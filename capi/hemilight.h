@@ -253,9 +253,11 @@ typedef struct hemilight_irradiance {
  * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
  * normal, a zero normal, N odd or outside [2, 4096].
  * Cost: one hemicube (Cornell box, N = 64: about 25 us on one core, docs/capi.md). Each thread
- * keeps the tables of the last N it used up to N = 512 (about 40 bytes per hemicube texel, 3 N^2:
- * 0.5 MB at N = 64, 31 MB at N = 512) between calls, but no reference to the scene; the first call
- * on a thread for a new N builds them (~5 ms at N = 64). Above N = 512 every call builds its own.
+ * keeps a context for the last N it used up to N = 512 (scratch and a reference to its tables:
+ * 342 N^2 bytes, 1.3 MiB at N = 64, 86 MiB at N = 512; hemilight_release_tables frees it)
+ * between calls, but no reference to the scene; the first call on a thread for a new N builds it
+ * (~5 ms at N = 64). Above N = 512 every call makes its own context (the tables come from the
+ * table cache while they fit its budget).
  * For many points use hemilight_sampler_irradiance (one per thread) or the batch below. */
 HEMILIGHT_API hemilight_status hemilight_sample_irradiance(const hemilight_scene* scene, const float position[3],
                                                            const float normal[3], int resolution,
@@ -318,7 +320,7 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight
  * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
  * Cost: 2 hemicubes and their projections per probe plus the lights' shadow rays (Cornell box,
  * N = 64: ~7k probes/s per core, 14k on two; docs/probes.md); tables of 36 N^2 floats per N,
- * kept up to N = 512. */
+ * kept between calls within the table budget (hemilight_set_table_budget). */
 HEMILIGHT_API hemilight_status hemilight_sample_probes(const hemilight_scene* scene, const float* positions, size_t count,
                                                        int resolution, int thread_count, float* sh9_rgb);
 
@@ -780,6 +782,35 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_irradiance(const float* input, 
                                                             hemilight_edge_fixup fixup, int output_size,
                                                             const hemilight_cubemap_irradiance_options* options,
                                                             float* output);
+/* ---- memory kept between calls -----------------------------------------------------------------
+ * Tables that depend only on a resolution (hemicube weights, integrator weights, SH9 and HL2 cone
+ * weights, cube-map face tables) are built on first use and kept in one process-wide cache of the
+ * least recently used ones within a byte budget (default 256 MiB: every table of two hemicube
+ * resolutions up to 512). A table in use by a sampler, a call or another thread is never freed
+ * under it. Besides the cache, each thread that called hemilight_sample_irradiance with N <= 512
+ * keeps one context for its last N: 45 bytes per hemicube texel (3 N^2) of scratch plus a
+ * reference to that N's integrator weights (69 bytes per texel), 342 N^2 bytes in all (86 MiB at
+ * N = 512, 1.3 MiB at N = 64). docs/reliability.md ("Memory") gives every entry's peak. */
+
+/* Sets the table cache's budget in bytes (0: keep no table between calls) and frees least
+ * recently used tables until the kept ones fit. Never fails; thread-safe. Cost: O(tables kept). */
+HEMILIGHT_API void hemilight_set_table_budget(size_t bytes);
+
+/* The table cache's budget in bytes (268435456 unless hemilight_set_table_budget changed it). */
+HEMILIGHT_API size_t hemilight_table_budget(void);
+
+/* Bytes of the tables the cache keeps now (<= the budget; tables held only by live samplers or
+ * running calls are not counted). Thread-safe. */
+HEMILIGHT_API size_t hemilight_table_bytes(void);
+
+/* Frees what hemilight keeps between calls: every table in the cache (the budget is unchanged)
+ * and the per-thread context of hemilight_sample_irradiance of every thread not inside a call at
+ * that moment (a thread inside a call keeps its context until a later release or its exit), then
+ * (with glibc) returns the freed heap memory to the system (malloc_trim).
+ * Tables used by live samplers (hemilight_sampler_create) stay until those are released. Later
+ * calls rebuild what they need, with bitwise the same results. Never fails; thread-safe.
+ * Cost: O(tables kept + threads). */
+HEMILIGHT_API void hemilight_release_tables(void);
 
 #ifdef __cplusplus
 }

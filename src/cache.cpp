@@ -4,6 +4,8 @@
 
 #include "hemilight/parallel.hpp"
 
+#include "table_cache.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -883,15 +885,15 @@ std::shared_ptr<const cone_weights> build_cone_weights(int n) {
   return out;
 }
 
-// The table of resolution n, built once per process for n <= 512 (like integration_table::get).
+// The table of resolution n, in the process's table cache (table_cache.hpp, like
+// integration_table::get).
 std::shared_ptr<const cone_weights> make_cone_weights(int n) {
-  static std::mutex mutex;
-  static std::unordered_map<int, std::shared_ptr<const cone_weights>> cache;
-  if (n > 512) return build_cone_weights(n);
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[n];
-  if (!slot) slot = build_cone_weights(n);
-  return slot;
+  return detail::cached_table<cone_weights>(detail::table_kind::cone_weights, n, [n] { return build_cone_weights(n); },
+                                            [](const cone_weights& t) {
+                                              std::size_t bytes = 0;
+                                              for (const std::vector<float>& v : t.w) bytes += detail::vector_bytes(v);
+                                              return bytes;
+                                            });
 }
 
 // out[c] += sum_i plane_c[i] w[i] for the three planes r, g, b of `count` texels (a multiple of

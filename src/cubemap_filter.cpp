@@ -4,14 +4,13 @@
 #include "hemilight/parallel.hpp"
 
 #include "cubemap_internal.hpp"
+#include "table_cache.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
-#include <map>
-#include <mutex>
 #include <string>
 
 #if defined(__SSE2__)
@@ -59,13 +58,10 @@ face_table::face_table(int size) : n(size), texels(std::size_t(size) * std::size
 }
 
 std::shared_ptr<const face_table> face_table::get(int size) {
-  static std::mutex mutex;
-  static std::map<int, std::shared_ptr<const face_table>> cache;
-  if (size > 1024) return std::make_shared<const face_table>(size);
-  std::lock_guard<std::mutex> lock(mutex);
-  std::shared_ptr<const face_table>& slot = cache[size];
-  if (!slot) slot = std::make_shared<const face_table>(size);
-  return slot;
+  // Kept in the process's table cache (table_cache.hpp: LRU within the budget of memory.hpp).
+  return detail::cached_table<face_table>(
+      detail::table_kind::cube_face, size, [size] { return std::make_shared<const face_table>(size); },
+      [](const face_table& t) { return detail::vector_bytes(t.texels); });
 }
 
 }  // namespace cubemap_detail

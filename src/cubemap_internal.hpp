@@ -32,7 +32,7 @@ struct face_table {
   int n = 0;
   std::vector<glm::vec4> texels;
   explicit face_table(int size);
-  /// Shared table of one size (cached up to 1024 while the process lives). Thread-safe.
+  /// Shared table of one size (in the table cache of hemilight/memory.hpp). Thread-safe.
   static std::shared_ptr<const face_table> get(int size);
 };
 

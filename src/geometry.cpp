@@ -1,8 +1,8 @@
 #include "hemilight/geometry.hpp"
 
+#include "table_cache.hpp"
+
 #include <algorithm>
-#include <map>
-#include <mutex>
 #include <string>
 #include <thread>
 
@@ -88,21 +88,10 @@ hemicube_table::hemicube_table(int n) : n_(n) {
 
 std::shared_ptr<const hemicube_table> hemicube_table::get(int n) {
   if (!is_valid_hemicube_resolution(n)) return std::make_shared<const hemicube_table>(n);  // throws
-  // Tables up to N = 512 (6 MiB) stay cached for the life of the process, so a caller that does
-  // not hold one never pays for a rebuild; larger ones live only while someone holds them.
-  struct slot {
-    std::shared_ptr<const hemicube_table> strong;
-    std::weak_ptr<const hemicube_table> weak;
-  };
-  static std::mutex mutex;
-  static std::map<int, slot> cache;
-  std::lock_guard<std::mutex> lock(mutex);  // building under the lock: callers of one N wait once
-  slot& entry = cache[n];
-  if (std::shared_ptr<const hemicube_table> alive = entry.weak.lock()) return alive;
-  auto table = std::make_shared<const hemicube_table>(n);
-  entry.weak = table;
-  if (n <= 512) entry.strong = table;
-  return table;
+  // Kept in the process's table cache (table_cache.hpp: LRU within the budget of memory.hpp).
+  return detail::cached_table<hemicube_table>(
+      detail::table_kind::hemicube_weights, n, [n] { return std::make_shared<const hemicube_table>(n); },
+      [](const hemicube_table& t) { return detail::vector_bytes(t.solid_angle_) + detail::vector_bytes(t.projected_solid_angle_); });
 }
 
 }  // namespace hemilight

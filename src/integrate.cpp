@@ -2,12 +2,14 @@
 // passes (texels, walls) that reduce a hemicube buffer. See integrate.hpp and docs/integration.md.
 #include "hemilight/integrate.hpp"
 
+#include "hemilight/parallel.hpp"
+
+#include "table_cache.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <map>
-#include <mutex>
 #include <string>
 #include <type_traits>
 
@@ -17,6 +19,23 @@
 #define HEMILIGHT_TARGET_AVX2_FMA __attribute__((target("avx2,fma")))
 #else
 #define HEMILIGHT_INTEGRATE_AVX2 0
+#endif
+
+// AVX2 and default clones of the hot sums, picked at load time (an ifunc). Not under
+// ThreadSanitizer: the instrumented resolver would run before the sanitizer's runtime is set up
+// and crash the loader (the TSan build then runs the default clone).
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define HEMILIGHT_TSAN_BUILD 1
+#endif
+#endif
+#if defined(__SANITIZE_THREAD__)
+#define HEMILIGHT_TSAN_BUILD 1
+#endif
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__)) && !defined(HEMILIGHT_TSAN_BUILD)
+#define HEMILIGHT_TARGET_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#else
+#define HEMILIGHT_TARGET_CLONES_AVX2
 #endif
 
 namespace hemilight {
@@ -102,45 +121,51 @@ integration_table::integration_table(int n) : n_(n) {
   extrapolation_neighbours.assign(count, 0);
 
   const double s = 2.0 / n;
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::array<dvec3, 4> corners = hemicube_texel_corners(n, i);
-    const dvec3 v = vector_solid_angle(corners);
-    vx[i] = static_cast<float>(v.x);
-    vy[i] = static_cast<float>(v.y);
-    vz[i] = static_cast<float>(v.z);
-    const dvec3 c = texel_centre(n, i);
-    simple_x[i] = static_cast<float>(3.0 * v.z * c.x);
-    simple_y[i] = static_cast<float>(3.0 * v.z * c.y);
-    for (int k = 0; k < 3; ++k) {
-      const dvec3 b(hl2_basis[k][0], hl2_basis[k][1], hl2_basis[k][2]);
-      hl2[k][i] = static_cast<float>(std::max(0.0, glm::dot(v, b)));
-    }
-    solid_angle[i] = static_cast<float>(hemicube_texel_solid_angle(n, i));
+  // Each texel's entries depend on that texel alone: split over all cores for large tables (about
+  // 1 us per texel: N = 4096 took 50 s on one core), on the calling thread below 64k texels.
+  const int threads = count < (std::size_t(1) << 16) ? 1 : 0;
+  parallel_for(count, threads, 4096, [&](int, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      const std::array<dvec3, 4> corners = hemicube_texel_corners(n, i);
+      const dvec3 v = vector_solid_angle(corners);
+      vx[i] = static_cast<float>(v.x);
+      vy[i] = static_cast<float>(v.y);
+      vz[i] = static_cast<float>(v.z);
+      const dvec3 c = texel_centre(n, i);
+      simple_x[i] = static_cast<float>(3.0 * v.z * c.x);
+      simple_y[i] = static_cast<float>(3.0 * v.z * c.y);
+      for (int k = 0; k < 3; ++k) {
+        const dvec3 b(hl2_basis[k][0], hl2_basis[k][1], hl2_basis[k][2]);
+        hl2[k][i] = static_cast<float>(std::max(0.0, glm::dot(v, b)));
+      }
+      solid_angle[i] = static_cast<float>(hemicube_texel_solid_angle(n, i));
 
-    // Walls inside the face: to the right (x + 1) and up (y + 1) neighbours.
-    const hemicube_texel t = hemicube_texel_from_index(n, i);
-    const int height = hemicube_face_height(n, t.face);
-    extrapolation_neighbours[i] = static_cast<std::uint8_t>((t.x > 0 ? 1 : 0) | (t.x + 2 < n ? 2 : 0) |
-                                                            (t.y > 0 ? 4 : 0) | (t.y + 2 < height ? 8 : 0));
-    const glm::dvec2 lo = hemicube_texel_min_corner(n, t);
-    auto point = [&](double u, double w) { return glm::normalize(hemicube_face_point(t.face, u, w)); };
-    if (t.x + 1 < n) {
-      const wall_coefficients w = wall_between(point(lo.x + s, lo.y), point(lo.x + s, lo.y + s), c, texel_centre(n, i + 1));
-      right_great_arc_x[i] = static_cast<float>(w.great_arc.x);
-      right_great_arc_y[i] = static_cast<float>(w.great_arc.y);
-      right_classified_x[i] = static_cast<float>(w.classified.x);
-      right_classified_y[i] = static_cast<float>(w.classified.y);
+      // Walls inside the face: to the right (x + 1) and up (y + 1) neighbours.
+      const hemicube_texel t = hemicube_texel_from_index(n, i);
+      const int height = hemicube_face_height(n, t.face);
+      extrapolation_neighbours[i] = static_cast<std::uint8_t>((t.x > 0 ? 1 : 0) | (t.x + 2 < n ? 2 : 0) |
+                                                              (t.y > 0 ? 4 : 0) | (t.y + 2 < height ? 8 : 0));
+      const glm::dvec2 lo = hemicube_texel_min_corner(n, t);
+      auto point = [&](double u, double w) { return glm::normalize(hemicube_face_point(t.face, u, w)); };
+      if (t.x + 1 < n) {
+        const wall_coefficients w = wall_between(point(lo.x + s, lo.y), point(lo.x + s, lo.y + s), c, texel_centre(n, i + 1));
+        right_great_arc_x[i] = static_cast<float>(w.great_arc.x);
+        right_great_arc_y[i] = static_cast<float>(w.great_arc.y);
+        right_classified_x[i] = static_cast<float>(w.classified.x);
+        right_classified_y[i] = static_cast<float>(w.classified.y);
+      }
+      if (t.y + 1 < hemicube_face_height(n, t.face)) {
+        const wall_coefficients w = wall_between(point(lo.x, lo.y + s), point(lo.x + s, lo.y + s), c, texel_centre(n, i + un));
+        up_great_arc_x[i] = static_cast<float>(w.great_arc.x);
+        up_great_arc_y[i] = static_cast<float>(w.great_arc.y);
+        up_classified_x[i] = static_cast<float>(w.classified.x);
+        up_classified_y[i] = static_cast<float>(w.classified.y);
+      }
     }
-    if (t.y + 1 < hemicube_face_height(n, t.face)) {
-      const wall_coefficients w = wall_between(point(lo.x, lo.y + s), point(lo.x + s, lo.y + s), c, texel_centre(n, i + un));
-      up_great_arc_x[i] = static_cast<float>(w.great_arc.x);
-      up_great_arc_y[i] = static_cast<float>(w.great_arc.y);
-      up_classified_x[i] = static_cast<float>(w.classified.x);
-      up_classified_y[i] = static_cast<float>(w.classified.y);
-    }
-  }
+  });
 
   // Walls across face borders. (1) Each side face's top row meets the top face along z = 1.
+  border_walls.reserve(6 * un);
   auto add_border = [&](std::size_t a, std::size_t b, const dvec3& p0, const dvec3& p1) {
     const wall_coefficients w = wall_between(glm::normalize(p0), glm::normalize(p1), texel_centre(n, a), texel_centre(n, b));
     border_walls.push_back({static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
@@ -174,19 +199,18 @@ integration_table::integration_table(int n) : n_(n) {
 
 std::shared_ptr<const integration_table> integration_table::get(int n) {
   if (!is_valid_hemicube_resolution(n)) return std::make_shared<const integration_table>(n);  // throws
-  struct slot {
-    std::shared_ptr<const integration_table> strong;
-    std::weak_ptr<const integration_table> weak;
-  };
-  static std::mutex mutex;
-  static std::map<int, slot> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  slot& entry = cache[n];
-  if (auto alive = entry.weak.lock()) return alive;
-  auto table = std::make_shared<const integration_table>(n);
-  entry.weak = table;
-  if (n <= 512) entry.strong = table;
-  return table;
+  // Kept in the process's table cache (table_cache.hpp: LRU within the budget of memory.hpp).
+  return detail::cached_table<integration_table>(
+      detail::table_kind::integration, n, [n] { return std::make_shared<const integration_table>(n); },
+      [](const integration_table& t) {
+        std::size_t bytes = detail::vector_bytes(t.border_walls) + detail::vector_bytes(t.extrapolation_neighbours);
+        for (const std::vector<float>* v :
+             {&t.vx, &t.vy, &t.vz, &t.simple_x, &t.simple_y, &t.hl2[0], &t.hl2[1], &t.hl2[2], &t.solid_angle,
+              &t.right_great_arc_x, &t.right_great_arc_y, &t.up_great_arc_x, &t.up_great_arc_y, &t.right_classified_x,
+              &t.right_classified_y, &t.up_classified_x, &t.up_classified_y})
+          bytes += detail::vector_bytes(*v);
+        return bytes;
+      });
 }
 
 hemicube_integrator::hemicube_integrator(int resolution, const integrate_options& options)
@@ -270,9 +294,7 @@ void extrapolated_walls(const float* inv, const std::uint8_t* nb, std::size_t st
                                         (nb[i] & after_bit) != 0);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void wall_sums_given_float(const float* r, const float* g, const float* b, const float* wall_inv, const float* cx,
                            const float* cy, std::size_t step, std::size_t end, float cap, double* acc) {
   wall_sums_impl<float, true>(r, g, b, wall_inv, cx, cy, step, end, cap, acc);
@@ -306,7 +328,10 @@ inline __attribute__((always_inline)) float texel_sums_impl(const float* r, cons
     const Inner sums[6] = {e0, e1, e2, pt, hs, bk};
     for (int k = 0; k < 6; ++k) s1[k] += double(sums[k]);
   }
-  return min_d;
+  // OpenMP starts each lane of a min reduction at the largest float (Clang does; GCC uses +inf),
+  // so a hemicube of misses only (all +inf) gives FLT_MAX there. No hit is that far (coordinates
+  // are at most 1e18): FLT_MAX means nothing was hit.
+  return min_d >= std::numeric_limits<float>::max() ? std::numeric_limits<float>::infinity() : min_d;
 }
 
 // The sums of the directional outputs not shared with E and g_r: per channel, L_i times the
@@ -366,33 +391,25 @@ inline __attribute__((always_inline)) void vector_sums_impl(const float* r, cons
 // The float kernel is compiled twice where the compiler can dispatch at load time (GCC/Clang on
 // x86-64 Linux: an AVX2 clone and the portable SSE2 default, picked by the CPU); the two give the
 // same sums up to the order of float additions inside a block.
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void directional_sums_float(const float* r, const float* g, const float* b, const float* omega, const float* h0,
                             const float* h1, const float* h2, std::size_t count, double* d) {
   directional_sums_impl<float>(r, g, b, omega, h0, h1, h2, count, d);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void wall_sums_float(const float* r, const float* g, const float* b, const float* inv, const float* cx, const float* cy,
                      std::size_t step, std::size_t end, float cap, double* acc) {
   wall_sums_impl<float>(r, g, b, inv, cx, cy, step, end, cap, acc);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 void vector_sums_float(const float* r, const float* g, const float* b, const float* vx, const float* vy, std::size_t count,
                        double* phi) {
   vector_sums_impl<float>(r, g, b, vx, vy, count, phi);
 }
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target_clones("avx2", "default")))
-#endif
+HEMILIGHT_TARGET_CLONES_AVX2
 float texel_sums_float(const float* r, const float* g, const float* b, const float* dist, const std::uint8_t* flags,
                        const float* vz, float* inv, std::size_t count, double* s1) {
   return texel_sums_impl<float>(r, g, b, dist, flags, vz, inv, count, s1);

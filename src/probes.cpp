@@ -8,10 +8,10 @@
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
 
+#include "table_cache.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <mutex>
 #include <string>
 
 namespace hemilight {
@@ -74,15 +74,11 @@ class sh9_texel_table {
   std::size_t texels() const noexcept { return texels_; }
   const float* weights(int k) const noexcept { return weights_.data() + std::size_t(k) * texels_; }
 
-  // The shared table of resolution N (cached up to N = 512, as hemicube_table).
+  // The shared table of resolution N, in the process's table cache (table_cache.hpp).
   static std::shared_ptr<const sh9_texel_table> get(int n) {
-    static std::mutex m;
-    static std::map<int, std::shared_ptr<const sh9_texel_table>> cache;
-    if (n > 512) return std::make_shared<const sh9_texel_table>(n);
-    std::lock_guard<std::mutex> lock(m);
-    auto& slot = cache[n];
-    if (!slot) slot = std::make_shared<const sh9_texel_table>(n);
-    return slot;
+    return detail::cached_table<sh9_texel_table>(
+        detail::table_kind::sh9_texel, n, [n] { return std::make_shared<const sh9_texel_table>(n); },
+        [](const sh9_texel_table& t) { return detail::vector_bytes(t.weights_); });
   }
 
  private:
@@ -192,7 +188,11 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   const int n = o.resolution;
   const std::shared_ptr<const sh9_texel_table> table = sh9_texel_table::get(n);
   const std::shared_ptr<const hemicube_table> solid = hemicube_table::get(n);
-  const int workers = resolve_thread_count(o.thread_count);
+  // One context per worker that runs (at most min(thread_count, chunks of 8 points)), made by the
+  // worker on its first chunk.
+  constexpr std::size_t grain = 8;
+  const int workers = static_cast<int>(
+      std::min(static_cast<std::size_t>(resolve_thread_count(o.thread_count)), (count + grain - 1) / grain));
   raster_options ro;
   ro.sky = o.sky;
   struct context {
@@ -203,7 +203,7 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   const frame up{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, down{{1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
   static constexpr float up_sign[9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
   // Step 3: per point, the two hemicubes, their projections, the lights.
-  parallel_for(count, workers, 8, [&](int worker, std::size_t b, std::size_t e) {
+  parallel_for(count, workers, grain, [&](int worker, std::size_t b, std::size_t e) {
     context& cx = contexts[std::size_t(worker)];
     if (!cx.raster) cx.raster = std::make_unique<hemicube_rasterizer>(s, ro);
     for (std::size_t i = b; i < e; ++i) {

@@ -173,7 +173,8 @@ double hemicube_texel_projected_solid_angle(int n, std::size_t index) noexcept;
 /// Per-texel weights of one resolution, computed once and shared (immutable, thread-safe).
 ///
 /// Memory: 8 bytes per texel, 24 N^2 bytes (N = 64: 98 KiB; N = 512: 6 MiB; N = 4096: 384 MiB).
-/// get() caches tables up to N = 512 for the life of the process; larger ones live while held.
+/// get() keeps tables in the process's table cache (memory.hpp: least recently used ones are
+/// dropped beyond its byte budget; a table in use lives while held).
 class hemicube_table {
  public:
   /// The shared table of resolution N, built on first use (cost: about 100 ns per texel, split

@@ -4,6 +4,7 @@
 //   error.hpp     status codes, hemilight::error, version
 //   geometry.hpp  hemicube layout and exact texel weights, GL cube-map faces, frames
 //   image_io.hpp  float images and cube maps as OpenEXR
+//   memory.hpp    the budget of the tables kept between calls, and freeing them
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
 //   scene.hpp     immutable triangle scenes with materials, lightmap UVs, sky and BVH
@@ -27,6 +28,7 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/integrate.hpp"
 #include "hemilight/lights.hpp"
+#include "hemilight/memory.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/probes.hpp"
 #include "hemilight/raster.hpp"

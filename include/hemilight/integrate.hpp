@@ -96,8 +96,9 @@ struct irradiance_sample {
 /// Memory: 69 bytes per texel plus 6 N walls (N = 64: 0.8 MiB, N = 256: 13 MiB, N = 1024: 204 MiB).
 class integration_table {
  public:
-  /// The shared table of resolution N (cached like hemicube_table: up to N = 512 for the
-  /// process's life, larger ones while held). Cost of the first call: ~1 us per texel.
+  /// The shared table of resolution N (cached like hemicube_table: in the table cache of
+  /// memory.hpp, within its budget; a table in use lives while held). Cost of a build: ~1 us
+  /// per texel.
   /// Throws error(invalid_argument) for an invalid N.
   static std::shared_ptr<const integration_table> get(int n);
   explicit integration_table(int n);  ///< builds a private table; prefer get()

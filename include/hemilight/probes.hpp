@@ -92,7 +92,7 @@ struct probe_result {
 /// thread_count, bad direct options, an invalid texture or one on a scene without lightmap UVs.
 /// Cost: 2 hemicubes and their projections per point (Cornell box, N = 64: ~140 us on one core,
 /// 7k probes/s; docs/probes.md) plus the lights' shadow rays; tables of 36 N^2 floats per N
-/// (cached up to N = 512).
+/// (kept in the table cache of memory.hpp, within its budget).
 probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* positions, std::size_t count,
                            const probe_options& options = {});
 
