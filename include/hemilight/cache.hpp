@@ -304,7 +304,7 @@ struct hemicube_sampler_options {
   /// closed-form Fourier series of the clamped cosine max(0, w . b(phi)), integrated over 8 x 8
   /// sub-rectangles of each texel with exact solid angles, or exactly (the texel's vector solid
   /// angle) where the whole texel is within 35.26 degrees of the normal. Cost: one table per
-  /// resolution (28 bytes per texel; built once per process up to N = 512: ~0.1 s at N = 64) and
+  /// resolution (28 bytes per texel; built on first use and kept in the table cache, memory.hpp: ~0.1 s at N = 64) and
   /// 21 multiply-adds per texel.
   bool hl2_cone = false;
 };
