@@ -54,7 +54,6 @@
 #include "model_import.hpp"
 #include "preview.hpp"
 
-#include <png.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -366,7 +365,7 @@ scene_bake_input model_scene(const model_import::model& m, const settings& s, sc
   return in;
 }
 
-// The preview: exposure, Reinhard, sRGB, 8-bit PNG through libpng's simplified API.
+// The atlas preview: preview::write_png's tone mapping, exposed for the mean over sampled texels.
 void write_png_preview(const std::string& path, const bake_result& r) {
   const image& e = r.irradiance;
   double sum = 0.0;
@@ -376,23 +375,11 @@ void write_png_preview(const std::string& path, const bake_result& r) {
       sum += 0.2126 * e.pixels[3 * k] + 0.7152 * e.pixels[3 * k + 1] + 0.0722 * e.pixels[3 * k + 2];
       ++n;
     }
-  const double mean = n ? sum / double(n) : 0.0;
-  const double k = mean > 0.0 ? 0.5 / mean : 1.0;
-  std::vector<unsigned char> rgb(e.pixels.size());
-  for (std::size_t i = 0; i < e.pixels.size(); ++i) {
-    const double x = std::max(0.0, double(e.pixels[i])) * k;
-    const double t = x / (1.0 + x);
-    const double s = t <= 0.0031308 ? 12.92 * t : 1.055 * std::pow(t, 1.0 / 2.4) - 0.055;
-    rgb[i] = static_cast<unsigned char>(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
+  try {
+    preview::write_png(path, e, n ? sum / double(n) : 0.0);
+  } catch (const std::runtime_error& err) {
+    fail(err.what());
   }
-  png_image img;
-  std::memset(&img, 0, sizeof img);
-  img.version = PNG_IMAGE_VERSION;
-  img.width = png_uint_32(e.width);
-  img.height = png_uint_32(e.height);
-  img.format = PNG_FORMAT_RGB;
-  if (!png_image_write_to_file(&img, path.c_str(), 0, rgb.data(), 0, nullptr))
-    fail("cannot write '" + path + "': " + img.message);
 }
 
 // A progress bar on stderr with the time left (linear in the bake fraction).

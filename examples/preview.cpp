@@ -250,7 +250,10 @@ void write_png(const std::string& path, const image& picture) {
   const std::size_t pixels = picture.pixels.size() / 3;
   for (std::size_t k = 0; k < pixels; ++k)
     sum += 0.2126 * picture.pixels[3 * k] + 0.7152 * picture.pixels[3 * k + 1] + 0.0722 * picture.pixels[3 * k + 2];
-  const double mean = pixels ? sum / double(pixels) : 0.0;
+  write_png(path, picture, pixels ? sum / double(pixels) : 0.0);
+}
+
+void write_png(const std::string& path, const image& picture, double mean) {
   const double k = mean > 0.0 ? 0.5 / mean : 1.0;
   std::vector<unsigned char> rgb(picture.pixels.size());
   for (std::size_t i = 0; i < picture.pixels.size(); ++i) {

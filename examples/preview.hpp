@@ -43,9 +43,12 @@ image render(const scene_bake_input& in, const std::vector<image>& radiance, con
 /// outside). Cost: eight hemicubes at N = 64.
 camera default_camera(const scene_bake_input& in, const std::vector<image>& radiance);
 
-/// Writes a picture as an 8-bit sRGB PNG (libpng) with the baker's tone mapping: exposure
-/// k = 0.5 / (mean luminance of all pixels), Reinhard c k / (1 + c k), sRGB curve. Throws
+/// Writes a picture (RGB) as an 8-bit sRGB PNG (libpng) with the baker's tone mapping: exposure
+/// k = 0.5 / mean_luminance (1 if it is not > 0), Reinhard c k / (1 + c k), sRGB curve. Throws
 /// std::runtime_error naming the file on failure.
+void write_png(const std::string& path, const image& picture, double mean_luminance);
+
+/// write_png with the mean luminance of all pixels.
 void write_png(const std::string& path, const image& picture);
 
 }  // namespace hemilight::preview
