@@ -29,7 +29,7 @@
 // The filter time covers the filter call alone (input already in memory); read and write are
 // timed apart. filter_cpu_s is the process's CPU time (user + system) during the filter:
 // filter_cpu_s / filter_s is how many cores it actually had (the scheduler shares the cores
-// between sessions, so on a loaded machine a second thread may get no second core).
+// between process groups, so on a loaded machine a second thread may get no second core).
 #include "hemilight/cubemap.hpp"
 #include "hemilight/image_io.hpp"
 

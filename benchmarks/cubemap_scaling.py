@@ -7,8 +7,8 @@ records the 1-minute load average before the pair. Wall time, the process's CPU 
 filter and their ratio (the cores it actually had) are written per run; the summary gives the
 medians and the median of the per-round ratios t(1) / t(2).
 
-On a machine shared with other sessions the kernel's autogroup scheduling gives each session an
-equal share of the cores: once the load is above the core count, a second thread gets no second
+On a machine shared with other users the kernel's autogroup scheduling gives each process group
+(one per terminal) an equal share of the cores: once the load is above the core count, a second thread gets no second
 core and the wall-time ratio says nothing about the filter. Read the ratio together with
 cpu/wall (the cores had) and the load.
 
