@@ -1120,42 +1120,91 @@ std::array<double, 9> sh9_basis(const glm::dvec3& w) noexcept {
           0.5462742152960396 * (x * x - y * y)};
 }
 
-sh9 project_sh9(const cube_image& level, int thread_count) {
-  validate_level("project_sh9", level);
+namespace {
+
+// The projection of project_sh9 and project_sh25: per row of texels a float sum of
+// L(w) Y_k(w) d omega (basis(w, b) writes Y_0..Y_{K-1} at w into b), the rows added in double in
+// row order, so the result is the same for any thread count. `who` names the caller in errors.
+template <std::size_t K, class Basis>
+std::array<glm::dvec4, K> project_sh(const char* who, const cube_image& level, int thread_count, Basis basis) {
+  validate_level(who, level);
   const int n = level.size;
   const std::shared_ptr<const face_table> table = face_table::get(n);
   const std::size_t rows = 6u * std::size_t(n), ch = std::size_t(level.channels);
-  std::vector<sh9> partial(rows);  // one partial sum per row, added in row order: deterministic
+  std::vector<std::array<glm::dvec4, K>> partial(rows);  // one partial sum per row
   parallel_for(rows, thread_count, 8, [&](int, std::size_t begin, std::size_t end) {
+    float b[K];
     for (std::size_t r = begin; r < end; ++r) {
       const int f = static_cast<int>(r / std::size_t(n)), y = static_cast<int>(r % std::size_t(n));
       const face_frame& fr = frame_of(f);
-      // Float sums within the row (at most 16384 terms of similar size), double across rows.
-      std::array<glm::vec4, 9> acc{};
+      // Float sums within the row (at most 6688 terms of similar size), double across rows.
+      std::array<glm::vec4, K> acc{};
       for (int x = 0; x < n; ++x) {
         const glm::vec4& t = table->texels[std::size_t(y) * std::size_t(n) + std::size_t(x)];
         const glm::vec3 w = fr.column * t.x + fr.row * t.y + fr.axis * t.z;
         const float* p = level.at(f, x, y);
         const glm::vec4 lw = glm::vec4(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f) * t.w;
-        acc[0] += lw * 0.28209479177387814f;
-        acc[1] += lw * (0.4886025119029199f * w.y);
-        acc[2] += lw * (0.4886025119029199f * w.z);
-        acc[3] += lw * (0.4886025119029199f * w.x);
-        acc[4] += lw * (1.0925484305920792f * w.x * w.y);
-        acc[5] += lw * (1.0925484305920792f * w.y * w.z);
-        acc[6] += lw * (0.31539156525252005f * (3.0f * w.z * w.z - 1.0f));
-        acc[7] += lw * (1.0925484305920792f * w.x * w.z);
-        acc[8] += lw * (0.5462742152960396f * (w.x * w.x - w.y * w.y));
+        basis(w, b);
+        for (std::size_t k = 0; k < K; ++k) acc[k] += lw * b[k];
       }
-      sh9 row_sum;
-      for (std::size_t k = 0; k < 9; ++k) row_sum.coefficients[k] = glm::dvec4(acc[k]);
-      partial[r] = row_sum;
+      for (std::size_t k = 0; k < K; ++k) partial[r][k] = glm::dvec4(acc[k]);
     }
   });
-  sh9 total;
-  for (const sh9& s : partial)
-    for (std::size_t k = 0; k < 9; ++k) total.coefficients[k] += s.coefficients[k];
+  std::array<glm::dvec4, K> total{};
+  for (const auto& row : partial)
+    for (std::size_t k = 0; k < K; ++k) total[k] += row[k];
   return total;
+}
+
+// The output of irradiance_from_sh9 and irradiance_from_sh25: checks size, channels and mapping,
+// then each texel gets E = irradiance(n) at its unit direction n under `mapping` (RGB; alpha, if
+// any, is E.w / pi: the cosine-weighted mean, not scaled).
+template <class Irradiance>
+cube_image irradiance_map(const char* who, int size, edge_fixup mapping, int channels, int thread_count, Irradiance irradiance) {
+  check_output_size(who, size);
+  if (channels != 3 && channels != 4)
+    throw_invalid_argument(std::string(who) + ": channels is " + std::to_string(channels) + "; it must be 3 or 4");
+  const int m = static_cast<int>(mapping);
+  if (m < 0 || m > 2) throw_invalid_argument(std::string(who) + ": mapping " + std::to_string(m) + " is not 0, 1 or 2");
+  cube_image out = cube_image::make(size, channels);
+  const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
+  std::vector<float> coord(static_cast<std::size_t>(size));  // the mapping's face coordinate of each index
+  for (int i = 0; i < size; ++i) coord[std::size_t(i)] = static_cast<float>(cubemap_texel_coordinate(size, i, mapping));
+  parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
+      const face_frame& fr = frame_of(f);
+      const glm::vec3 row_point = fr.axis + coord[std::size_t(y)] * fr.row;
+      for (int x = 0; x < size; ++x) {
+        const glm::vec3 p3 = row_point + coord[std::size_t(x)] * fr.column;
+        const glm::vec4 e = irradiance(p3 / std::sqrt(glm::dot(p3, p3)));
+        float* p = out.at(f, x, y);
+        p[0] = e.x;
+        p[1] = e.y;
+        p[2] = e.z;
+        if (ch == 4) p[3] = static_cast<float>(static_cast<double>(e.w) / pi);
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
+sh9 project_sh9(const cube_image& level, int thread_count) {
+  sh9 out;
+  out.coefficients = project_sh<9>("project_sh9", level, thread_count, [](const glm::vec3& w, float* b) {
+    b[0] = 0.28209479177387814f;
+    b[1] = 0.4886025119029199f * w.y;
+    b[2] = 0.4886025119029199f * w.z;
+    b[3] = 0.4886025119029199f * w.x;
+    b[4] = 1.0925484305920792f * w.x * w.y;
+    b[5] = 1.0925484305920792f * w.y * w.z;
+    b[6] = 0.31539156525252005f * (3.0f * w.z * w.z - 1.0f);
+    b[7] = 1.0925484305920792f * w.x * w.z;
+    b[8] = 0.5462742152960396f * (w.x * w.x - w.y * w.y);
+  });
+  return out;
 }
 
 glm::dvec4 sh9_irradiance(const sh9& radiance, const glm::dvec3& n) noexcept {
@@ -1168,13 +1217,6 @@ glm::dvec4 sh9_irradiance(const sh9& radiance, const glm::dvec3& n) noexcept {
 }
 
 cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping, int channels, int thread_count) {
-  check_output_size("irradiance_from_sh9", size);
-  if (channels != 3 && channels != 4)
-    throw_invalid_argument("irradiance_from_sh9: channels is " + std::to_string(channels) + "; it must be 3 or 4");
-  const int m = static_cast<int>(mapping);
-  if (m < 0 || m > 2) throw_invalid_argument("irradiance_from_sh9: mapping " + std::to_string(m) + " is not 0, 1 or 2");
-  cube_image out = cube_image::make(size, channels);
-  const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
   // E(n) is a quadratic polynomial in n: fold the band factors and basis constants into one
   // coefficient per monomial (1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2) and channel.
   static constexpr double band[9] = {pi, 2.0 * pi / 3, 2.0 * pi / 3, 2.0 * pi / 3, pi / 4, pi / 4, pi / 4, pi / 4, pi / 4};
@@ -1183,27 +1225,10 @@ cube_image irradiance_from_sh9(const sh9& radiance, int size, edge_fixup mapping
                                                0.31539156525252005, 1.0925484305920792, 0.5462742152960396};
   std::array<glm::vec4, 9> k;
   for (std::size_t j = 0; j < 9; ++j) k[j] = glm::vec4(radiance.coefficients[j] * (band[j] * basis_constant[j]));
-  std::vector<float> coord(static_cast<std::size_t>(size));  // the mapping's face coordinate of each index
-  for (int i = 0; i < size; ++i) coord[std::size_t(i)] = static_cast<float>(cubemap_texel_coordinate(size, i, mapping));
-  parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
-      const face_frame& fr = frame_of(f);
-      const glm::vec3 row_point = fr.axis + coord[std::size_t(y)] * fr.row;
-      for (int x = 0; x < size; ++x) {
-        const glm::vec3 p3 = row_point + coord[std::size_t(x)] * fr.column;
-        const glm::vec3 n = p3 / std::sqrt(glm::dot(p3, p3));
-        const glm::vec4 e = k[0] + k[1] * n.y + k[2] * n.z + k[3] * n.x + k[4] * (n.x * n.y) + k[5] * (n.y * n.z) +
-                            k[6] * (3.0f * n.z * n.z - 1.0f) + k[7] * (n.x * n.z) + k[8] * (n.x * n.x - n.y * n.y);
-        float* p = out.at(f, x, y);
-        p[0] = e.x;
-        p[1] = e.y;
-        p[2] = e.z;
-        if (ch == 4) p[3] = static_cast<float>(e.w / pi);  // alpha: its cosine-weighted mean, not scaled by pi
-      }
-    }
+  return irradiance_map("irradiance_from_sh9", size, mapping, channels, thread_count, [&](const glm::vec3& n) {
+    return k[0] + k[1] * n.y + k[2] * n.z + k[3] * n.x + k[4] * (n.x * n.y) + k[5] * (n.y * n.z) +
+           k[6] * (3.0f * n.z * n.z - 1.0f) + k[7] * (n.x * n.z) + k[8] * (n.x * n.x - n.y * n.y);
   });
-  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1258,33 +1283,10 @@ std::array<double, 25> sh25_basis(const glm::dvec3& w) noexcept {
 }
 
 sh25 project_sh25(const cube_image& level, int thread_count) {
-  validate_level("project_sh25", level);
-  const int n = level.size;
-  const std::shared_ptr<const face_table> table = face_table::get(n);
-  const std::size_t rows = 6u * std::size_t(n), ch = std::size_t(level.channels);
-  std::vector<sh25> partial(rows);  // one partial sum per row, added in row order: deterministic
-  parallel_for(rows, thread_count, 8, [&](int, std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const int f = static_cast<int>(r / std::size_t(n)), y = static_cast<int>(r % std::size_t(n));
-      const face_frame& fr = frame_of(f);
-      // Float sums within the row (at most 6688 terms of similar size), double across rows.
-      std::array<glm::vec4, 25> acc{};
-      float b[25];
-      for (int x = 0; x < n; ++x) {
-        const glm::vec4& t = table->texels[std::size_t(y) * std::size_t(n) + std::size_t(x)];
-        const glm::vec3 w = fr.column * t.x + fr.row * t.y + fr.axis * t.z;
-        const float* p = level.at(f, x, y);
-        const glm::vec4 lw = glm::vec4(p[0], p[1], p[2], ch == 4 ? p[3] : 1.0f) * t.w;
-        sh25_basis_t(w.x, w.y, w.z, b);
-        for (std::size_t k = 0; k < 25; ++k) acc[k] += lw * b[k];
-      }
-      for (std::size_t k = 0; k < 25; ++k) partial[r].coefficients[k] = glm::dvec4(acc[k]);
-    }
-  });
-  sh25 total;
-  for (const sh25& s : partial)
-    for (std::size_t k = 0; k < 25; ++k) total.coefficients[k] += s.coefficients[k];
-  return total;
+  sh25 out;
+  out.coefficients = project_sh<25>("project_sh25", level, thread_count,
+                                    [](const glm::vec3& w, float* b) { sh25_basis_t(w.x, w.y, w.z, b); });
+  return out;
 }
 
 glm::dvec4 sh25_irradiance(const sh25& radiance, const glm::dvec3& n) noexcept {
@@ -1296,40 +1298,17 @@ glm::dvec4 sh25_irradiance(const sh25& radiance, const glm::dvec3& n) noexcept {
 }
 
 cube_image irradiance_from_sh25(const sh25& radiance, int size, edge_fixup mapping, int channels, int thread_count) {
-  check_output_size("irradiance_from_sh25", size);
-  if (channels != 3 && channels != 4)
-    throw_invalid_argument("irradiance_from_sh25: channels is " + std::to_string(channels) + "; it must be 3 or 4");
-  const int m = static_cast<int>(mapping);
-  if (m < 0 || m > 2) throw_invalid_argument("irradiance_from_sh25: mapping " + std::to_string(m) + " is not 0, 1 or 2");
-  cube_image out = cube_image::make(size, channels);
-  const std::size_t rows = 6u * std::size_t(size), ch = std::size_t(channels);
   // Band factors folded into the coefficients; band 3 (A_3 = 0) is skipped.
   std::array<glm::vec4, 25> k;
   for (std::size_t j = 0; j < 25; ++j) k[j] = glm::vec4(radiance.coefficients[j] * sh25_band_factor(j));
-  std::vector<float> coord(static_cast<std::size_t>(size));
-  for (int i = 0; i < size; ++i) coord[std::size_t(i)] = static_cast<float>(cubemap_texel_coordinate(size, i, mapping));
-  parallel_for(rows, thread_count, 16, [&](int, std::size_t begin, std::size_t end) {
+  return irradiance_map("irradiance_from_sh25", size, mapping, channels, thread_count, [&](const glm::vec3& n) {
     float b[25];
-    for (std::size_t r = begin; r < end; ++r) {
-      const int f = static_cast<int>(r / std::size_t(size)), y = static_cast<int>(r % std::size_t(size));
-      const face_frame& fr = frame_of(f);
-      const glm::vec3 row_point = fr.axis + coord[std::size_t(y)] * fr.row;
-      for (int x = 0; x < size; ++x) {
-        const glm::vec3 p3 = row_point + coord[std::size_t(x)] * fr.column;
-        const glm::vec3 nn = p3 / std::sqrt(glm::dot(p3, p3));
-        sh25_basis_t(nn.x, nn.y, nn.z, b);
-        glm::vec4 e(0.0f);
-        for (std::size_t j = 0; j < 9; ++j) e += k[j] * b[j];
-        for (std::size_t j = 16; j < 25; ++j) e += k[j] * b[j];
-        float* p = out.at(f, x, y);
-        p[0] = e.x;
-        p[1] = e.y;
-        p[2] = e.z;
-        if (ch == 4) p[3] = static_cast<float>(static_cast<double>(e.w) / pi);  // alpha: the mean, not scaled
-      }
-    }
+    sh25_basis_t(n.x, n.y, n.z, b);
+    glm::vec4 e(0.0f);
+    for (std::size_t j = 0; j < 9; ++j) e += k[j] * b[j];
+    for (std::size_t j = 16; j < 25; ++j) e += k[j] * b[j];
+    return e;
   });
-  return out;
 }
 
 }  // namespace hemilight
