@@ -527,17 +527,29 @@ TEST_CASE("cache: bad input gets a clear error", "[cache]") {
   CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("invalid_backface_fraction"));
 }
 
-TEST_CASE("cache: points inside geometry are invalid and filled from valid records", "[cache]") {
-  // Floor points of the lit room, plus points inside a closed outward-facing box standing on
-  // the floor (their hemicubes see its back faces).
+namespace {
+
+// The lit room with a closed, outward-facing box (corners box_lo, box_hi, albedo 0.5) standing on
+// its floor and reaching 1 cm below it: floor points under it are inside geometry.
+const glm::dvec3 box_lo(0.2, 0.2, -0.01), box_hi(0.6, 0.6, 0.5);
+closed_form_scene lit_room_with_box() {
   closed_form_scene s = lit_room();
-  const glm::dvec3 lo(0.2, 0.2, -0.01), hi(0.6, 0.6, 0.5);
+  const glm::dvec3 lo = box_lo, hi = box_hi;
   auto q = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) { add_quad(s.tris, a, b, c, d, glm::vec3(0.5f)); };
   q({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});  // top, facing up
   q({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});  // +x
   q({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});  // -x
   q({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});  // +y
   q({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});  // -y
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("cache: points inside geometry are invalid and filled from valid records", "[cache]") {
+  // Floor points of the lit room, plus points inside a closed outward-facing box standing on
+  // the floor (their hemicubes see its back faces).
+  closed_form_scene s = lit_room_with_box();
   std::vector<glm::vec3> p, n;
   floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.1f, p, n);
   const cache_result r = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), cache_options{});
@@ -929,14 +941,7 @@ TEST_CASE("cache: statistics add up - rounds, seeds, checked points and the reco
 
 TEST_CASE("cache: fill_invalid = false leaves points inside geometry at 0 and everything else unchanged", "[cache]") {
   // The floor of the lit room with a closed box standing on it (as the test above).
-  closed_form_scene s = lit_room();
-  const glm::dvec3 lo(0.2, 0.2, -0.01), hi(0.6, 0.6, 0.5);
-  auto q = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) { add_quad(s.tris, a, b, c, d, glm::vec3(0.5f)); };
-  q({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
-  q({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
-  q({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});
-  q({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});
-  q({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});
+  closed_form_scene s = lit_room_with_box();
   std::vector<glm::vec3> p, n;
   floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.1f, p, n);
   const irradiance_sampler sampler = raycast_sampler(s, 16);
@@ -960,14 +965,8 @@ TEST_CASE("cache: fill_invalid = false leaves points inside geometry at 0 and ev
 TEST_CASE("cache: known_inside points get no hemicube and stay invalid; the rest is sampled as before", "[cache]") {
   // The floor of the lit room with a closed box standing on it (as the tests above): a first
   // run finds the floor points under the box inside; a second run is told them.
-  closed_form_scene s = lit_room();
-  const glm::dvec3 lo(0.2, 0.2, -0.01), hi(0.6, 0.6, 0.5);
-  auto q = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) { add_quad(s.tris, a, b, c, d, glm::vec3(0.5f)); };
-  q({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
-  q({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
-  q({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z});
-  q({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});
-  q({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});
+  const glm::dvec3 lo = box_lo, hi = box_hi;
+  closed_form_scene s = lit_room_with_box();
   std::vector<glm::vec3> p, n;
   floor_grid(-0.9f, 0.9f, -0.9f, 0.9f, 0.05f, p, n);
   const irradiance_sampler inner = raycast_sampler(s, 16);
