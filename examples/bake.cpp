@@ -129,18 +129,7 @@ struct settings {
 // "a,b,c,d[,e]": 4 or 5 finite numbers.
 std::vector<float> parse_list(const std::string& name, const std::string& text, const char* form) {
   std::vector<float> v;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = text.find(',', at);
-    const std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
-    char* end = nullptr;
-    const float x = std::strtof(item.c_str(), &end);
-    if (item.empty() || *end || !std::isfinite(x)) fail(name + " " + text + " is invalid: it must be " + form, 2);
-    v.push_back(x);
-    if (comma == std::string::npos) break;
-    at = comma + 1;
-  }
-  if (v.size() < 4 || v.size() > 5) fail(name + " " + text + " is invalid: it must be " + form, 2);
+  if (!preview::parse_numbers(text, v) || v.size() < 4 || v.size() > 5) fail(name + " " + text + " is invalid: it must be " + form, 2);
   return v;
 }
 

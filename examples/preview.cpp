@@ -111,8 +111,8 @@ void crop_of(const camera& cam, int size, int& n, int& first) {
 
 }  // namespace
 
-bool parse_camera(const std::string& text, camera& out) {
-  std::vector<float> v;
+bool parse_numbers(const std::string& text, std::vector<float>& out) {
+  out.clear();
   std::size_t at = 0;
   while (at <= text.size()) {
     const std::size_t comma = text.find(',', at);
@@ -120,11 +120,16 @@ bool parse_camera(const std::string& text, camera& out) {
     char* end = nullptr;
     const float x = std::strtof(item.c_str(), &end);
     if (item.empty() || *end || !std::isfinite(x)) return false;
-    v.push_back(x);
+    out.push_back(x);
     if (comma == std::string::npos) break;
     at = comma + 1;
   }
-  if (v.size() != 6 && v.size() != 7) return false;
+  return true;
+}
+
+bool parse_camera(const std::string& text, camera& out) {
+  std::vector<float> v;
+  if (!parse_numbers(text, v) || (v.size() != 6 && v.size() != 7)) return false;
   camera c;
   c.eye = {v[0], v[1], v[2]};
   c.target = {v[3], v[4], v[5]};

@@ -24,6 +24,10 @@ struct camera {
 /// target). Returns false (camera untouched) for anything else.
 bool parse_camera(const std::string& text, camera& out);
 
+/// Parses "a,b,c,..." (comma-separated finite floats, no spaces, at least one) into out. Returns
+/// false, out unspecified, if an item is empty, not a number or not finite.
+bool parse_numbers(const std::string& text, std::vector<float>& out);
+
 /// What a picture shows per lightmap texel of each page: emission + albedo x E / pi, E the
 /// page's baked irradiance; albedo and emission from the page's images where it has them, else
 /// the area-weighted materials of the page's triangles in the texel. Dilated 2 rings around the
