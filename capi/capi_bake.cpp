@@ -5,9 +5,11 @@
 
 #include "hemilight/bake.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -44,10 +46,8 @@ struct uv_target {
 
 std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, const uv_target& target) {
   const int width = target.width, height = target.height;
-  for (std::size_t i = 0; i < 3 * mesh.vertex_count; ++i)
-    if (!(std::fabs(mesh.positions[i]) <= hemilight::max_coordinate))
-      return name + ".positions[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
-             std::to_string(mesh.positions[i]) + "; it must be finite and at most 1e18 in magnitude";
+  if (std::string p = hemilight::capi::positions_problem(mesh.positions, mesh.vertex_count, name + ".positions"); !p.empty())
+    return p;
   if (!target.occluder())
     for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i) {
       const float q = target.map(mesh.lightmap_uvs[i], int(i % 2));
@@ -138,35 +138,53 @@ hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, co
 
 namespace {
 
-// The checks of the options every bake entry shares, in the order hemilight_bake_lightmap has
-// always made them (after its size and capacity checks): the environment, the cache threshold,
-// the switches, the sky, the shadow-mask indices (mask: some index names a light).
+// The optional environment sky of the options, checked and converted (null without one).
+hemilight_status environment_of(const char* fn, const hemilight_bake_options& o,
+                                std::shared_ptr<const hemilight::cubemap>& environment) {
+  if (!o.environment_rgb) {
+    if (o.environment_size != 0)
+      return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
+                             " but environment_rgb is NULL (use 0 without an environment map)");
+    return HEMILIGHT_OK;
+  }
+  if (o.environment_size < 1 || o.environment_size > hemilight::cubemap_max_size)
+    return invalid(fn, "options->environment_size " + std::to_string(o.environment_size) + " is out of range: 1.." +
+                           std::to_string(hemilight::cubemap_max_size) + " with an environment map");
+  hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
+  for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
+    const float v = o.environment_rgb[i];
+    if (!(v >= 0.0f && v <= hemilight::max_radiance))
+      return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
+                             "; radiance must be finite, >= 0 and at most 1e30");
+    faces.pixels[i] = v;
+  }
+  environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
+  return HEMILIGHT_OK;
+}
+
+// The checks of the options every bake entry shares (all but the lightmap's size, which only
+// hemilight_bake_lightmap reads, and the lights: to_lights), each naming the C field: the
+// environment, the hemicube resolution, bounces, thresholds and counts, the switches, the sky,
+// the shadow-mask indices (mask: some index names a light). Every value the C++ bake would refuse
+// is refused here first, in the caller's terms.
 hemilight_status check_common_options(const char* fn, const hemilight_bake_options& o,
                                       std::shared_ptr<const hemilight::cubemap>& environment, bool& mask) {
-  if (o.environment_rgb) {
-    if (o.environment_size < 1 || o.environment_size > hemilight::cubemap_max_size)
-      return invalid(fn, "options->environment_size " + std::to_string(o.environment_size) + " is out of range: 1.." +
-                             std::to_string(hemilight::cubemap_max_size) + " with an environment map");
-    hemilight::cube_image faces = hemilight::cube_image::make(o.environment_size, 3);
-    for (std::size_t i = 0; i < faces.pixels.size(); ++i) {
-      const float v = o.environment_rgb[i];
-      if (!(v >= 0.0f && v <= hemilight::max_radiance))
-        return invalid(fn, "options->environment_rgb[" + std::to_string(i) + "] = " + std::to_string(v) +
-                               "; radiance must be finite, >= 0 and at most 1e30");
-      faces.pixels[i] = v;
-    }
-    environment = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
-  } else if (o.environment_size != 0) {
-    return invalid(fn, "options->environment_size is " + std::to_string(o.environment_size) +
-                           " but environment_rgb is NULL (use 0 without an environment map)");
-  }
+  if (const hemilight_status st = environment_of(fn, o, environment)) return st;
+  if (const hemilight_status st = hemilight::capi::check_resolution(fn, o.resolution, "options->resolution")) return st;
+  if (o.bounces < 1 || o.bounces > 64)
+    return invalid(fn, "options->bounces " + std::to_string(o.bounces) + " is not in [1, 64]");
   if (!(o.error_threshold >= hemilight::min_error_threshold && o.error_threshold <= 1.0f))
     return invalid(fn, "options->error_threshold is " + std::to_string(o.error_threshold) + "; it must be in [0.001, 1] (checked "
                        "whatever use_cache is)");
-  for (const char* f : {"indirect_only", "use_cache"}) {
-    const int v = std::string(f) == "use_cache" ? o.use_cache : o.indirect_only;
-    if (v != 0 && v != 1) return invalid(fn, std::string("options->") + f + " is " + std::to_string(v) + "; it must be 0 or 1");
-  }
+  if (!(o.min_coverage >= 0.0f && o.min_coverage <= 1.0f))
+    return invalid(fn, "options->min_coverage " + std::to_string(o.min_coverage) + " is not in [0, 1]");
+  if (o.dilation < -1) return invalid(fn, "options->dilation " + std::to_string(o.dilation) + " must be >= -1 (-1: fill every texel)");
+  if (o.thread_count < 0) return invalid(fn, "options->thread_count " + std::to_string(o.thread_count) + " must be >= 0 (0: all cores)");
+  const std::pair<const char*, int> switches[] = {
+      {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}};
+  for (const auto& sw : switches)
+    if (sw.second != 0 && sw.second != 1)
+      return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
   for (int c = 0; c < 3; ++c)
     if (!(o.sky_radiance[c] >= 0.0f && o.sky_radiance[c] <= hemilight::max_radiance))
       return invalid(fn, "options->sky_radiance[" + std::to_string(c) + "] = " + std::to_string(o.sky_radiance[c]) +
@@ -222,12 +240,10 @@ hemilight_status gather_meshes(const char* fn, const hemilight_bake_mesh* meshes
         g.normals.push_back(mesh.normals ? glm::vec3(mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2])
                                          : glm::vec3(0.0f));  // zero: the baker falls back to the face normal
     }
-    for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) {
-      if (mesh.indices[i] >= mesh.vertex_count)
-        return invalid(fn, name + ".indices[" + std::to_string(i) + "] = " + std::to_string(mesh.indices[i]) +
-                               " is out of range: " + std::to_string(mesh.vertex_count) + " vertices");
-      g.indices.push_back(base + mesh.indices[i]);
-    }
+    if (std::string p = hemilight::capi::indices_problem(mesh.indices, mesh.triangle_count, mesh.vertex_count, name + ".indices");
+        !p.empty())
+      return invalid(fn, p);
+    for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) g.indices.push_back(base + mesh.indices[i]);
     for (size_t t = 0; t < mesh.triangle_count; ++t)
       g.materials.push_back(to_material(mesh.materials ? mesh.materials[t] : mesh.material));
   }
@@ -269,76 +285,6 @@ bool result_finite(const hemilight::bake_result& r) {
   return all_ok;
 }
 
-hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
-                      const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
-                      uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
-                      size_t hl2_capacity, hemilight_bake_stats* stats) {
-  return guarded(fn, [&] {
-    if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
-    hemilight_bake_options full = hemilight::capi::default_bake_options();
-    if (const std::string problem = hemilight::capi::read_sized(options, full); !problem.empty()) return invalid(fn, problem);
-    if (stats)
-      if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
-    if (mesh_count == 0) return invalid(fn, "mesh_count is 0: there is nothing to bake");
-    if (!meshes) return invalid(fn, "meshes is NULL");
-    if (!irradiance_rgb) return invalid(fn, "irradiance_rgb is NULL");
-    const hemilight_bake_options& o = full;
-    if (o.width < 1 || o.width > hemilight::max_lightmap_size || o.height < 1 || o.height > hemilight::max_lightmap_size)
-      return invalid(fn, "options->width x height = " + std::to_string(o.width) + " x " + std::to_string(o.height) +
-                             " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
-    const size_t texels = size_t(o.width) * size_t(o.height);
-    if (irradiance_capacity < 3 * texels)
-      return invalid(fn, "irradiance_capacity " + std::to_string(irradiance_capacity) + " is below 3 x width x height = " +
-                             std::to_string(3 * texels) + " floats");
-    if (valid && valid_capacity < texels)
-      return invalid(fn, "valid_capacity " + std::to_string(valid_capacity) + " is below width x height = " + std::to_string(texels));
-    if (sh_l1_rgb && sh_l1_capacity < 12 * texels)
-      return invalid(fn, "sh_l1_capacity " + std::to_string(sh_l1_capacity) + " is below 12 x width x height = " +
-                             std::to_string(12 * texels) + " floats (four RGB images)");
-    if (hl2_rgb && hl2_capacity < 9 * texels)
-      return invalid(fn, "hl2_capacity " + std::to_string(hl2_capacity) + " is below 9 x width x height = " +
-                             std::to_string(9 * texels) + " floats (three RGB images)");
-    std::shared_ptr<const hemilight::cubemap> environment;
-    bool mask = false;
-    if (const hemilight_status st = check_common_options(fn, o, environment, mask); st != HEMILIGHT_OK) return st;
-    if (mask && !o.shadow_mask_rgba)
-      return invalid(fn, "options->shadow_mask_lights names a light but options->shadow_mask_rgba is NULL");
-    if (mask && o.shadow_mask_capacity < 4 * texels)
-      return invalid(fn, "options->shadow_mask_capacity " + std::to_string(o.shadow_mask_capacity) +
-                             " is below 4 x width x height = " + std::to_string(4 * texels) + " floats");
-    std::vector<hemilight::light> lights;
-    const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
-    if (lights_status != HEMILIGHT_OK) return lights_status;
-
-    gathered_scene g;
-    uv_target target;
-    target.width = o.width;
-    target.height = o.height;
-    if (const hemilight_status st = gather_meshes(fn, meshes, mesh_count, std::vector<uv_target>(mesh_count, target), g);
-        st != HEMILIGHT_OK)
-      return st;
-    const hemilight::bake_input in = input_of(g, o);
-    const hemilight::bake_options bo =
-        hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), sh_l1_rgb != nullptr, hl2_rgb != nullptr);
-    hemilight::bake_result r;
-    try {
-      r = hemilight::bake_lightmap(in, bo);
-    } catch (const hemilight::error& e) {
-      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
-    }
-    if (!result_finite(r)) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
-    std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), irradiance_rgb);
-    if (mask) std::copy(r.shadow_mask.pixels.begin(), r.shadow_mask.pixels.end(), o.shadow_mask_rgba);
-    if (valid) std::copy(r.valid.begin(), r.valid.end(), valid);
-    if (sh_l1_rgb)
-      for (std::size_t k = 0; k < 4; ++k) std::copy(r.sh_l1[k].pixels.begin(), r.sh_l1[k].pixels.end(), sh_l1_rgb + 3 * texels * k);
-    if (hl2_rgb)
-      for (std::size_t k = 0; k < 3; ++k) std::copy(r.hl2[k].pixels.begin(), r.hl2[k].pixels.end(), hl2_rgb + 3 * texels * k);
-    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
-    return HEMILIGHT_OK;
-  });
-}
-
 // Checks a page's optional material image: every value in [0, hi].
 std::string check_page_image(const float* rgb, std::size_t texels, const std::string& name, float hi, const char* range) {
   if (!rgb) return {};
@@ -356,133 +302,232 @@ hemilight::image image_of(const float* rgb, int width, int height) {
   return img;
 }
 
+// ---- the stages of the bake entries -----------------------------------------------------------
+
+// Stage 1 of every entry: the caller's options over the defaults (read_sized) into `o`, and the
+// statistics' struct_size.
+hemilight_status read_options(const char* fn, const hemilight_bake_options* options, const hemilight_bake_stats* stats,
+                              hemilight_bake_options& o) {
+  if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
+  o = hemilight::capi::default_bake_options();
+  if (const std::string problem = hemilight::capi::read_sized(options, o); !problem.empty()) return invalid(fn, problem);
+  if (stats)
+    if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
+  return HEMILIGHT_OK;
+}
+
+// How check_page's messages name a page's fields: hemilight_bake_lightmap's own arguments
+// ("options->width x height", "irradiance_capacity", "options->shadow_mask_rgba") or a page of a
+// scene bake ("scene->pages[2]: width x height", "scene->pages[2].irradiance_capacity", ...).
+struct page_names {
+  std::string size;    // before "width x height = ..."
+  std::string buffer;  // before each output buffer's and material image's name
+  std::string mask;    // before "shadow_mask_rgba" and "shadow_mask_capacity"
+};
+
+// The outputs of hemilight_bake_lightmap(_directional) as the one page of a scene bake (the same
+// checks and copies serve both entries).
+hemilight_bake_page page_of_arguments(const hemilight_bake_options& o, float* irradiance_rgb, size_t irradiance_capacity,
+                                      uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity,
+                                      float* hl2_rgb, size_t hl2_capacity) {
+  hemilight_bake_page page{};
+  page.width = o.width;
+  page.height = o.height;
+  page.irradiance_rgb = irradiance_rgb;
+  page.irradiance_capacity = irradiance_capacity;
+  page.valid = valid;
+  page.valid_capacity = valid_capacity;
+  page.sh_l1_rgb = sh_l1_rgb;
+  page.sh_l1_capacity = sh_l1_capacity;
+  page.hl2_rgb = hl2_rgb;
+  page.hl2_capacity = hl2_capacity;
+  page.shadow_mask_rgba = o.shadow_mask_rgba;
+  page.shadow_mask_capacity = o.shadow_mask_capacity;
+  return page;
+}
+
+// A page's size, its output buffers against their capacities, the shadow mask's buffer when
+// `mask` (some options->shadow_mask_lights index names a light) and its material images.
+hemilight_status check_page(const char* fn, const hemilight_bake_page& page, const page_names& name, bool mask) {
+  if (page.width < 1 || page.width > hemilight::max_lightmap_size || page.height < 1 || page.height > hemilight::max_lightmap_size)
+    return invalid(fn, name.size + "width x height = " + std::to_string(page.width) + " x " + std::to_string(page.height) +
+                           " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
+  const size_t texels = size_t(page.width) * size_t(page.height);
+  if (!page.irradiance_rgb) return invalid(fn, name.buffer + "irradiance_rgb is NULL");
+  const auto below = [&](const char* field, size_t capacity, size_t per_texel, const char* what) {
+    return invalid(fn, name.buffer + field + " " + std::to_string(capacity) + " is below " +
+                           (per_texel > 1 ? std::to_string(per_texel) + " x " : std::string()) + "width x height = " +
+                           std::to_string(per_texel * texels) + what);
+  };
+  if (page.irradiance_capacity < 3 * texels) return below("irradiance_capacity", page.irradiance_capacity, 3, " floats");
+  if (page.valid && page.valid_capacity < texels) return below("valid_capacity", page.valid_capacity, 1, "");
+  if (page.sh_l1_rgb && page.sh_l1_capacity < 12 * texels)
+    return below("sh_l1_capacity", page.sh_l1_capacity, 12, " floats (four RGB images)");
+  if (page.hl2_rgb && page.hl2_capacity < 9 * texels) return below("hl2_capacity", page.hl2_capacity, 9, " floats (three RGB images)");
+  if (mask && !page.shadow_mask_rgba)
+    return invalid(fn, "options->shadow_mask_lights names a light but " + name.mask + "shadow_mask_rgba is NULL");
+  if (mask && page.shadow_mask_capacity < 4 * texels)
+    return invalid(fn, name.mask + "shadow_mask_capacity " + std::to_string(page.shadow_mask_capacity) +
+                           " is below 4 x width x height = " + std::to_string(4 * texels) + " floats");
+  if (std::string e = check_page_image(page.albedo_rgb, texels, name.buffer + "albedo_rgb", 1.0f, "in [0, 1]"); !e.empty())
+    return invalid(fn, e);
+  if (std::string e = check_page_image(page.emission_rgb, texels, name.buffer + "emission_rgb", hemilight::max_radiance,
+                                       "finite, >= 0 and at most 1e30");
+      !e.empty())
+    return invalid(fn, e);
+  return HEMILIGHT_OK;
+}
+
+// Copies a successful bake's images into the page's buffers (checked by check_page).
+void write_page(const hemilight::bake_result& r, const hemilight_bake_page& page, bool mask) {
+  const size_t texels = size_t(page.width) * size_t(page.height);
+  std::copy(r.irradiance.pixels.begin(), r.irradiance.pixels.end(), page.irradiance_rgb);
+  if (mask) std::copy(r.shadow_mask.pixels.begin(), r.shadow_mask.pixels.end(), page.shadow_mask_rgba);
+  if (page.valid) std::copy(r.valid.begin(), r.valid.end(), page.valid);
+  if (page.sh_l1_rgb)
+    for (std::size_t k = 0; k < 4; ++k) std::copy(r.sh_l1[k].pixels.begin(), r.sh_l1[k].pixels.end(), page.sh_l1_rgb + 3 * texels * k);
+  if (page.hl2_rgb)
+    for (std::size_t k = 0; k < 3; ++k) std::copy(r.hl2[k].pixels.begin(), r.hl2[k].pixels.end(), page.hl2_rgb + 3 * texels * k);
+}
+
+const char* const overflow_message = "the irradiance overflows float (a light too intense or too close to a surface?)";
+
+hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
+                      const hemilight_bake_options* options, float* irradiance_rgb, size_t irradiance_capacity,
+                      uint8_t* valid, size_t valid_capacity, float* sh_l1_rgb, size_t sh_l1_capacity, float* hl2_rgb,
+                      size_t hl2_capacity, hemilight_bake_stats* stats) {
+  return guarded(fn, [&] {
+    // Step 1: the options, the meshes' and the outputs' arguments, the lights.
+    hemilight_bake_options o;
+    if (const hemilight_status st = read_options(fn, options, stats, o)) return st;
+    if (mesh_count == 0) return invalid(fn, "mesh_count is 0: there is nothing to bake");
+    if (!meshes) return invalid(fn, "meshes is NULL");
+    const hemilight_bake_page page = page_of_arguments(o, irradiance_rgb, irradiance_capacity, valid, valid_capacity, sh_l1_rgb,
+                                                       sh_l1_capacity, hl2_rgb, hl2_capacity);
+    std::shared_ptr<const hemilight::cubemap> environment;
+    bool mask = false;
+    if (const hemilight_status st = check_common_options(fn, o, environment, mask)) return st;
+    if (const hemilight_status st = check_page(fn, page, {"options->", "", "options->"}, mask)) return st;
+    std::vector<hemilight::light> lights;
+    if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
+    // Step 2: the meshes, checked in the caller's terms and concatenated.
+    gathered_scene g;
+    uv_target target;
+    target.width = o.width;
+    target.height = o.height;
+    if (const hemilight_status st = gather_meshes(fn, meshes, mesh_count, std::vector<uv_target>(mesh_count, target), g)) return st;
+    // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
+    const hemilight::bake_options bo =
+        hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), sh_l1_rgb != nullptr, hl2_rgb != nullptr);
+    const hemilight::bake_result r = hemilight::bake_lightmap(input_of(g, o), bo);
+    // Step 4: the outputs, only when everything is finite.
+    if (!result_finite(r)) return invalid(fn, overflow_message);
+    write_page(r, page, mask);
+    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
+    return HEMILIGHT_OK;
+  });
+}
+
+// The scene description's own fields (its arrays' presence, the occluders' radiance).
+hemilight_status check_scene_desc(const char* fn, const hemilight_bake_scene_desc& sd) {
+  if (sd.mesh_count == 0) return invalid(fn, "scene->mesh_count is 0: there is nothing to bake");
+  if (!sd.meshes) return invalid(fn, "scene->meshes is NULL");
+  if (!sd.placements) return invalid(fn, "scene->placements is NULL (one per mesh)");
+  if (sd.page_count == 0) return invalid(fn, "scene->page_count is 0: a scene bake needs at least one page");
+  if (!sd.pages) return invalid(fn, "scene->pages is NULL");
+  if (sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION && sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE)
+    return invalid(fn, "scene->occluder_radiance is " + std::to_string(sd.occluder_radiance) +
+                           "; it must be HEMILIGHT_OCCLUDER_EMISSION (0) or HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE (1)");
+  return HEMILIGHT_OK;
+}
+
+// Where each mesh's UVs go (targets[m] for placements[m]), the placements checked.
+hemilight_status placement_targets(const char* fn, const hemilight_bake_scene_desc& sd, std::vector<uv_target>& targets) {
+  targets.assign(sd.mesh_count, uv_target{});
+  for (size_t m = 0; m < sd.mesh_count; ++m) {
+    const hemilight_bake_placement& pl = sd.placements[m];
+    const std::string name = "scene->placements[" + std::to_string(m) + "]";
+    if (pl.page < -1 || (pl.page >= 0 && size_t(pl.page) >= sd.page_count))
+      return invalid(fn, name + ".page = " + std::to_string(pl.page) + " is not -1 (occluder only) or a page index (page_count " +
+                             std::to_string(sd.page_count) + ")");
+    for (int c = 0; c < 2; ++c)
+      if (!std::isfinite(pl.uv_scale[c]) || !std::isfinite(pl.uv_offset[c]))
+        return invalid(fn, name + ".uv_scale or uv_offset is not finite");
+    targets[m].placement = &pl;
+    if (pl.page >= 0) {
+      targets[m].width = sd.pages[pl.page].width;
+      targets[m].height = sd.pages[pl.page].height;
+    }
+  }
+  return HEMILIGHT_OK;
+}
+
+// The C++ scene bake's input: the concatenated meshes, the pages' sizes and material images, each
+// mesh's triangle range and placement.
+hemilight::scene_bake_input scene_input_of(const hemilight_bake_scene_desc& sd, const gathered_scene& g,
+                                           const hemilight_bake_options& o) {
+  hemilight::scene_bake_input in;
+  in.geometry = input_of(g, o);
+  in.occluders = sd.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION ? hemilight::occluder_radiance::emission
+                                                                      : hemilight::occluder_radiance::emission_plus_mean_bounce;
+  for (size_t p = 0; p < sd.page_count; ++p) {
+    const hemilight_bake_page& page = sd.pages[p];
+    hemilight::lightmap_page lp;
+    lp.width = page.width;
+    lp.height = page.height;
+    lp.albedo = image_of(page.albedo_rgb, page.width, page.height);
+    lp.emission = image_of(page.emission_rgb, page.width, page.height);
+    in.pages.push_back(std::move(lp));
+  }
+  std::size_t first = 0;
+  for (size_t m = 0; m < sd.mesh_count; ++m) {
+    hemilight::bake_mesh bm;
+    bm.first_triangle = first;
+    bm.triangle_count = sd.meshes[m].triangle_count;
+    bm.page = sd.placements[m].page;
+    bm.uv_scale = glm::vec2(sd.placements[m].uv_scale[0], sd.placements[m].uv_scale[1]);
+    bm.uv_offset = glm::vec2(sd.placements[m].uv_offset[0], sd.placements[m].uv_offset[1]);
+    in.meshes.push_back(bm);
+    first += bm.triangle_count;
+  }
+  return in;
+}
+
 hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
                             hemilight_bake_stats* stats) {
   const char* fn = "hemilight_bake_scene";
   return guarded(fn, [&] {
+    // Step 1: the description, the options, every page, the lights.
     if (!scene) return invalid(fn, "scene is NULL (use hemilight_bake_scene_desc_init)");
     hemilight_bake_scene_desc sd = hemilight::capi::default_bake_scene_desc();
     if (const std::string problem = hemilight::capi::read_sized(scene, sd); !problem.empty()) return invalid(fn, problem);
-    if (!options) return invalid(fn, "options is NULL (use hemilight_bake_options_init)");
-    hemilight_bake_options o = hemilight::capi::default_bake_options();
-    if (const std::string problem = hemilight::capi::read_sized(options, o); !problem.empty()) return invalid(fn, problem);
-    if (stats)
-      if (const std::string problem = hemilight::capi::check_sized(stats); !problem.empty()) return invalid(fn, problem);
-    if (sd.mesh_count == 0) return invalid(fn, "scene->mesh_count is 0: there is nothing to bake");
-    if (!sd.meshes) return invalid(fn, "scene->meshes is NULL");
-    if (!sd.placements) return invalid(fn, "scene->placements is NULL (one per mesh)");
-    if (sd.page_count == 0) return invalid(fn, "scene->page_count is 0: a scene bake needs at least one page");
-    if (!sd.pages) return invalid(fn, "scene->pages is NULL");
-    if (sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION && sd.occluder_radiance != HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE)
-      return invalid(fn, "scene->occluder_radiance is " + std::to_string(sd.occluder_radiance) +
-                             "; it must be HEMILIGHT_OCCLUDER_EMISSION (0) or HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE (1)");
+    hemilight_bake_options o;
+    if (const hemilight_status st = read_options(fn, options, stats, o)) return st;
+    if (const hemilight_status st = check_scene_desc(fn, sd)) return st;
     std::shared_ptr<const hemilight::cubemap> environment;
     bool mask = false;
-    if (const hemilight_status st = check_common_options(fn, o, environment, mask); st != HEMILIGHT_OK) return st;
+    if (const hemilight_status st = check_common_options(fn, o, environment, mask)) return st;
     bool want_sh = false, want_hl2 = false;
     for (size_t p = 0; p < sd.page_count; ++p) {
-      const hemilight_bake_page& page = sd.pages[p];
       const std::string name = "scene->pages[" + std::to_string(p) + "]";
-      if (page.width < 1 || page.width > hemilight::max_lightmap_size || page.height < 1 || page.height > hemilight::max_lightmap_size)
-        return invalid(fn, name + ": width x height = " + std::to_string(page.width) + " x " + std::to_string(page.height) +
-                               " is invalid: each must be in [1, " + std::to_string(hemilight::max_lightmap_size) + "]");
-      const size_t texels = size_t(page.width) * size_t(page.height);
-      if (!page.irradiance_rgb) return invalid(fn, name + ".irradiance_rgb is NULL");
-      if (page.irradiance_capacity < 3 * texels)
-        return invalid(fn, name + ".irradiance_capacity " + std::to_string(page.irradiance_capacity) +
-                               " is below 3 x width x height = " + std::to_string(3 * texels) + " floats");
-      if (page.valid && page.valid_capacity < texels)
-        return invalid(fn, name + ".valid_capacity " + std::to_string(page.valid_capacity) + " is below width x height = " +
-                               std::to_string(texels));
-      if (page.sh_l1_rgb && page.sh_l1_capacity < 12 * texels)
-        return invalid(fn, name + ".sh_l1_capacity " + std::to_string(page.sh_l1_capacity) + " is below 12 x width x height = " +
-                               std::to_string(12 * texels) + " floats (four RGB images)");
-      if (page.hl2_rgb && page.hl2_capacity < 9 * texels)
-        return invalid(fn, name + ".hl2_capacity " + std::to_string(page.hl2_capacity) + " is below 9 x width x height = " +
-                               std::to_string(9 * texels) + " floats (three RGB images)");
-      if (mask && !page.shadow_mask_rgba)
-        return invalid(fn, "options->shadow_mask_lights names a light but " + name + ".shadow_mask_rgba is NULL");
-      if (mask && page.shadow_mask_capacity < 4 * texels)
-        return invalid(fn, name + ".shadow_mask_capacity " + std::to_string(page.shadow_mask_capacity) +
-                               " is below 4 x width x height = " + std::to_string(4 * texels) + " floats");
-      if (std::string e = check_page_image(page.albedo_rgb, texels, name + ".albedo_rgb", 1.0f, "in [0, 1]"); !e.empty())
-        return invalid(fn, e);
-      if (std::string e = check_page_image(page.emission_rgb, texels, name + ".emission_rgb", hemilight::max_radiance,
-                                           "finite, >= 0 and at most 1e30");
-          !e.empty())
-        return invalid(fn, e);
-      want_sh = want_sh || page.sh_l1_rgb;
-      want_hl2 = want_hl2 || page.hl2_rgb;
+      if (const hemilight_status st = check_page(fn, sd.pages[p], {name + ": ", name + ".", name + "."}, mask)) return st;
+      want_sh = want_sh || sd.pages[p].sh_l1_rgb;
+      want_hl2 = want_hl2 || sd.pages[p].hl2_rgb;
     }
     std::vector<hemilight::light> lights;
-    const hemilight_status lights_status = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights);
-    if (lights_status != HEMILIGHT_OK) return lights_status;
-
-    std::vector<uv_target> targets(sd.mesh_count);
-    for (size_t m = 0; m < sd.mesh_count; ++m) {
-      const hemilight_bake_placement& pl = sd.placements[m];
-      const std::string name = "scene->placements[" + std::to_string(m) + "]";
-      if (pl.page < -1 || (pl.page >= 0 && size_t(pl.page) >= sd.page_count))
-        return invalid(fn, name + ".page = " + std::to_string(pl.page) + " is not -1 (occluder only) or a page index (page_count " +
-                               std::to_string(sd.page_count) + ")");
-      for (int c = 0; c < 2; ++c)
-        if (!std::isfinite(pl.uv_scale[c]) || !std::isfinite(pl.uv_offset[c]))
-          return invalid(fn, name + ".uv_scale or uv_offset is not finite");
-      targets[m].placement = &pl;
-      if (pl.page >= 0) {
-        targets[m].width = sd.pages[pl.page].width;
-        targets[m].height = sd.pages[pl.page].height;
-      }
-    }
+    if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
+    // Step 2: the placements, then the meshes (checked against their pages) concatenated.
+    std::vector<uv_target> targets;
+    if (const hemilight_status st = placement_targets(fn, sd, targets)) return st;
     gathered_scene g;
-    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, g, "scene->"); st != HEMILIGHT_OK) return st;
-
-    hemilight::scene_bake_input in;
-    in.geometry = input_of(g, o);
-    in.occluders = sd.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION ? hemilight::occluder_radiance::emission
-                                                                        : hemilight::occluder_radiance::emission_plus_mean_bounce;
-    for (size_t p = 0; p < sd.page_count; ++p) {
-      const hemilight_bake_page& page = sd.pages[p];
-      hemilight::lightmap_page lp;
-      lp.width = page.width;
-      lp.height = page.height;
-      lp.albedo = image_of(page.albedo_rgb, page.width, page.height);
-      lp.emission = image_of(page.emission_rgb, page.width, page.height);
-      in.pages.push_back(std::move(lp));
-    }
-    std::size_t first = 0;
-    for (size_t m = 0; m < sd.mesh_count; ++m) {
-      hemilight::bake_mesh bm;
-      bm.first_triangle = first;
-      bm.triangle_count = sd.meshes[m].triangle_count;
-      bm.page = sd.placements[m].page;
-      bm.uv_scale = glm::vec2(sd.placements[m].uv_scale[0], sd.placements[m].uv_scale[1]);
-      bm.uv_offset = glm::vec2(sd.placements[m].uv_offset[0], sd.placements[m].uv_offset[1]);
-      in.meshes.push_back(bm);
-      first += bm.triangle_count;
-    }
+    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, g, "scene->")) return st;
+    // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
     const hemilight::bake_options bo = hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
-    hemilight::scene_bake_result r;
-    try {
-      r = hemilight::bake_scene(in, bo);
-    } catch (const hemilight::error& e) {
-      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
-    }
+    const hemilight::scene_bake_result r = hemilight::bake_scene(scene_input_of(sd, g, o), bo);
+    // Step 4: the outputs, only when every page is finite.
     for (const hemilight::bake_result& page : r.pages)
-      if (!result_finite(page)) return invalid(fn, "the irradiance overflows float (a light too intense or too close to a surface?)");
-    for (size_t p = 0; p < sd.page_count; ++p) {
-      const hemilight_bake_page& page = sd.pages[p];
-      const hemilight::bake_result& pr = r.pages[p];
-      const size_t texels = size_t(page.width) * size_t(page.height);
-      std::copy(pr.irradiance.pixels.begin(), pr.irradiance.pixels.end(), page.irradiance_rgb);
-      if (mask) std::copy(pr.shadow_mask.pixels.begin(), pr.shadow_mask.pixels.end(), page.shadow_mask_rgba);
-      if (page.valid) std::copy(pr.valid.begin(), pr.valid.end(), page.valid);
-      if (page.sh_l1_rgb)
-        for (std::size_t k = 0; k < 4; ++k)
-          std::copy(pr.sh_l1[k].pixels.begin(), pr.sh_l1[k].pixels.end(), page.sh_l1_rgb + 3 * texels * k);
-      if (page.hl2_rgb)
-        for (std::size_t k = 0; k < 3; ++k) std::copy(pr.hl2[k].pixels.begin(), pr.hl2[k].pixels.end(), page.hl2_rgb + 3 * texels * k);
-    }
+      if (!result_finite(page)) return invalid(fn, overflow_message);
+    for (size_t p = 0; p < sd.page_count; ++p) write_page(r.pages[p], sd.pages[p], mask);
     if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
     return HEMILIGHT_OK;
   });

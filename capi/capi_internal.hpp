@@ -6,12 +6,14 @@
 
 #include "hemilight/error.hpp"
 #include "hemilight/cubemap.hpp"
+#include "hemilight/geometry.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
 
 #include <memory>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -74,10 +76,28 @@ int enum_value(const E& e) noexcept {
   return v;
 }
 
+/// HEMILIGHT_OK, or INVALID_ARGUMENT with "function: <name> N is invalid: it must be even and in
+/// [2, 4096]" (the rule's one message: hemicube_resolution_problem, geometry.hpp) when N is not a
+/// valid hemicube resolution. `name`: the argument in the C caller's terms.
+inline hemilight_status check_resolution(const char* function, int resolution, const char* name = "resolution") {
+  if (is_valid_hemicube_resolution(resolution)) return HEMILIGHT_OK;
+  return invalid(function, hemicube_resolution_problem(resolution, name));
+}
+
 /// The C lights as C++ lights, checked: on a bad one, sets the error "function: what[i].field ..."
 /// (what = "lights" or "options->lights") and returns INVALID_ARGUMENT; else HEMILIGHT_OK.
 hemilight_status to_lights(const char* function, const char* what, const hemilight_light* lights, std::size_t count,
                            std::vector<light>& out);
+
+/// The checks of a C mesh's arrays that hemilight_scene_create and the bake entries share, in the
+/// caller's terms. "" or what is wrong with 3 * vertex_count positions named `name` ("positions",
+/// "meshes[1].positions"): "<name>[4] (vertex 1) = nan; it must be finite and at most 1e18 in
+/// magnitude".
+std::string positions_problem(const float* positions, std::size_t vertex_count, const std::string& name);
+/// "" or what is wrong with 3 * triangle_count vertex indices named `name`: "<name>[8] = 900 is out
+/// of range: 7 vertices".
+std::string indices_problem(const std::uint32_t* indices, std::size_t triangle_count, std::size_t vertex_count,
+                            const std::string& name);
 
 /// True if all `count` floats are finite.
 inline bool all_finite(const float* v, std::size_t count) noexcept {

@@ -40,9 +40,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     if (!positions) return invalid(fn, "positions is NULL");
     if (!normals) return invalid(fn, "normals is NULL");
     if (count == 0) return invalid(fn, "count is 0: there are no points");
-    if (!hemilight::is_valid_hemicube_resolution(opts->resolution))
-      return invalid(fn, "options->resolution " + std::to_string(opts->resolution) +
-                             " is invalid: it must be even and in [2, 4096]");
+    if (const hemilight_status st = hemilight::capi::check_resolution(fn, opts->resolution, "options->resolution")) return st;
     if (opts->thread_count < 0)
       return invalid(fn, "options->thread_count is " + std::to_string(opts->thread_count) + "; it must be >= 0");
     const std::pair<const char*, int> switches[] = {{"use_gradients", opts->use_gradients},
@@ -51,7 +49,8 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
                                                     {"shrink_disagreeing", opts->shrink_disagreeing},
                                                     {"refine_disagreement", opts->refine_disagreement},
                                                     {"extrapolate_wall_depth", opts->extrapolate_wall_depth},
-                                                    {"second_order", opts->second_order}};
+                                                    {"second_order", opts->second_order},
+                                                    {"edge_coverage", opts->edge_coverage}};
     for (const auto& sw : switches)
       if (sw.second != 0 && sw.second != 1)
         return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
@@ -65,25 +64,18 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
                              "or HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS (2)");
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     const hemilight::cache_options o = hemilight::capi::to_cpp(full);
-    // Every option before the sampler builds its tables (up to GBs at N = 4096); the message as
-    // cache_irradiance's own check gives it below.
-    try {
-      hemilight::validate_cache_options(o, "cache_irradiance");
-    } catch (const hemilight::error& e) {
-      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
-    }
+    // Every option before the sampler builds its tables (up to GBs at N = 4096), by the C++ rules
+    // (one statement of each), named from here: "hemilight_cache_irradiance: options: min_radius
+    // is -1; ...".
+    hemilight::validate_cache_options(o, std::string(fn) + ": options");
     hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
     so.raster.sky = scene->sky;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
-    hemilight::cache_result r;
-    try {
-      r = hemilight::cache_irradiance(reinterpret_cast<const glm::vec3*>(positions), reinterpret_cast<const glm::vec3*>(normals),
-                                      count, sampler, o);
-    } catch (const hemilight::error& e) {
-      // "cache_irradiance: normals[3] ..." -> "hemilight_cache_irradiance: normals[3] ..."
-      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string("hemilight_") + e.what());
-    }
+    // The points are checked by cache_irradiance (positions[i], normals[i]: the C arrays' names
+    // too); its message reaches the caller under this function's name (guarded, c_message).
+    hemilight::cache_result r = hemilight::cache_irradiance(reinterpret_cast<const glm::vec3*>(positions),
+                                                                  reinterpret_cast<const glm::vec3*>(normals), count, sampler, o);
     if (scene->lights) {
       // Direct light at every point, never interpolated (parallel; each point's value depends on
       // the point alone, so the result is the same for any thread count).

@@ -28,7 +28,8 @@ const span cache_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cache_options, shrink_disagreeing), HEMILIGHT_SPAN(hemilight_cache_options, refine_disagreement),
     HEMILIGHT_SPAN(hemilight_cache_options, second_opinion), HEMILIGHT_SPAN(hemilight_cache_options, nearby_opinion),
     HEMILIGHT_SPAN(hemilight_cache_options, sole_record_reach), HEMILIGHT_SPAN(hemilight_cache_options, invalid_backface_fraction),
-    HEMILIGHT_SPAN(hemilight_cache_options, extrapolate_wall_depth), HEMILIGHT_SPAN(hemilight_cache_options, second_order)};
+    HEMILIGHT_SPAN(hemilight_cache_options, extrapolate_wall_depth), HEMILIGHT_SPAN(hemilight_cache_options, second_order),
+    HEMILIGHT_SPAN(hemilight_cache_options, edge_coverage)};  // (reserved0 is padding: never read)
 const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, struct_size), HEMILIGHT_SPAN(hemilight_bake_options, width),
     HEMILIGHT_SPAN(hemilight_bake_options, height), HEMILIGHT_SPAN(hemilight_bake_options, resolution),
@@ -40,7 +41,7 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, environment_rgb), HEMILIGHT_SPAN(hemilight_bake_options, environment_size),
     HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
-    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity)};
+    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage)};
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -56,10 +57,16 @@ const span cubemap_irradiance_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, thread_count)};
 #undef HEMILIGHT_SPAN
 
-// The sizes of this ABI's first layouts (x86-64 and every LP64 ABI). A struct that grows keeps
-// its old size here and its new fields start at or after it.
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 96, "hemilight_cache_options changed: see above");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 144, "hemilight_bake_options changed: see above");
+// The sizes of this ABI's layouts (x86-64 and every LP64 ABI). A struct that grows keeps its old
+// size here and its new fields start at or after it: edge_coverage was appended to the cache
+// options of 96 bytes (after the padding field reserved0, since offset 92 was the old layout's
+// tail padding) and to the bake options of 144.
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 104, "hemilight_cache_options changed: see above");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_cache_options, edge_coverage) >= 96,
+              "hemilight_cache_options: edge_coverage must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 152, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, edge_coverage) >= 144,
+              "hemilight_bake_options: edge_coverage must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cubemap_irradiance_options) == 24,
@@ -115,6 +122,7 @@ hemilight_cache_options default_cache_options() {
   o.invalid_backface_fraction = d.invalid_backface_fraction;
   o.extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth ? 1 : 0;
   o.second_order = d.second_order ? 1 : 0;
+  o.edge_coverage = raster_options{}.edge_coverage ? 1 : 0;
   return o;
 }
 
@@ -140,6 +148,7 @@ hemilight_bake_options default_bake_options() {
   for (int& l : o.shadow_mask_lights) l = -1;
   o.shadow_mask_rgba = nullptr;
   o.shadow_mask_capacity = 0;
+  o.edge_coverage = bake_options{}.edge_coverage ? 1 : 0;
   return o;
 }
 
@@ -217,6 +226,7 @@ hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_optio
   hemicube_sampler_options so;
   so.resolution = c.resolution;
   so.integrate.extrapolate_wall_depth = c.extrapolate_wall_depth == 1;
+  so.raster.edge_coverage = c.edge_coverage == 1;
   return so;
 }
 
@@ -238,6 +248,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.output_sh_l1 = output_sh_l1;
   o.output_hl2 = output_hl2;
   for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
+  o.edge_coverage = c.edge_coverage == 1;
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;

@@ -35,8 +35,8 @@ void write_sized(const hemilight_cache_stats& from, hemilight_cache_stats* out);
 void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out);
 
 /// The C++ options of checked C options (switches already 0 or 1, the weight a known value).
-/// Every field of the C struct but resolution and extrapolate_wall_depth (which belong to the
-/// hemicube sampler: hemicube_sampler_options_of) lands here.
+/// Every field of the C struct but resolution, extrapolate_wall_depth and edge_coverage (which
+/// belong to the hemicube sampler: hemicube_sampler_options_of) lands here.
 cache_options to_cpp(const hemilight_cache_options& c);
 hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_options& c);
 

@@ -25,8 +25,7 @@ hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, con
     if (count > hemilight::max_scene_elements)
       return invalid(fn, "count " + std::to_string(count) + " is over the limit of " +
                              std::to_string(hemilight::max_scene_elements) + " probes per call");
-    if (!hemilight::is_valid_hemicube_resolution(resolution))
-      return invalid(fn, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
+    if (const hemilight_status st = hemilight::capi::check_resolution(fn, resolution)) return st;
     if (thread_count < 0) return invalid(fn, "thread_count is " + std::to_string(thread_count) + "; it must be >= 0 (0 = all cores)");
     for (std::size_t i = 0; i < count; ++i)
       if (!all_finite(positions + 3 * i, 3) || std::fabs(positions[3 * i]) > hemilight::max_coordinate ||

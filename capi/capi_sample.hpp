@@ -41,7 +41,4 @@ hemilight_status check_point(const char* function, const std::string& where, con
 /// The unit vector of a finite nonzero normal, computed in double (tiny and huge normals work).
 glm::vec3 unit_normal(const float* normal);
 
-/// Checks a hemicube resolution for `function` (even, in [2, 4096]); as check_point.
-hemilight_status check_resolution(const char* function, int resolution);
-
 }  // namespace hemilight::capi

@@ -69,12 +69,6 @@ hemilight_status check_point(const char* function, const std::string& where, con
   return HEMILIGHT_OK;
 }
 
-hemilight_status check_resolution(const char* function, int resolution) {
-  if (!is_valid_hemicube_resolution(resolution))
-    return invalid(function, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
-  return HEMILIGHT_OK;
-}
-
 void point_sampler::prepare(const hemilight_scene& scene, int resolution) {
   raster_options ro;
   ro.sky = scene.sky;

@@ -23,6 +23,23 @@ using hemilight::capi::invalid;
 
 namespace hemilight::capi {
 
+std::string positions_problem(const float* positions, std::size_t vertex_count, const std::string& name) {
+  for (std::size_t i = 0; i < 3 * vertex_count; ++i)
+    if (!(std::fabs(positions[i]) <= max_coordinate))
+      return name + "[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " + std::to_string(positions[i]) +
+             "; it must be finite and at most 1e18 in magnitude";
+  return {};
+}
+
+std::string indices_problem(const std::uint32_t* indices, std::size_t triangle_count, std::size_t vertex_count,
+                            const std::string& name) {
+  for (std::size_t i = 0; i < 3 * triangle_count; ++i)
+    if (indices[i] >= vertex_count)
+      return name + "[" + std::to_string(i) + "] = " + std::to_string(indices[i]) + " is out of range: " +
+             std::to_string(vertex_count) + " vertices";
+  return {};
+}
+
 hemilight_status to_lights(const char* function, const char* what, const hemilight_light* lights, std::size_t count,
                            std::vector<light>& out) {
   if (count > 0 && !lights) return invalid(function, std::string(what) + " is NULL but the count is " + std::to_string(count));
@@ -127,8 +144,11 @@ hemilight_status hemilight_scene_create(const float* positions, size_t vertex_co
       if (!(triangle_radiance[i] >= 0.0f && triangle_radiance[i] <= hemilight::max_radiance))
         return invalid(fn, "triangle_radiance[" + std::to_string(i) + "] = " + std::to_string(triangle_radiance[i]) +
                                " (triangle " + std::to_string(i / 3) + "); radiance must be finite, >= 0 and at most 1e30");
-    // glm::vec3 is three packed floats: the caller's arrays are read in place by scene::create,
-    // which validates positions and indices with messages naming them.
+    if (std::string p = hemilight::capi::positions_problem(positions, vertex_count, "positions"); !p.empty()) return invalid(fn, p);
+    if (std::string p = hemilight::capi::indices_problem(indices, triangle_count, vertex_count, "indices"); !p.empty())
+      return invalid(fn, p);
+    // glm::vec3 is three packed floats: the caller's arrays are read in place by scene::create
+    // (checked above in the caller's terms; scene::create checks them again).
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
     std::vector<hemilight::material> materials(triangle_count);
     for (size_t i = 0; i < triangle_count; ++i)
@@ -141,15 +161,7 @@ hemilight_status hemilight_scene_create(const float* positions, size_t vertex_co
     desc.materials = materials.data();
     desc.sky_radiance = {sky_radiance[0], sky_radiance[1], sky_radiance[2]};
     auto handle = std::make_unique<hemilight_scene>();
-    try {
-      handle->scene = hemilight::scene::create(desc);
-    } catch (const hemilight::error& e) {
-      // Same message, under this function's name ("scene::create: indices[17] = ...").
-      std::string what = e.what();
-      const std::string prefix = "scene::create: ";
-      if (what.compare(0, prefix.size(), prefix) == 0) what.erase(0, prefix.size());
-      return hemilight::capi::set_error(hemilight::capi::to_c(e.code()), std::string(fn) + ": " + what);
-    }
+    handle->scene = hemilight::scene::create(desc);
     *out = handle.release();
     return HEMILIGHT_OK;
   });

@@ -357,9 +357,21 @@ typedef enum hemilight_cache_weight {
                                                       continuous there (lower error, docs/cache.md) */
 } hemilight_cache_weight;
 
+/* Options of hemilight_cache_irradiance; fill with hemilight_cache_options_init, then change what
+ * you need. Fields come in two groups. Fields are only ever appended ("Structs that grow"), so the
+ * groups cannot be contiguous; each field below is marked with its group:
+ *   - what an engine tunes: resolution, error_threshold, min_radius, max_radius, use_gradients,
+ *     thread_count, progress, progress_user, weight, invalid_backface_fraction, second_order,
+ *     edge_coverage;
+ *   - expert: kept for comparisons; see cache_options in C++ (include/hemilight/cache.hpp):
+ *     gradient_radius_limit, neighbour_clamp, shrink_disagreeing, refine_disagreement,
+ *     second_opinion, nearby_opinion, sole_record_reach, extrapolate_wall_depth. Each switches one
+ *     placement rule or estimator so that its effect can be measured; the defaults are the
+ *     measured best (docs/cache.md) and an engine leaves them alone. */
 typedef struct hemilight_cache_options {
   size_t struct_size;     /* sizeof(hemilight_cache_options) as the caller was built: set by
                              hemilight_cache_options_init (see "Structs that grow" at the top) */
+  /* ---- what an engine tunes ---- */
   int resolution;         /* hemicube N, even, 2..4096 (default 64) */
   float error_threshold;  /* Ward's a, [0.001, 1]: larger = fewer hemicubes, more error (default 0.2) */
   float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
@@ -368,9 +380,10 @@ typedef struct hemilight_cache_options {
   int thread_count;       /* 0 = all cores (default 0) */
   hemilight_progress_fn progress; /* may be NULL (default NULL) */
   void* progress_user;    /* passed to progress */
-  /* Since 0.5: the placement rules and radius limits of include/hemilight/cache.hpp
-   * (cache_options), each switchable so that its effect can be measured (docs/cache.md). */
-  hemilight_cache_weight weight;  /* interpolation weight (default HEMILIGHT_CACHE_WEIGHT_WARD) */
+  hemilight_cache_weight weight;  /* since 0.5: interpolation weight (default HEMILIGHT_CACHE_WEIGHT_WARD) */
+  /* ---- expert: kept for comparisons; see cache_options in C++ (include/hemilight/cache.hpp) ----
+   * Since 0.5: the placement rules and radius limits, each switchable so that its effect can be
+   * measured (docs/cache.md). Leave them at their defaults. */
   int gradient_radius_limit;      /* 0 or 1: R <= E / |translation gradient| (default 1) */
   int neighbour_clamp;            /* 0 or 1: R_i <= R_j + |x_i - x_j| (default 1) */
   int shrink_disagreeing;         /* 0 or 1: shrink neighbours whose gradients disagree (default 1) */
@@ -382,14 +395,23 @@ typedef struct hemilight_cache_options {
                                      point must agree with it, within this many finest spacings (default 2) */
   float sole_record_reach;        /* (0, 1], 1 = off: a singly covered point must lie inside this fraction
                                      of the record's reach (default 0.99) */
-  float invalid_backface_fraction; /* [0, 1]: samples seeing more back faces are invalid (default 0.1) */
-  int extrapolate_wall_depth;     /* 0 or 1: the hemicubes' translation gradients take each texel wall's
-                                     depth extrapolated from the nearer texel (more accurate where planes
-                                     are seen at grazing angles; docs/integration.md) (default 0) */
+  float invalid_backface_fraction; /* engine: [0, 1]: samples seeing more back faces are invalid, i.e. the
+                                      point is inside geometry (default 0.1) */
+  int extrapolate_wall_depth;     /* expert; 0 or 1: the hemicubes' translation gradients take each texel
+                                     wall's depth extrapolated from the nearer texel (more accurate where
+                                     planes are seen at grazing angles; docs/integration.md) (default 0) */
+  /* ---- what an engine tunes (continued) ---- */
   int second_order;               /* since 0.7; 0 or 1: after placement, each record gets a Hessian fitted
                                      from its neighbours' gradients (scaled by how well it predicts their
                                      values) and the interpolation adds its quadratic term; the same
                                      records and hemicubes, lower error (docs/cache.md) (default 1) */
+  int reserved0;                  /* padding, not read: keeps edge_coverage past the earlier layout's
+                                     sizeof on every ABI (its tail padding is not the caller's to fill) */
+  int edge_coverage;              /* since 0.14; 0 or 1: the hemicubes give a texel an edge crosses the
+                                     exact covered fraction of its weight instead of what its centre sees
+                                     (no edge aliasing: an emitter's irradiance to about 1e-4 where point
+                                     sampling is off by up to 18% at N = 16; docs/raster.md, "Exact edge
+                                     coverage"). Costs several times the render time (default 0) */
 } hemilight_cache_options;
 
 /* Fills the first struct_size bytes of options with the defaults above and sets
@@ -496,6 +518,9 @@ typedef struct hemilight_bake_options {
   int shadow_mask_lights[4];
   float* shadow_mask_rgba;
   size_t shadow_mask_capacity;
+  /* Since 0.14; 0 or 1: every hemicube of the bake with exact edge coverage, as
+   * hemilight_cache_options.edge_coverage (default 0). */
+  int edge_coverage;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */

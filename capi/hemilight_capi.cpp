@@ -15,16 +15,11 @@
 
 namespace {
 
+using hemilight::capi::check_resolution;
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
 
 thread_local std::string last_error_message;
-
-bool check_resolution(const char* function, int resolution, hemilight_status& status) {
-  if (hemilight::is_valid_hemicube_resolution(resolution)) return true;
-  status = invalid(function, "resolution " + std::to_string(resolution) + " is invalid: it must be even and in [2, 4096]");
-  return false;
-}
 
 bool check_size(const char* function, const char* name, int value, hemilight_status& status) {
   if (value > 0) return true;
@@ -60,9 +55,8 @@ void hemilight_version(int* major, int* minor, int* patch) {
 hemilight_status hemilight_hemicube_texel_count(int resolution, size_t* count) {
   const char* fn = "hemilight_hemicube_texel_count";
   return guarded(fn, [&] {
-    hemilight_status st = HEMILIGHT_OK;
     if (!count) return invalid(fn, "count is NULL");
-    if (!check_resolution(fn, resolution, st)) return st;
+    if (const hemilight_status st = check_resolution(fn, resolution)) return st;
     *count = hemilight::hemicube_texel_count(resolution);
     return HEMILIGHT_OK;
   });
@@ -72,8 +66,7 @@ hemilight_status hemilight_hemicube_texel_info(int resolution, size_t texel, flo
                                                float* projected_solid_angle) {
   const char* fn = "hemilight_hemicube_texel_info";
   return guarded(fn, [&] {
-    hemilight_status st = HEMILIGHT_OK;
-    if (!check_resolution(fn, resolution, st)) return st;
+    if (const hemilight_status st = check_resolution(fn, resolution)) return st;
     const std::size_t count = hemilight::hemicube_texel_count(resolution);
     if (texel >= count)
       return invalid(fn, "texel " + std::to_string(texel) + " is out of range: resolution " +

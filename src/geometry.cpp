@@ -15,6 +15,16 @@ double area_element(double u, double v) noexcept { return std::atan2(u * v, std:
 
 }  // namespace
 
+std::string hemicube_resolution_problem(int n, const std::string& name) {
+  if (is_valid_hemicube_resolution(n)) return {};
+  return name + " " + std::to_string(n) + " is invalid: it must be even and in [" + std::to_string(hemicube_min_resolution) +
+         ", " + std::to_string(hemicube_max_resolution) + "]";
+}
+
+void check_hemicube_resolution(int n, const char* function, const std::string& name) {
+  if (!is_valid_hemicube_resolution(n)) throw_invalid_argument(std::string(function) + ": " + hemicube_resolution_problem(n, name));
+}
+
 double rectangle_solid_angle(double u0, double v0, double u1, double v1) noexcept {
   return area_element(u1, v1) - area_element(u0, v1) - area_element(u1, v0) + area_element(u0, v0);
 }

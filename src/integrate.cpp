@@ -109,9 +109,7 @@ constexpr float sh_y1 = 0.488602511902919921f;   // sqrt(3) / (2 sqrt(pi))
 }  // namespace
 
 integration_table::integration_table(int n) : n_(n) {
-  if (!is_valid_hemicube_resolution(n))
-    throw_invalid_argument("integration_table: resolution " + std::to_string(n) +
-                           " is invalid: it must be even and in [2, 4096]");
+  check_hemicube_resolution(n, "integration_table");
   const std::size_t count = hemicube_texel_count(n);
   const std::size_t un = static_cast<std::size_t>(n);
   for (std::vector<float>* v : {&vx, &vy, &vz, &simple_x, &simple_y, &hl2[0], &hl2[1], &hl2[2], &solid_angle,

@@ -166,8 +166,7 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   // Step 1: checks, before any work.
   if (!s) throw_invalid_argument("sample_probes: scene is null");
   if (count > 0 && !positions) throw_invalid_argument("sample_probes: positions is null but count is " + std::to_string(count));
-  if (!is_valid_hemicube_resolution(o.resolution))
-    throw_invalid_argument("sample_probes: resolution " + std::to_string(o.resolution) + " is invalid: it must be even and in [2, 4096]");
+  check_hemicube_resolution(o.resolution, "sample_probes");
   if (o.thread_count < 0)
     throw_invalid_argument("sample_probes: thread_count is " + std::to_string(o.thread_count) + "; it must be >= 0 (0 = all cores)");
   if (o.lights) validate_direct_options(o.direct);
@@ -195,6 +194,7 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
       std::min(static_cast<std::size_t>(resolve_thread_count(o.thread_count)), (count + grain - 1) / grain));
   raster_options ro;
   ro.sky = o.sky;
+  ro.edge_coverage = o.edge_coverage;
   struct context {
     std::unique_ptr<hemicube_rasterizer> raster;
     hemicube_buffer buffer;

@@ -164,7 +164,7 @@ static void test_scene(void) {
   CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, radiance, NULL, &out), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "sky_radiance is NULL");
   CHECK_FAILS(hemilight_scene_create(nan_positions, 7, indices, 3, radiance, sky, &out),
-              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_scene_create: positions[1].y is nan");
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_scene_create: positions[4] (vertex 1) = nan");
   CHECK_FAILS(hemilight_scene_create(positions, 7, bad_indices, 3, radiance, sky, &out),
               HEMILIGHT_ERROR_INVALID_ARGUMENT, "indices[8] = 900 is out of range: 7 vertices");
   CHECK_FAILS(hemilight_scene_create(positions, 7, indices, 3, bad_radiance, sky, &out),

@@ -37,6 +37,53 @@ static int cancel_at_once(void* user, float fraction) {
   return 0;
 }
 
+/* hemilight_bake_options.edge_coverage: a floor quad (UV [0, 0.5] x [0, 1]) under an emitter quad
+ * 0.3 above it that covers part of it (UV [0.5, 1] x [0, 1]), baked with and without exact edge
+ * coverage. Both must succeed with finite values; they must differ where the emitter's edges cut
+ * hemicube texels (exact coverage against point sampling, up to ~18% of an edge's weight at N = 16).
+ * The accuracy itself is tested through hemilight_cache_irradiance (test_capi_irradiance.c). */
+static void test_edge_coverage(void) {
+  static const float floor_pos[] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
+  static const float lamp_pos[] = {0.2f, 0.3f, -0.1f, 0.7f, 0.3f, -0.1f, 0.7f, 0.3f, -0.55f, 0.2f, 0.3f, -0.55f};
+  static const float floor_uv[] = {0, 0, 0.5f, 0, 0.5f, 1, 0, 1};
+  static const float lamp_uv[] = {0.5f, 0, 1, 0, 1, 1, 0.5f, 1};
+  static const uint32_t up[] = {0, 1, 2, 0, 2, 3}, down[] = {0, 2, 1, 0, 3, 2};
+  static float with_edges[3 * W * H];
+  hemilight_bake_mesh meshes[2];
+  hemilight_bake_options o;
+  int i, finite = 1, differ = 0;
+  memset(meshes, 0, sizeof meshes);
+  meshes[0].positions = floor_pos;
+  meshes[0].lightmap_uvs = floor_uv;
+  meshes[0].vertex_count = 4;
+  meshes[0].indices = up; /* normal +y */
+  meshes[0].triangle_count = 2;
+  meshes[0].material.albedo[0] = meshes[0].material.albedo[1] = meshes[0].material.albedo[2] = 0.5f;
+  meshes[1] = meshes[0];
+  meshes[1].positions = lamp_pos;
+  meshes[1].lightmap_uvs = lamp_uv;
+  meshes[1].indices = down; /* normal -y: towards the floor */
+  meshes[1].material.emission[0] = meshes[1].material.emission[1] = meshes[1].material.emission[2] = 1.0f;
+  hemilight_bake_options_init(&o);
+  CHECK(o.edge_coverage == 0); /* off by default */
+  o.width = W;
+  o.height = H;
+  o.resolution = 16;
+  o.use_cache = 0; /* a hemicube per texel: the difference is the hemicubes' alone */
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL) == HEMILIGHT_OK);
+  o.edge_coverage = 1;
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, with_edges, 3 * W * H, NULL, 0, NULL) == HEMILIGHT_OK);
+  for (i = 0; i < 3 * W * H; ++i) {
+    if (!isfinite(with_edges[i]) || with_edges[i] < 0.0f) finite = 0;
+    if (fabs(with_edges[i] - out[i]) > 1e-3 * (fabs(out[i]) + 1e-3)) differ = 1;
+  }
+  CHECK(finite);
+  CHECK(differ);
+  o.edge_coverage = -1;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_bake_lightmap: options->edge_coverage is -1; it must be 0 or 1");
+}
+
 int main(void) {
   /* Two unit floor quads side by side (x in [0, 1] and [1, 2]), facing up, each on half of the map. */
   static const float pos_a[] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
@@ -269,6 +316,7 @@ int main(void) {
   CHECK(calls == 1);
   CHECK(untouched());
 
+  test_edge_coverage();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

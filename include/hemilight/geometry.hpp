@@ -38,6 +38,7 @@
 #include <cmath>
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hemilight {
@@ -71,6 +72,17 @@ struct hemicube_face_axes {
 constexpr bool is_valid_hemicube_resolution(int n) noexcept {
   return n >= hemicube_min_resolution && n <= hemicube_max_resolution && n % 2 == 0;
 }
+
+/// The one statement of the rule above for messages: "" when N is valid, else
+/// "<name> <N> is invalid: it must be even and in [2, 4096]", where `name` is the argument in the
+/// caller's terms ("resolution", "options->resolution", ...). Every check of a hemicube
+/// resolution builds its message here (callers prefix their function's name). Cost: one short
+/// string when N is invalid, nothing otherwise.
+std::string hemicube_resolution_problem(int n, const std::string& name = "resolution");
+
+/// Throws error(invalid_argument) "<function>: <hemicube_resolution_problem(n, name)>" when N is
+/// not a valid hemicube resolution; does nothing otherwise.
+void check_hemicube_resolution(int n, const char* function, const std::string& name = "resolution");
 
 /// Total number of texels, 3 N^2. Precondition: N valid.
 constexpr std::size_t hemicube_texel_count(int n) noexcept {

@@ -76,6 +76,12 @@ struct probe_options {
   /// Needs a scene with lightmap UVs; must outlive the call.
   const radiance_texture* texture = nullptr;
   direct_options direct;                  ///< the lights' shadow sampling
+  /// Exact edge coverage in both hemicubes (raster_options::edge_coverage; docs/raster.md, "Exact
+  /// edge coverage"): a texel an emitter's edge crosses gets the emitter's exact share of it
+  /// instead of what its centre sees, which removes the edge aliasing of point sampling (the
+  /// rectangle of docs/probes.md: SH band 0 off by 11% at N = 16 without it, 0.1% with it).
+  /// Cost: several times the render time at N = 64 (docs/raster.md), so off by default.
+  bool edge_coverage = false;
 };
 
 /// Probes at points.
