@@ -42,10 +42,12 @@ TEST_CASE("C ABI options: every cache option reaches the C++ side", "[capi]") {
   c.invalid_backface_fraction = 0.3f;
   c.extrapolate_wall_depth = 1;
   c.second_order = 0;
+  c.edge_coverage = 1;
   const cache_options o = capi::to_cpp(c);
   const hemicube_sampler_options so = capi::hemicube_sampler_options_of(c);
   CHECK(so.resolution == 48);
   CHECK(so.integrate.extrapolate_wall_depth);
+  CHECK(so.raster.edge_coverage);
   CHECK(o.error_threshold == 0.37f);
   CHECK(o.min_radius == 0.011f);
   CHECK(o.max_radius == 2.5f);
@@ -91,6 +93,8 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(o.second_order == d.second_order);
   CHECK(!o.progress);
   CHECK(capi::hemicube_sampler_options_of(capi::default_cache_options()).resolution == hemicube_sampler_options{}.resolution);
+  CHECK(capi::hemicube_sampler_options_of(capi::default_cache_options()).raster.edge_coverage ==
+        hemicube_sampler_options{}.raster.edge_coverage);
   const bake_options bd;
   const bake_options b = capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false);
   CHECK(b.resolution == bd.resolution);
@@ -101,6 +105,7 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(b.dilation == bd.dilation);
   CHECK(b.use_cache == bd.use_cache);
   CHECK(b.thread_count == bd.thread_count);
+  CHECK(b.edge_coverage == bd.edge_coverage);
 }
 
 TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
@@ -119,6 +124,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   c.progress_user = &progress_calls;
   c.shadow_mask_lights[0] = 2;
   c.shadow_mask_lights[3] = 0;
+  c.edge_coverage = 1;
   light l;
   l.position = {1, 2, 3};
   const auto env = std::make_shared<const cubemap>();
@@ -141,6 +147,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.shadow_mask_lights[0] == 2);
   CHECK(o.shadow_mask_lights[1] == -1);
   CHECK(o.shadow_mask_lights[3] == 0);
+  CHECK(o.edge_coverage);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
@@ -173,6 +180,22 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   CHECK(bfull.width == 17);
   CHECK(bfull.light_count == 0);
   CHECK(bfull.lights == nullptr);
+  // The layouts before edge_coverage (cache: up to second_order, whose tail padding is not read;
+  // bake: up to shadow_mask_capacity): the field takes its default, 0, whatever lies beyond.
+  hemilight_cache_options before_edge;
+  std::memset(&before_edge, 0x01, sizeof before_edge);  // edge_coverage and the padding would read as nonzero
+  before_edge.struct_size = offsetof(hemilight_cache_options, edge_coverage);  // the older sizeof (96 on LP64)
+  hemilight_cache_options edge_full = capi::default_cache_options();
+  REQUIRE(capi::read_sized(&before_edge, edge_full).empty());
+  CHECK(edge_full.edge_coverage == 0);
+  CHECK(edge_full.reserved0 == 0);              // padding: never read
+  CHECK(edge_full.second_order == 0x01010101);  // read: within the older size
+  hemilight_bake_options bake_before_edge = capi::default_bake_options();
+  bake_before_edge.edge_coverage = 1;
+  bake_before_edge.struct_size = offsetof(hemilight_bake_options, edge_coverage);
+  hemilight_bake_options bake_edge_full = capi::default_bake_options();
+  REQUIRE(capi::read_sized(&bake_before_edge, bake_edge_full).empty());
+  CHECK(bake_edge_full.edge_coverage == 0);
   // Statistics: only the fields within struct_size are written.
   hemilight_cache_stats from{};
   from.struct_size = sizeof from;
