@@ -82,6 +82,16 @@ static void test_edge_coverage(void) {
   o.edge_coverage = -1;
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "hemilight_bake_lightmap: options->edge_coverage is -1; it must be 0 or 1");
+  /* The options the C++ bake also checks are checked by the C layer first, naming the C field. */
+  o.edge_coverage = 0;
+  o.dilation = -2;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_bake_lightmap: options->dilation -2 must be >= -1");
+  o.dilation = 16;
+  o.resolution = 7;
+  CHECK_FAILS(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, NULL, 0, sh, 12 * W * H, NULL, 0, NULL),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_bake_lightmap_directional: options->resolution 7 is invalid: it must be even and in [2, 4096]");
 }
 
 int main(void) {

@@ -519,6 +519,15 @@ static void test_edge_coverage(void) {
   o.edge_coverage = 2;
   CHECK_FAILS(hemilight_cache_irradiance(rect, p, n, 1, &o, exact, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "hemilight_cache_irradiance: options->edge_coverage is 2; it must be 0 or 1");
+  /* The cache options' own rules (validate_cache_options), named by the C layer. */
+  o.edge_coverage = 0;
+  o.min_radius = -1.0f;
+  CHECK_FAILS(hemilight_cache_irradiance(rect, p, n, 1, &o, exact, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_cache_irradiance: options: min_radius is -1.000000; it must be finite and >= 0");
+  o.min_radius = 0.0f;
+  o.resolution = 15;
+  CHECK_FAILS(hemilight_cache_irradiance(rect, p, n, 1, &o, exact, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_cache_irradiance: options->resolution 15 is invalid: it must be even and in [2, 4096]");
   hemilight_scene_release(rect);
 }
 
