@@ -358,8 +358,8 @@ typedef enum hemilight_cache_weight {
 } hemilight_cache_weight;
 
 /* Options of hemilight_cache_irradiance; fill with hemilight_cache_options_init, then change what
- * you need. Fields come in two groups. Fields are only ever appended ("Structs that grow"), so the
- * groups cannot be contiguous; each field below is marked with its group:
+ * you need. The fields come in two groups; since fields are only ever appended ("Structs that
+ * grow"), the groups cannot be contiguous in memory, so the comments below mark each field's:
  *   - what an engine tunes: resolution, error_threshold, min_radius, max_radius, use_gradients,
  *     thread_count, progress, progress_user, weight, invalid_backface_fraction, second_order,
  *     edge_coverage;
