@@ -58,8 +58,9 @@
 // CSV columns: part,scene,mode,N,a,round,points,hemicubes,seconds,hemicubes_per_s,rms_rel_err,
 // max_rel_err,mean_rel_err,target_hemicubes,matched,threads,loadavg. `seconds` is the wall time of the
 // row's work (hemicubes_per_s = hemicubes / seconds; 0 for a reference read from --truth-cache);
-// mean_rel_err is the mean signed error (a bias shows there, aliasing noise averages out); parts:
-// reference, check, cost, time, per_point, cache.
+// mean_rel_err is the mean signed error (a bias shows there, aliasing noise averages out); rows
+// without an error (reference, cost, time) have rms and max -1, mean 0. Parts: reference, check,
+// cost, time, per_point, cache.
 #include "hemilight/cache.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/reference_scenes.hpp"
@@ -619,6 +620,10 @@ int main(int argc, char** argv) {
     }
     if (!st.has_part("n") && !st.has_part("cache")) continue;
     const reference ref = make_reference(st, ps, out);
+    if (ref.idx.empty()) {
+      std::printf("  no valid reference point (every one sees > 10%% back faces): no errors for %s\n", scene_name(key));
+      continue;
+    }
     if (st.has_part("n")) n_part(st, ps, ref, out);
     if (st.has_part("cache")) cache_part(st, ps, ref, out);
   }
