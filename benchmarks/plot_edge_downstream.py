@@ -6,7 +6,8 @@ against the time per hemicube (median of the paired one-thread rounds), N = 16 .
 sampling and edge coverage; the 1% line, and the first N under it marked. Bottom row, per scene:
 the cache's RMS error against the hemicubes it rendered, point sampling at each threshold a and
 edge coverage at the threshold matched to the same count, with the per-point hemicube's own error
-at the cache's N as dotted lines (what the cache cannot beat).
+at the cache's N as dotted lines (what the cache cannot beat). The silhouette rows (closed boxes
+against their front faces only) are printed, not drawn.
 
 usage: plot_edge_downstream.py [DIR]   (DIR holds edge_downstream.csv; the PNG is written there)
 """
@@ -92,6 +93,14 @@ for s in scenes:
         print(f"| {s} | {p['a']:.2f} / {e['a']:.3f} | {int(p['hemicubes'])} / {int(e['hemicubes'])} | "
               f"{100 * p['rms_rel_err']:.2f} ({100 * p['max_rel_err']:.1f}) | {100 * e['rms_rel_err']:.2f} "
               f"({100 * e['max_rel_err']:.1f}) | {p['seconds']:.1f} / {e['seconds']:.1f} |")
+
+print("\nsilhouettes of closed meshes: 8 boxes under a sky of 1 against the closed form, RMS % (mean signed %)")
+sil = part("silhouette")
+for shape in dict.fromkeys(r["scene"] for r in sil):
+    for m, *_ in MODES:
+        cells = [f"{100 * r['rms_rel_err']:.3f} ({100 * r['mean_rel_err']:+.3f})"
+                 for r in sorted((r for r in sil if r["scene"] == shape and r["mode"] == m), key=lambda r: r["N"])]
+        print(f"| {shape} | {m} | " + " | ".join(cells) + " |")
 
 # ---- chart ----------------------------------------------------------------------------------
 if not scenes:

@@ -4,7 +4,7 @@
 // "Measure", the downstream part; docs/raster.md, "Exact edge coverage").
 //
 //   usage: sweep_edge_downstream out.csv [options]
-//     --parts LIST        any of cost,n,cache (default all three)
+//     --parts LIST        any of cost,n,cache,silhouette (default all four)
 //     --scenes LIST       any of cornell,hexagon,sky (default all three)
 //     --grid K            points per side of each surface (default 64)
 //     --stride S          the converged reference (and the per-point sweep) use every S-th point (default 5)
@@ -54,6 +54,12 @@
 //    row; the one closest to the target has matched = 1.
 // Error: |E - E_ref| / max(E_ref, 5% of the mean E_ref) in luminance, as sweep_cache (umbra points do
 // not divide by ~0).
+// 5. Silhouettes of closed meshes (part "silhouette", once, not per scene): 8 boxes (pseudo-random
+//    sizes and places, wholly above the horizon) under a sky of 1, each alone, seen from the origin
+//    with normal +z, rendered and integrated at each N of --ns; E against the closed form pi minus
+//    Lambert's formula over the faces that face the point. Each box twice: closed (12 triangles) and
+//    its front faces only (the back faces left out). Rows: scene closed_box or front_faces, the RMS,
+//    max and mean of the signed relative error over the 8 boxes.
 //
 // CSV columns: part,scene,mode,N,a,round,points,hemicubes,seconds,hemicubes_per_s,rms_rel_err,
 // max_rel_err,mean_rel_err,target_hemicubes,matched,threads,loadavg. `seconds` is the wall time of the
@@ -62,7 +68,9 @@
 // without an error (reference, cost, time) have rms and max -1, mean 0. Parts: reference, check,
 // cost, time, per_point, cache.
 #include "hemilight/cache.hpp"
+#include "hemilight/integrate.hpp"
 #include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
 #include "hemilight/reference_scenes.hpp"
 
 #include "bench_points.hpp"
@@ -74,6 +82,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -85,7 +94,7 @@ namespace {
 
 struct settings {
   std::string path;
-  std::vector<std::string> parts{"cost", "n", "cache"};
+  std::vector<std::string> parts{"cost", "n", "cache", "silhouette"};
   std::vector<std::string> scenes{"cornell", "hexagon", "sky"};
   int grid = 64, stride = 5, converged = 512, check = 1024, check_point = 1024, check_stride = 8;
   std::vector<int> ns{16, 24, 32, 48, 64, 96, 128, 192, 256};
@@ -102,7 +111,7 @@ struct settings {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "sweep_edge_downstream: %s\n"
-               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache] [--scenes cornell,hexagon,sky] [--grid K]\n"
+               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache,silhouette] [--scenes cornell,hexagon,sky] [--grid K]\n"
                "       [--stride S] [--converged N] [--reference edge|point] [--check N] [--check-point N] [--check-stride S] [--ns N,...]\n"
                "       [--cost-n N] [--rounds R] [--cost-points P] [--time-rounds R] [--time-points P] [--cache-n N]\n"
                "       [--a a,...] [--threads T] [--truth-cache DIR] [--append]\n"
@@ -154,7 +163,7 @@ settings parse(int argc, char** argv) {
       if (v.empty()) usage(arg + " needs at least one entry");
       return v;
     };
-    if (arg == "--parts") st.parts = list({"cost", "n", "cache"});
+    if (arg == "--parts") st.parts = list({"cost", "n", "cache", "silhouette"});
     else if (arg == "--scenes") st.scenes = list({"cornell", "hexagon", "sky"});
     else if (arg == "--grid") st.grid = to_int(value(), "--grid", 2, 1024);
     else if (arg == "--stride") st.stride = to_int(value(), "--stride", 1, 1 << 20);
@@ -364,6 +373,98 @@ void write(FILE* out, const row& r) {
 }
 
 const char* mode_name(bool edge) { return edge ? "edge" : "point"; }
+
+// ---- part "silhouette" -------------------------------------------------------------------------
+
+// Lambert's formula: the projected solid angle (normal +z) of the convex polygon `poly` (relative
+// to the point), all of it above the horizon.
+double lambert(const std::vector<glm::dvec3>& poly) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec3 u = glm::normalize(poly[i]), v = glm::normalize(poly[(i + 1) % poly.size()]);
+    const glm::dvec3 g = glm::cross(u, v);
+    const double len = glm::length(g);
+    if (len > 0.0) sum += std::atan2(len, glm::dot(u, v)) * g.z / len;
+  }
+  return 0.5 * std::fabs(sum);
+}
+
+// Boxes under a sky of 1, closed and with their front faces only: the closed form E = pi - the
+// front faces' projected solid angle holds for both (the back faces are hidden behind the front).
+void silhouette_part(const settings& st, FILE* out) {
+  constexpr double pi = 3.14159265358979323846;
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.0, 1.0);
+  struct box_case {
+    std::vector<glm::dvec3> quads[6];  // outward-facing, counter-clockwise seen from outside
+    bool front[6];
+    double e_ref;
+  };
+  std::vector<box_case> boxes(8);
+  for (box_case& b : boxes) {
+    const glm::dvec3 c(0.8 * u(rng), 0.8 * u(rng), 1.0 + 0.8 * pos(rng));
+    const glm::dvec3 h(0.1 + 0.25 * pos(rng), 0.1 + 0.25 * pos(rng), 0.1 + 0.3 * pos(rng));
+    double occluded = 0.0;
+    for (int f = 0; f < 6; ++f) {
+      const int ax = f / 2, a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+      const double side = f % 2 ? 1.0 : -1.0;
+      const double corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+      for (const auto& k : corners) {
+        glm::dvec3 p = c;
+        p[ax] += side * h[ax];
+        p[a1] += k[0] * h[a1];
+        p[a2] += k[1] * h[a2];
+        b.quads[f].push_back(p);
+      }
+      glm::dvec3 n(0.0);
+      n[ax] = side;
+      std::vector<glm::dvec3>& q = b.quads[f];
+      if (glm::dot(glm::cross(q[1] - q[0], q[2] - q[0]), n) < 0.0) std::swap(q[1], q[3]);
+      b.front[f] = glm::dot(n, q[0]) < 0.0;  // the face faces the origin
+      if (b.front[f]) occluded += lambert(q);
+    }
+    b.e_ref = pi - occluded;
+  }
+  const material occluder{glm::vec3(0.0f), glm::vec3(0.5f), false};
+  const frame basis{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (const bool closed : {true, false})
+    for (const bool edge : {false, true})
+      for (const int n : st.ns) {
+        double sum = 0.0, signed_sum = 0.0, worst = 0.0;
+        for (const box_case& b : boxes) {
+          scene_mesh m;
+          m.sky_radiance = glm::vec3(1.0f);
+          for (int f = 0; f < 6; ++f)
+            if (closed || b.front[f]) {
+              const std::vector<glm::dvec3>& q = b.quads[f];
+              m.add_triangle(glm::vec3(q[0]), glm::vec3(q[1]), glm::vec3(q[2]), occluder);
+              m.add_triangle(glm::vec3(q[0]), glm::vec3(q[2]), glm::vec3(q[3]), occluder);
+            }
+          raster_options o;
+          o.edge_coverage = edge;
+          hemicube_rasterizer r(scene::create(m.desc()), o);
+          hemicube_buffer buf;
+          r.render({0, 0, 0}, basis, n, buf);
+          hemicube_integrator integ(n);
+          const double err = (double(integ.integrate(buf).irradiance.x) - b.e_ref) / b.e_ref;
+          sum += err * err;
+          signed_sum += err;
+          worst = std::max(worst, std::fabs(err));
+        }
+        row r{"silhouette", closed ? "closed_box" : "front_faces", mode_name(edge)};
+        r.n = n;
+        r.points = boxes.size();
+        r.rms = std::sqrt(sum / double(boxes.size()));
+        r.worst = worst;
+        r.mean = signed_sum / double(boxes.size());
+        write(out, r);
+        if (n == 64)
+          std::printf("silhouettes, %s, %s, N = 64: mean %+.4f%%, max |%.4f%%| over %zu boxes\n",
+                      closed ? "closed boxes" : "front faces only", edge ? "edge coverage" : "point sampling",
+                      100.0 * r.mean, 100.0 * worst, boxes.size());
+      }
+  std::fflush(stdout);
+}
 
 // ---- the reference -----------------------------------------------------------------------------
 
@@ -612,6 +713,7 @@ int main(int argc, char** argv) {
     std::fprintf(out, "part,scene,mode,N,a,round,points,hemicubes,seconds,hemicubes_per_s,rms_rel_err,max_rel_err,"
                       "mean_rel_err,target_hemicubes,matched,threads,loadavg\n");
   const auto t0 = std::chrono::steady_clock::now();
+  if (st.has_part("silhouette")) silhouette_part(st, out);
   for (const std::string& key : st.scenes) {
     const point_set ps = make_points(key, st.grid);
     if (st.has_part("cost")) {
