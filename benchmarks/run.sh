@@ -10,6 +10,8 @@
 #                                     ward_continuous, first order (docs/cache.md; 15-30 min; not run by default)
 #   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
 #                                     both weights (docs/cache.md; ~25 min; not run by default)
+#   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~5 min; also
+#                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -114,6 +116,16 @@ for n in "${names[@]}"; do
         --stride 76 --check-stride 6
     done
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
+  if [ "$n" = edge_downstream ]; then
+    # What exact edge coverage buys downstream (docs/raster.md): cost, the cache at a matched hemicube
+    # budget, the N at which a hemicube per point reaches 1%. ~5 min on 2 cores. A subset:
+    # EDGE_DOWNSTREAM_FLAGS="--parts n --scenes cornell" (flags at the top of sweep_edge_downstream.cpp).
+    echo "== sweep_edge_downstream"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream.csv ${EDGE_DOWNSTREAM_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench
     continue
   fi
   if [ "$n" = edge ]; then
