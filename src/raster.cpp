@@ -720,6 +720,8 @@ void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_opti
   // order within each face, which the edge resolve's ties need): up to five per triangle.
   const std::size_t draws = scene_->drawable_triangle_count() * (edge_ ? 5 : 1) + 1;
   key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
+  edge_candidates_.clear();
+  if (edge_) edge_find_candidates();
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -782,13 +784,28 @@ void hemicube_rasterizer::prepare(int resolution) {
   stats_ = {};
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
-    if (fragment_head_.size() != count)
-      fragment_head_.assign(count, no_triangle);
+    if (fragment_count_.size() != count)
+      fragment_count_.assign(count, 0u);
     else
-      for (const std::uint32_t t : fragment_texels_) fragment_head_[t] = no_triangle;
+      for (const std::uint32_t t : fragment_texels_) fragment_count_[t] = 0u;
     fragments_.clear();
     fragment_texels_.clear();
     edge_groups_.clear();
+    if (whole_z_.size() != count) {
+      whole_z_.assign(count, 0.0f);
+      whole_id_.resize(count);
+    } else {
+      for (const std::uint32_t t : hard_texels_) whole_z_[t] = 0.0f;
+    }
+    words_per_row_ = (static_cast<std::size_t>(resolution) + 63) / 64;
+    hard_bits_.assign(words_per_row_ * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
+    hard_texels_.clear();
+    hard_rows_.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
+    for (std::size_t i = 0; i < hard_rows_.size(); i += 2) {
+      hard_rows_[i] = resolution;
+      hard_rows_[i + 1] = -1;
+    }
+    hard_faces_ = 0;
   }
 }
 
@@ -798,7 +815,8 @@ std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexce
 }
 
 unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
-                                                               const glm::vec3& position, const frame& basis) const {
+                                                               const glm::vec3& position, const frame& basis,
+                                                               bool hard) const {
   // A node far away compared with its size may fall between texel centres on every face it
   // touches: then none of its triangles can cover a centre. Bound the node by its bounding
   // sphere (centre c, radius R, local frame); on a face where it lies in front of the near plane,
@@ -844,7 +862,20 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
       const int ceil_a = static_cast<int>(a) + (static_cast<float>(static_cast<int>(a)) < a ? 1 : 0);
       return std::max(ceil_a, 2) <= std::min(floor_b, static_cast<int>(count) + 1);
     };
-    if (!has_centre(x0 - m, x1 + m, n) || !has_centre(y0 - m, y1 + m, rows)) mask &= ~(1u << f);
+    if (has_centre(x0 - m, x1 + m, n) && has_centre(y0 - m, y1 + m, rows)) continue;
+    // With edge coverage a node between texel centres still covers parts of texels: kept where
+    // those may be hard (the texels its bounds overlap, widened by the margin).
+    if (hard && (hard_faces_ >> f & 1u)) {
+      const auto clamp_index = [](float x, float count) {
+        return static_cast<std::int64_t>(std::floor(std::min(std::max(x, -1.0f), count)));
+      };
+      const std::int64_t c0 = std::max<std::int64_t>(clamp_index(x0 - m, n), 0);
+      const std::int64_t c1 = std::min<std::int64_t>(clamp_index(x1 + m, n), n_ - 1);
+      const std::int64_t r0 = std::max<std::int64_t>(clamp_index(y0 - m, rows), 0);
+      const std::int64_t r1 = std::min<std::int64_t>(clamp_index(y1 + m, rows), static_cast<std::int64_t>(rows) - 1);
+      if (c0 <= c1 && r0 <= r1 && edge_box_is_hard(f, c0, c1, r0, r1)) continue;
+    }
+    mask &= ~(1u << f);
   }
   return mask;
 }
@@ -908,8 +939,7 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
     unsigned mask = parent_mask & node_faces(node, position, basis);
-    // (Not with edge coverage: a node between texel centres still covers parts of texels.)
-    if (mask && !(M == mode::depth && edge_)) mask = drop_faces_between_texel_centres(node, mask, position, basis);
+    if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
     if (!mask) continue;
     if (node.count == 0) {
       stack_.push_back(node.first + 1);
@@ -1103,19 +1133,22 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   }
   const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
   const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
-  // Exact edge coverage: the texels the triangle covers in part become fragments (edge_texels);
-  // the coverage paths below then depth-test the texels it covers whole (see `bias`).
-  const bool edge = M == mode::depth && edge_;
-  if (edge) {
+  // Exact edge coverage: the hard texels (those a hard edge may cross) the triangle touches get
+  // its exact share (edge_texels); the coverage paths below draw it as without the option.
+  if (M == mode::depth && edge_ && (hard_faces_ >> face & 1u)) {
     // Texels the box overlaps (not only those whose centre it holds; grown by the snapping for
     // the unsnapped triangle), clamped to the face.
-    if (std::max<std::int64_t>(floor_sub(min_x - 1), 0) > std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1) ||
-        std::max<std::int64_t>(floor_sub(min_y - 1), 0) > std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1))
-      return;
-    if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
-    fs.prepare(face, texel_step_, first_centre_, rec);
-    const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
-    edge_texels(face, qx, qy, unsnapped, fs, draw);
+    const std::int64_t c0 = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
+    const std::int64_t c1 = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
+    const std::int64_t r0 = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
+    const std::int64_t r1 = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
+    if (c0 > c1 || r0 > r1) return;
+    if (edge_box_is_hard(face, c0, c1, r0, r1)) {
+      if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
+      fs.prepare(face, texel_step_, first_centre_, rec);
+      const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
+      edge_texels(face, qx, qy, unsnapped, fs, draw);
+    }
   }
   // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
   const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
@@ -1125,12 +1158,8 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   if (x_begin > x_end || y_begin > y_end) return;
   if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
   // The tie bias of edge k: 0 for owned edges, 1 for the others (a texel centre is covered iff
-  // every edge function minus its bias is >= 0). With edge coverage the bias is the edge
-  // function's drop from the texel centre to the texel's farthest corner, 128 (|dx| + |dy|):
-  // then "covered" means the whole texel (closed) is inside the triangle, and the same paths
-  // (the same kernels, the same depths) draw exactly the texels it covers whole.
-  const auto bias = [edge](std::int64_t dx, std::int64_t dy) -> std::int64_t {
-    if (edge) return sub_half * (std::abs(dx) + std::abs(dy));
+  // every edge function minus its bias is >= 0).
+  const auto bias = [](std::int64_t dx, std::int64_t dy) -> std::int64_t {
     return dy > 0 || (dy == 0 && dx < 0) ? 0 : 1;
   };
 
@@ -1361,8 +1390,8 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   if (texture) texture->validate(who);
   prepare(resolution);
   textured_ = texture && scene_->has_lightmap_uvs();
+  if (edge_) edge_mark_hard(position, basis);
   draw_all<mode::depth>(position, basis);
-  if (edge_) edge_resolve_centres();
 
   // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
   // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
@@ -1422,7 +1451,10 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
       blue[i] = l.z;
     }
   }
-  if (edge_) edge_blend(out, basis, textured_ ? texture : nullptr);
+  if (edge_) {
+    edge_group_fragments();
+    edge_blend(out, basis, textured_ ? texture : nullptr);
+  }
 }
 
 void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,

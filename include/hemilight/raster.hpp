@@ -159,6 +159,8 @@ struct raster_statistics {
   std::size_t fragments = 0;           ///< texels depth-tested (or counted) by the span paths
   std::size_t edge_texels_tested = 0;  ///< edge coverage: texels classified by the partial-texel pass
   std::size_t edge_fragments = 0;      ///< edge coverage: partial (triangle, texel) fragments kept
+  std::size_t edge_hard_edges = 0;     ///< edge coverage: edges needing exact coverage in this view
+  std::size_t edge_hard_texels = 0;    ///< edge coverage: texels such an edge may cross (exact there)
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
@@ -248,7 +250,7 @@ class alignas(64) hemicube_rasterizer {
   void check_arguments(const char* who, const glm::vec3& position, const frame& basis, int resolution) const;
   void prepare(int resolution);
   unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
-                                            const frame& basis) const;
+                                            const frame& basis, bool hard) const;
   template <mode M>
   void draw_all(const glm::vec3& position, const frame& basis);
   template <mode M>
@@ -276,23 +278,46 @@ class alignas(64) hemicube_rasterizer {
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
     float coverage;       // the covered fraction of the texel's weight, [0, 1]
     std::uint32_t id;     // the draw's texel id (as in ids_)
-    std::uint32_t next;   // next fragment of the same texel (no_triangle = none)
-    bool centre;          // the triangle covers the texel centre (the point-sampled test)
   };
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw);
-  void edge_resolve_centres();
+  // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
+  // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
+  struct edge_candidate {
+    std::uint32_t triangle;   // scene_->triangles() position
+    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
+    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
+    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
+  };
+  void edge_find_candidates();
+  void edge_mark_hard(const glm::vec3& position, const frame& basis);
+  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b);
+  bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
+  std::vector<edge_candidate> edge_candidates_;
+  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
+  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
+  // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
+  // a hard edge may cross texel c (words_per_row_ words a row).
+  std::vector<std::uint64_t> hard_bits_;
+  std::size_t words_per_row_ = 0;
+  template <class Visit>
+  void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
+  std::vector<float> whole_z_;                // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
+  std::vector<std::uint32_t> whole_id_;       // and its texel id
+  std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
+  std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
+  unsigned hard_faces_ = 0;                   // faces with a hard texel
+  void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
   glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
   bool edge_ = false;
   std::vector<edge_fragment> fragments_;
-  std::vector<std::uint32_t> fragment_head_;    // per texel: first fragment (no_triangle = none)
+  std::vector<std::uint32_t> fragment_count_;   // per texel: its fragments (0 = none)
+  std::vector<edge_fragment> grouped_;          // fragments_ by texel (edge_groups_ ranges)
   std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
   struct edge_group {
     std::uint32_t texel;
-    float full_z;             // the nearest triangle covering the whole texel: 1/w (0 = none)
-    std::uint32_t full_id;    // and its id
-    float centre_z;           // 1/w of what the texel centre sees (0 = nothing)
+    std::uint32_t first, count;  // its fragments in grouped_
   };
   std::vector<edge_group> edge_groups_;
 
