@@ -129,18 +129,21 @@ struct raster_options {
   /// Shared and immutable; build it with cubemap::from_image (which checks every value); the
   /// constructor throws error(invalid_argument) for an empty or inconsistent map.
   std::shared_ptr<const cubemap> sky = nullptr;
-  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that an edge of a
-  /// triangle crosses gets the exact area of the (projected, clipped) triangle within the texel
-  /// as a fraction of the texel, not the all-or-nothing sample at its centre; the triangles
-  /// sharing a texel are resolved front to back (each takes the smaller of its coverage and what
-  /// is left; the sky, or the triangle that covers the whole texel behind them, the rest), and
-  /// the texel's radiance is the blend. Texels inside a triangle are as without it. flags and
+  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that a hard edge (a
+  /// mesh boundary, a change of material, a silhouette) may cross gets, from each triangle that
+  /// covers it in part, the exact area of the (projected, clipped) triangle within the texel as a
+  /// fraction of the texel, not the all-or-nothing sample at its centre; the triangles sharing a
+  /// texel are resolved front to back (each takes the smaller of its coverage and what is left;
+  /// the sky, or the triangle that covers the whole texel behind them, the rest), and the
+  /// texel's radiance is the blend. Every other texel (inside a triangle, or crossed only by
+  /// edges between triangles of one material facing the same way) is as without it. flags and
   /// seen_triangle() keep their meaning (what the texel centre sees: bit-identical to a render
   /// without the option); a blended texel's distance is to the plane of the nearest triangle
   /// with a share of it (along the centre's direction), which is the centre's distance unless a
   /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost: 12-36x a render + integration without it at N = 64 (docs/raster.md), so off by
-  /// default.
+  /// path. Cost at N = 64 (render + integration): 1.6x on tessellated rooms, 5x on the Cornell
+  /// box (material changes all around), 19x on a terrain seen from its own surface
+  /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
 };
 
@@ -167,9 +170,10 @@ struct raster_statistics {
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
 /// direction tables, plus 8 bytes per triangle drawn (~70 with a texture) and 16 bytes per distinct
-/// emission of the scene; kept between renders and grown on demand. With edge coverage, 4 more
-/// bytes per texel and 24 per partial (triangle, texel) fragment (~3,000 per hemicube of the
-/// Cornell box at N = 64, about one per texel in tessellated rooms).
+/// emission of the scene; kept between renders and grown on demand. With edge coverage, 16 bytes
+/// per scene edge that may be hard and per crease triangle, 12 more bytes per texel and 32 per
+/// partial (triangle, texel) fragment (~1,000 per hemicube of the Cornell box at N = 64, under
+/// 100 in tessellated rooms).
 /// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
 /// must not share a line, or the counters one writes slow down the members the other reads.
 class alignas(64) hemicube_rasterizer {
@@ -204,7 +208,8 @@ class alignas(64) hemicube_rasterizer {
   /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
   /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
   /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
-  /// raster_options::edge_coverage add O(partial texels): 12-36x in all at N = 64.
+  /// raster_options::edge_coverage add O(hard edges + the hard texels of the triangles touching
+  /// them): 1.6-19x in all at N = 64 (see the option).
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
@@ -272,7 +277,7 @@ class alignas(64) hemicube_rasterizer {
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
-  // Exact edge coverage (raster_options::edge_coverage; raster.cpp, "Exact edge coverage").
+  // Exact edge coverage (raster_options::edge_coverage; raster_edge.cpp).
   struct edge_fragment {
     std::uint32_t texel;  // hemicube texel index
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
