@@ -799,6 +799,7 @@ void hemicube_rasterizer::prepare(int resolution) {
     }
     words_per_row_ = (static_cast<std::size_t>(resolution) + 63) / 64;
     hard_bits_.assign(words_per_row_ * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
+    silhouette_bits_.assign(hard_bits_.size(), 0u);
     hard_texels_.clear();
     hard_rows_.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
     for (std::size_t i = 0; i < hard_rows_.size(); i += 2) {
@@ -1147,7 +1148,7 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
       if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
       fs.prepare(face, texel_step_, first_centre_, rec);
       const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
-      edge_texels(face, qx, qy, unsnapped, fs, draw);
+      edge_texels(face, qx, qy, unsnapped, fs, draw, rec.plane > 0.0f);
     }
   }
   // Texels whose centre (k + 1/2) lies in the box, clamped to the face.

@@ -252,16 +252,18 @@ void hemicube_rasterizer::edge_mark_hard(const glm::vec3& position, const frame&
   }
   const std::vector<scene::triangle>& tris = scene_->triangles();
   for (const edge_candidate& c : edge_candidates_) {
+    bool silhouette = false;
     if (c.plane_a != no_triangle) {
-      const std::int8_t fa = edge_facing_[c.plane_a];
-      if (fa != 0 && fa == edge_facing_[c.plane_b]) continue;
+      const std::int8_t fa = edge_facing_[c.plane_a], fb = edge_facing_[c.plane_b];
+      if (fa != 0 && fa == fb) continue;
+      silhouette = fa * fb < 0;
     }
     const scene::triangle& t = tris[c.triangle];
     const glm::vec3 a = basis.to_local(corner(t, c.k) - position);
     const glm::vec3 b = basis.to_local(corner(t, c.k == 2 ? 0 : c.k + 1) - position);
     if (a.z < 0.0f && b.z < 0.0f) continue;  // below the tangent plane: on no face
     ++stats_.edge_hard_edges;
-    edge_mark_segment(a, b);
+    edge_mark_segment(a, b, silhouette);
   }
   stats_.edge_hard_texels = hard_texels_.size();
 }
@@ -271,7 +273,7 @@ void hemicube_rasterizer::edge_mark_hard(const glm::vec3& position, const frame&
 // and every texel within 1/16 texel of it is marked. The rasterizer's vertices differ from these
 // by its float set-up and 1/512 texel of snapping, far below the margins, so no texel a hard edge
 // crosses is missed; the margins only add a few texels of exact coverage.
-void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3& b) {
+void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette) {
   const int n = n_;
   const double grow = 1.0 + texel_step_, near = 0.5 * static_cast<double>(near_), eps = 1.0 / 16.0;
   for (int face = 0; face < 5; ++face) {
@@ -320,6 +322,7 @@ void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3&
       hi = std::max(hi, static_cast<std::int32_t>(c_last));
       const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
       std::uint64_t* bits = hard_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
+      std::uint64_t* outline = silhouette_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
       for (int c = c_first; c <= c_last; ++c) {
         std::uint64_t& word = bits[c >> 6];
         const std::uint64_t bit = std::uint64_t(1) << (c & 63);
@@ -327,6 +330,7 @@ void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3&
           word |= bit;
           hard_texels_.push_back(static_cast<std::uint32_t>(row + static_cast<std::size_t>(c)));
         }
+        if (silhouette) outline[c >> 6] |= bit;
       }
       hard_faces_ |= 1u << face;
     }
@@ -380,7 +384,8 @@ void hemicube_rasterizer::edge_for_hard(std::size_t row, std::int64_t c0, std::i
 // draw the triangle as without the option (centre samples). Cost: O(rows + the hard texels of
 // its rows within its extent).
 void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
-                                      const double (&exact)[6], const face_setup& fs, std::uint32_t draw) {
+                                      const double (&exact)[6], const face_setup& fs, std::uint32_t draw,
+                                      bool back) {
   const int n = n_;
   const int rows = face == 0 ? n : n / 2;
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
@@ -439,6 +444,11 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
     // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
     // blend stops at the whole-texel winner, which can only come nearer).
     if (!(z > whole_z_[texel])) return;
+    // Facing away, in a texel a silhouette crosses: near a silhouette the surface's far sheet
+    // lies behind its near one over the same part of the texel (a ray entering the surface
+    // leaves it through the far sheet), which the blend, taking fragments as side by side,
+    // would count again in place of what lies behind.
+    if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two

@@ -1097,6 +1097,22 @@ TEST_CASE("raster: exact edge coverage finds silhouettes and material changes of
   point.render({0, 0, 0}, up, 16, buf);
   CHECK(std::fabs(integrate(buf).irradiance.x - want) > 1e-2 * want);  // what the silhouette test fixes
 
+  // The same box black under a sky of 1: E = pi - (the front faces' projected solid angle). At its
+  // silhouette the back faces lie behind the front faces over the same part of each texel; the
+  // blend must not give them a share of what is the sky's (taken as side by side, they made the
+  // box 3% too big at N = 16, 0.55% at 64). Measured: 8e-6 at N = 16, 2e-7 at 64; asserted 1e-4
+  // (the density's linearisation, as above).
+  scene_mesh black = box;
+  for (material& m : black.materials) m.emission = glm::vec3(0.0f);
+  black.sky_radiance = glm::vec3(1.0f);
+  hemicube_rasterizer rb(scene::create(black.desc()), on);
+  const double pi = 3.14159265358979323846, want_sky = pi - want;
+  for (const int n : {16, 64}) {
+    rb.render({0, 0, 0}, up, n, buf);
+    INFO("black box under the sky, N = " << n);
+    CHECK(std::fabs(integrate(buf).irradiance.x - want_sky) <= 1e-4 * want_sky);
+  }
+
   // One quad of two triangles sharing its diagonal, of two emissions: the diagonal is hard (a
   // change of material). E = e1 L(t1) + e2 L(t2).
   const glm::dvec3 c0(-0.4, 0.2, 1.0), c1(0.5, 0.1, 0.9), c2(0.6, 0.8, 1.1), c3(-0.3, 0.7, 1.0);

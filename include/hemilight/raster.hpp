@@ -285,7 +285,7 @@ class alignas(64) hemicube_rasterizer {
     std::uint32_t id;     // the draw's texel id (as in ids_)
   };
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
-                   const face_setup& fs, std::uint32_t draw);
+                   const face_setup& fs, std::uint32_t draw, bool back);
   // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
   // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
   struct edge_candidate {
@@ -296,7 +296,7 @@ class alignas(64) hemicube_rasterizer {
   };
   void edge_find_candidates();
   void edge_mark_hard(const glm::vec3& position, const frame& basis);
-  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b);
+  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
   bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
   std::vector<edge_candidate> edge_candidates_;
   std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
@@ -304,6 +304,7 @@ class alignas(64) hemicube_rasterizer {
   // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
   // a hard edge may cross texel c (words_per_row_ words a row).
   std::vector<std::uint64_t> hard_bits_;
+  std::vector<std::uint64_t> silhouette_bits_;  // the same for silhouette edges only
   std::size_t words_per_row_ = 0;
   template <class Visit>
   void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
