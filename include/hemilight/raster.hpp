@@ -141,8 +141,8 @@ struct raster_options {
   /// without the option); a blended texel's distance is to the plane of the nearest triangle
   /// with a share of it (along the centre's direction), which is the centre's distance unless a
   /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost at N = 64 (render + integration): 1.6x on tessellated rooms, 5x on the Cornell
-  /// box (material changes all around), 19x on a terrain seen from its own surface
+  /// path. Cost at N = 64 (render + integration): 1.5x on tessellated rooms, 5x on the Cornell
+  /// box (material changes all around), 15x on a terrain seen from its own surface
   /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
 };
@@ -209,7 +209,7 @@ class alignas(64) hemicube_rasterizer {
   /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
   /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
   /// raster_options::edge_coverage add O(hard edges + the hard texels of the triangles touching
-  /// them): 1.6-19x in all at N = 64 (see the option).
+  /// them): 1.5-15x in all at N = 64 (see the option).
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
