@@ -1,4 +1,5 @@
 #include "hemilight/raster.hpp"
+#include "raster_internal.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -28,32 +29,9 @@
 
 namespace hemilight {
 
+using namespace raster_detail;
+
 namespace {
-
-constexpr int sub_bits = 8;                   // sub-texel bits of the fixed-point grid
-constexpr std::int64_t sub_one = 1 << sub_bits;
-constexpr std::int64_t sub_half = sub_one / 2;
-// Guard band: clip |u|, |v| <= 1000 w. Wide, so that big triangles crossing a face's edges are
-// rarely clipped (clipping multiplies the rows to walk), narrow enough that snapped coordinates
-// stay below 1001 * 2048 * 256 < 2^29 for N <= 4096 (edge-function terms below 2^60 in int64).
-constexpr float guard_band = 1000.0f;
-constexpr int max_clip_vertices = 3 + 5;      // each of the 5 clip planes adds at most one
-
-// A vertex in a face's clip space: u = c.p, v = r.p, w = a.p (geometry.hpp face axes).
-struct clip_vertex {
-  float u, v, w;
-};
-
-// The local-frame point p seen on face f, as (c.p, r.p, a.p). Exact (sign changes, permutation).
-inline clip_vertex to_clip(int face, const glm::vec3& p) noexcept {
-  switch (face) {
-    case 0: return {p.x, p.y, p.z};
-    case 1: return {p.y, p.z, p.x};
-    case 2: return {-p.y, p.z, -p.x};
-    case 3: return {-p.x, p.z, p.y};
-    default: return {p.x, p.z, -p.y};
-  }
-}
 
 // Signed distance to clip plane k (inside when >= 0).
 inline float clip_distance(int k, const clip_vertex& c, float near) noexcept {
@@ -155,11 +133,6 @@ inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, cons
   return faces;
 }
 
-// floor(a / 2^sub_bits) and ceil(a / 2^sub_bits) for any sign.
-// (Arithmetic right shift: floor for negative values too; every supported compiler does this,
-// and C++20 requires it.)
-inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >> sub_bits; }
-inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
 
 // floor(a / m) for m > 0 and |a|, m < 2^52: a double estimate (off by at most one, both are
 // exact doubles) made exact with integer checks; cheaper than a 64-bit division.
@@ -747,6 +720,8 @@ void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_opti
   // order within each face, which the edge resolve's ties need): up to five per triangle.
   const std::size_t draws = scene_->drawable_triangle_count() * (edge_ ? 5 : 1) + 1;
   key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
+  edge_candidates_.clear();
+  if (edge_) edge_find_candidates();
 }
 
 void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -809,13 +784,29 @@ void hemicube_rasterizer::prepare(int resolution) {
   stats_ = {};
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
-    if (fragment_head_.size() != count)
-      fragment_head_.assign(count, no_triangle);
+    if (fragment_count_.size() != count)
+      fragment_count_.assign(count, 0u);
     else
-      for (const std::uint32_t t : fragment_texels_) fragment_head_[t] = no_triangle;
+      for (const std::uint32_t t : fragment_texels_) fragment_count_[t] = 0u;
     fragments_.clear();
     fragment_texels_.clear();
     edge_groups_.clear();
+    if (whole_z_.size() != count) {
+      whole_z_.assign(count, 0.0f);
+      whole_id_.resize(count);
+    } else {
+      for (const std::uint32_t t : hard_texels_) whole_z_[t] = 0.0f;
+    }
+    words_per_row_ = (static_cast<std::size_t>(resolution) + 63) / 64;
+    hard_bits_.assign(words_per_row_ * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
+    silhouette_bits_.assign(hard_bits_.size(), 0u);
+    hard_texels_.clear();
+    hard_rows_.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
+    for (std::size_t i = 0; i < hard_rows_.size(); i += 2) {
+      hard_rows_[i] = resolution;
+      hard_rows_[i + 1] = -1;
+    }
+    hard_faces_ = 0;
   }
 }
 
@@ -825,7 +816,8 @@ std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexce
 }
 
 unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
-                                                               const glm::vec3& position, const frame& basis) const {
+                                                               const glm::vec3& position, const frame& basis,
+                                                               bool hard) const {
   // A node far away compared with its size may fall between texel centres on every face it
   // touches: then none of its triangles can cover a centre. Bound the node by its bounding
   // sphere (centre c, radius R, local frame); on a face where it lies in front of the near plane,
@@ -871,33 +863,24 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
       const int ceil_a = static_cast<int>(a) + (static_cast<float>(static_cast<int>(a)) < a ? 1 : 0);
       return std::max(ceil_a, 2) <= std::min(floor_b, static_cast<int>(count) + 1);
     };
-    if (!has_centre(x0 - m, x1 + m, n) || !has_centre(y0 - m, y1 + m, rows)) mask &= ~(1u << f);
+    if (has_centre(x0 - m, x1 + m, n) && has_centre(y0 - m, y1 + m, rows)) continue;
+    // With edge coverage a node between texel centres still covers parts of texels: kept where
+    // those may be hard (the texels its bounds overlap, widened by the margin).
+    if (hard && (hard_faces_ >> f & 1u)) {
+      const auto clamp_index = [](float x, float count) {
+        return static_cast<std::int64_t>(std::floor(std::min(std::max(x, -1.0f), count)));
+      };
+      const std::int64_t c0 = std::max<std::int64_t>(clamp_index(x0 - m, n), 0);
+      const std::int64_t c1 = std::min<std::int64_t>(clamp_index(x1 + m, n), n_ - 1);
+      const std::int64_t r0 = std::max<std::int64_t>(clamp_index(y0 - m, rows), 0);
+      const std::int64_t r1 = std::min<std::int64_t>(clamp_index(y1 + m, rows), static_cast<std::int64_t>(rows) - 1);
+      if (c0 <= c1 && r0 <= r1 && edge_box_is_hard(f, c0, c1, r0, r1)) continue;
+    }
+    mask &= ~(1u << f);
   }
   return mask;
 }
 
-// The depth plane of one (triangle, face) pair, computed when the pair first covers a texel.
-struct hemicube_rasterizer::face_setup {
-  bool ready = false;
-  double z00 = 0.0, dzdy = 0.0;
-  float dzdx = 0.0f;
-
-  // step = 2 / N, u0 = 1 / N - 1: the texel pitch and the first texel centre in face units
-  // (hemicube_rasterizer::prepare computes them once per resolution).
-  void prepare(int face, double step, double u0, const draw_record& rec) noexcept {
-    if (ready) return;
-    // Depth 1/w of the triangle's plane at texel centres: with the plane n.p = k and
-    // p = w (a + u c + v r), 1/w = (n.a + u n.c + v n.r) / k, affine in the texel indices.
-    // Evaluated per row in double, then per texel in float.
-    const clip_vertex nm = to_clip(face, rec.normal);  // (n.c, n.r, n.a)
-    const double inv_k = 1.0 / static_cast<double>(rec.plane);
-    const double v0 = face == 0 ? u0 : 0.5 * step;  // side faces: rows start at v = 0
-    dzdx = static_cast<float>(nm.u * step * inv_k);
-    dzdy = nm.v * step * inv_k;
-    z00 = (nm.w + nm.u * u0 + nm.v * v0) * inv_k;
-    ready = true;
-  }
-};
 
 #if HEMILIGHT_RASTER_AVX2
 // The position and the frame's axes, broadcast once per render for draw_leaf_avx2, and the
@@ -957,8 +940,7 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
     unsigned mask = parent_mask & node_faces(node, position, basis);
-    // (Not with edge coverage: a node between texel centres still covers parts of texels.)
-    if (mask && !(M == mode::depth && edge_)) mask = drop_faces_between_texel_centres(node, mask, position, basis);
+    if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
     if (!mask) continue;
     if (node.count == 0) {
       stack_.push_back(node.first + 1);
@@ -1152,19 +1134,22 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   }
   const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
   const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
-  // Exact edge coverage: the texels the triangle covers in part become fragments (edge_texels);
-  // the coverage paths below then depth-test the texels it covers whole (see `bias`).
-  const bool edge = M == mode::depth && edge_;
-  if (edge) {
+  // Exact edge coverage: the hard texels (those a hard edge may cross) the triangle touches get
+  // its exact share (edge_texels); the coverage paths below draw it as without the option.
+  if (M == mode::depth && edge_ && (hard_faces_ >> face & 1u)) {
     // Texels the box overlaps (not only those whose centre it holds; grown by the snapping for
     // the unsnapped triangle), clamped to the face.
-    if (std::max<std::int64_t>(floor_sub(min_x - 1), 0) > std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1) ||
-        std::max<std::int64_t>(floor_sub(min_y - 1), 0) > std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1))
-      return;
-    if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
-    fs.prepare(face, texel_step_, first_centre_, rec);
-    const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
-    edge_texels(face, qx, qy, unsnapped, fs, draw);
+    const std::int64_t c0 = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
+    const std::int64_t c1 = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
+    const std::int64_t r0 = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
+    const std::int64_t r1 = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
+    if (c0 > c1 || r0 > r1) return;
+    if (edge_box_is_hard(face, c0, c1, r0, r1)) {
+      if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
+      fs.prepare(face, texel_step_, first_centre_, rec);
+      const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
+      edge_texels(face, qx, qy, unsnapped, fs, draw, rec.plane > 0.0f);
+    }
   }
   // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
   const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
@@ -1174,12 +1159,8 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   if (x_begin > x_end || y_begin > y_end) return;
   if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
   // The tie bias of edge k: 0 for owned edges, 1 for the others (a texel centre is covered iff
-  // every edge function minus its bias is >= 0). With edge coverage the bias is the edge
-  // function's drop from the texel centre to the texel's farthest corner, 128 (|dx| + |dy|):
-  // then "covered" means the whole texel (closed) is inside the triangle, and the same paths
-  // (the same kernels, the same depths) draw exactly the texels it covers whole.
-  const auto bias = [edge](std::int64_t dx, std::int64_t dy) -> std::int64_t {
-    if (edge) return sub_half * (std::abs(dx) + std::abs(dy));
+  // every edge function minus its bias is >= 0).
+  const auto bias = [](std::int64_t dx, std::int64_t dy) -> std::int64_t {
     return dy > 0 || (dy == 0 && dx < 0) ? 0 : 1;
   };
 
@@ -1403,309 +1384,6 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   walk_rows_of(nl, nr, left, right, y_first, y_last, x_begin, x_end, span);
 }
 
-// ---------------------------------------------------------------------------------------------
-// Exact edge coverage (raster_options::edge_coverage; docs/raster.md, "Exact edge coverage")
-// ---------------------------------------------------------------------------------------------
-
-namespace {
-
-// The part of the unit square [0, 1]^2 (a texel, in texel units) inside the half-planes
-// f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of the edges in `clip` (bit k): Sutherland-Hodgman
-// on the square's polygon (at most 4 + 3 vertices), then the polygon's area and first moments
-// about the square's centre (the shoelace formula and its moment form), weighted by the density
-// 1 + wx (x - 1/2) + wy (y - 1/2). Double precision: within ~1e-15 of the exact value for the
-// snapped triangle. The square's own moments vanish, so the values of two triangles sharing an
-// edge sum to those of their union.
-double square_part_inside(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3], unsigned clip,
-                          double wx, double wy) noexcept {
-  double px[8] = {0.0, 1.0, 1.0, 0.0}, py[8] = {0.0, 0.0, 1.0, 1.0};
-  double qx[8], qy[8];
-  int count = 4;
-  for (int k = 0; k < 3 && count >= 3; ++k) {
-    if (!(clip >> k & 1u)) continue;
-    double value[8];
-    for (int i = 0; i < count; ++i) value[i] = f0[k] + gx[k] * px[i] + gy[k] * py[i];
-    int out = 0;
-    for (int i = 0; i < count; ++i) {
-      const int j = i + 1 == count ? 0 : i + 1;
-      const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
-      if (in_i) {
-        qx[out] = px[i];
-        qy[out] = py[i];
-        ++out;
-      }
-      if (in_i != in_j) {
-        const double t = value[i] / (value[i] - value[j]);
-        qx[out] = px[i] + t * (px[j] - px[i]);
-        qy[out] = py[i] + t * (py[j] - py[i]);
-        ++out;
-      }
-    }
-    count = out;
-    std::copy(qx, qx + out, px);
-    std::copy(qy, qy + out, py);
-  }
-  if (count < 3) return 0.0;
-  double twice = 0.0, mx = 0.0, my = 0.0;  // 2 area, 6 first moments (about the centre)
-  for (int i = 0; i < count; ++i) {
-    const int j = i + 1 == count ? 0 : i + 1;
-    const double ax = px[i] - 0.5, ay = py[i] - 0.5, bx = px[j] - 0.5, by = py[j] - 0.5;
-    const double cross = ax * by - bx * ay;
-    twice += cross;
-    mx += (ax + bx) * cross;
-    my += (ay + by) * cross;
-  }
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
-}
-
-}  // namespace
-
-// The texels that the snapped triangle (px, py: fixed point, counter-clockwise) covers in part on
-// `face`: each gets a fragment with the exact covered fraction of its area. Row by row: the
-// triangle's x extent within the row's strip (its vertices in the strip and its edges' crossings
-// of the strip's lines) bounds the texels it touches; they are classified exactly with the
-// integer edge functions at their corners (outside: an edge leaves every corner at <= 0, i.e. no
-// area in common; whole: every corner of every edge >= 0; else partial), from both ends of the
-// row inwards until a whole texel (the triangle is convex: its whole texels in a row are
-// contiguous, with the partial ones on either side). Whole texels are left to the coverage
-// paths. `exact`: the unsnapped vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the
-// covered part. Cost: O(rows + partial texels).
-void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
-                                      const double (&exact)[6], const face_setup& fs, std::uint32_t draw) {
-  const int n = n_;
-  const int rows = face == 0 ? n : n / 2;
-  const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
-  std::int64_t dx[3], dy[3], tie[3];
-  for (int k = 0; k < 3; ++k) {
-    const int b = k == 2 ? 0 : k + 1;
-    dx[k] = px[b] - px[k];
-    dy[k] = py[b] - py[k];
-    tie[k] = dy[k] > 0 || (dy[k] == 0 && dx[k] < 0) ? 0 : 1;  // the coverage paths' tie bias
-  }
-  const std::int64_t min_y = std::min({py[0], py[1], py[2]}), max_y = std::max({py[0], py[1], py[2]});
-  const std::int64_t min_x = std::min({px[0], px[1], px[2]}), max_x = std::max({px[0], px[1], px[2]});
-  // Texels the box overlaps, grown by the snapping (half a unit) for the unsnapped triangle.
-  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
-  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
-  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
-  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
-
-  // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
-  // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
-  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
-  for (int k = 0; k < 3; ++k) {
-    const int b = k == 2 ? 0 : k + 1;
-    edx[k] = exact[b] - exact[k];
-    edy[k] = exact[3 + b] - exact[3 + k];
-    gx[k] = -edy[k] * static_cast<double>(sub_one);
-    gy[k] = edx[k] * static_cast<double>(sub_one);
-    gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
-    gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
-  }
-  // 0: no area in common, 1: partial (a fragment is added), 2: the whole texel.
-  const auto classify = [&](std::int64_t c, std::int64_t r) -> int {
-    ++stats_.edge_texels_tested;
-    const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
-    // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
-    // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
-    // snapped edges (exact integers) decide which texels the coverage paths draw whole and
-    // which centres are covered (as without the option). The two differ by less than 1/512
-    // texel. Two triangles sharing an edge clip it from the same unsnapped endpoints, so
-    // between them they miss no part of a texel.
-    double f0[3];
-    bool outside = false;
-    unsigned clip = 0;  // the unsnapped edges that cut the texel
-    for (int k = 0; k < 3; ++k) {
-      f0[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) - edy[k] * (static_cast<double>(x0) - exact[k]);
-      outside = outside || f0[k] + gx_hi[k] <= 0.0;
-      if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
-    }
-    // The snapped edge functions at the texel's (x0, y0) corner and their steps across it.
-    bool whole = true, centre = true;
-    for (int k = 0; k < 3; ++k) {
-      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
-      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
-      whole = whole && e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0) >= 0;
-      centre = centre && e + (sx + sy) / 2 - tie[k] >= 0;  // exact: sx, sy are multiples of 256
-    }
-    if (whole) return 2;
-    if (outside && !centre) return 0;
-
-    // The integrator weights a texel by the projected solid angle over it; within the texel its
-    // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
-    // centre's, in texel units): the covered fraction of the texel's weight, to second order.
-    // Top face (z = 1): density (1 + u^2 + v^2)^-2; side faces (v = height): v (1 + u^2 + v^2)^-2.
-    const double u = first_centre_ + texel_step_ * static_cast<double>(c);
-    const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
-    const double q = 1.0 + u * u + v * v;
-    const double wx = -4.0 * u / q * texel_step_;
-    const double wy = (face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_;
-    const double area = outside ? 0.0 : square_part_inside(f0, gx, gy, clip, wx, wy);
-    // (A covered centre always makes a fragment, for the centre's resolve, even of no area.)
-    if (!(area > 0.0) && !centre) return 0;
-    edge_fragment fr;
-    fr.texel = static_cast<std::uint32_t>(face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n) +
-                                          static_cast<std::size_t>(c));
-    // The coverage paths' depth at this texel, bit for bit (span: the row in double, then float).
-    const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
-    const float z = zrow + fs.dzdx * static_cast<float>(c);
-    fr.z = z > FLT_MIN ? z : FLT_MIN;
-    fr.coverage = static_cast<float>(std::min(std::max(area, 0.0), 1.0));
-    fr.id = draw;
-    fr.centre = centre;
-    std::uint32_t& head = fragment_head_[fr.texel];
-    if (head == no_triangle) fragment_texels_.push_back(fr.texel);
-    fr.next = head;
-    head = static_cast<std::uint32_t>(fragments_.size());
-    fragments_.push_back(fr);
-    ++stats_.edge_fragments;
-    return 1;
-  };
-
-  for (std::int64_t r = row_lo; r <= row_hi; ++r) {
-    // The triangle's x extent within the strip y0 <= y <= y1 (fixed point, in double).
-    const std::int64_t y0 = r * sub_one, y1 = y0 + sub_one;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (int k = 0; k < 3; ++k) {
-      if (py[k] >= y0 && py[k] <= y1) {
-        lo = std::min(lo, static_cast<double>(px[k]));
-        hi = std::max(hi, static_cast<double>(px[k]));
-      }
-      const int b = k == 2 ? 0 : k + 1;
-      for (const std::int64_t y : {y0, y1}) {
-        if ((py[k] < y) == (py[b] < y)) continue;
-        const double x = static_cast<double>(px[k]) +
-                         static_cast<double>(y - py[k]) / static_cast<double>(dy[k]) * static_cast<double>(dx[k]);
-        lo = std::min(lo, x);
-        hi = std::max(hi, x);
-      }
-    }
-    if (!(lo <= hi)) continue;
-    // Widened by a texel each way (the crossings are rounded; the classification is exact).
-    const std::int64_t c0 = std::max(col_lo, static_cast<std::int64_t>(std::floor(lo / sub_one)) - 1);
-    const std::int64_t c1 = std::min(col_hi, static_cast<std::int64_t>(std::floor(hi / sub_one)) + 1);
-    std::int64_t c = c0;
-    for (; c <= c1; ++c)
-      if (classify(c, r) == 2) break;
-    if (c > c1) continue;  // no whole texel in the row: every texel was classified
-    for (std::int64_t d = c1; d > c; --d)
-      if (classify(d, r) == 2) break;
-  }
-}
-
-// Before the resolve: the texels with fragments get what the texel centre sees, as a render
-// without edge coverage would (the depth buffer holds the nearest triangle covering the whole
-// texel; a fragment covering the centre and nearer, or as near and drawn earlier, wins), so
-// distance, flags and seen_triangle() keep their meaning bit for bit. The whole-texel winner is
-// kept for the blend.
-void hemicube_rasterizer::edge_resolve_centres() {
-  const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
-  edge_groups_.reserve(fragment_texels_.size());
-  for (const std::uint32_t t : fragment_texels_) {
-    const float full_z = depth_[t];
-    const std::uint32_t full_id = full_z > 0.0f ? ids_[t] : 0u;
-    edge_groups_.push_back({t, full_z, full_id, 0.0f});
-    float best_z = full_z;
-    std::uint32_t best_id = full_id;
-    for (std::uint32_t f = fragment_head_[t]; f != no_triangle; f = fragments_[f].next) {
-      const edge_fragment& fr = fragments_[f];
-      if (!fr.centre) continue;
-      if (best_z == 0.0f || fr.z > best_z || (fr.z == best_z && draw_of(fr.id) < draw_of(best_id))) {
-        best_z = fr.z;
-        best_id = fr.id;
-      }
-    }
-    depth_[t] = best_z;
-    ids_[t] = best_id;
-    edge_groups_.back().centre_z = best_z;
-  }
-}
-
-// The radiance a draw (texel id) gives at a texel whose centre direction meets its plane at 1/w
-// = z: the resolve's computation (shade, or the texture at the perspective-correct UV).
-glm::vec3 hemicube_rasterizer::fragment_radiance(std::uint32_t id, std::size_t texel, float z,
-                                                 const radiance_texture* texture) const {
-  const std::uint32_t draw = id >> key_bits_;
-  if (textured_ && draws_[draw].textured) {
-    const draw_record& rec = draws_[draw];
-    const float distance = lengths_[texel] / z;
-    const glm::vec3 q = distance * directions_[texel] - rec.v0;
-    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-    const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
-    const std::vector<std::uint32_t>& indices = scene_->indices();
-    const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
-    const glm::vec2& uv0 = uvs[indices[tri]];
-    const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
-    return texture->sample(uv);
-  }
-  const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];
-  return {sh.r, sh.g, sh.b};
-}
-
-// After the resolve: each texel with fragments gets the blend of what covers it. Its fragments,
-// front to back (1/w at the texel centre, larger first; ties: the earlier draw first, then the
-// order they were added), each take min(coverage, what is left) until the whole-texel winner
-// (or the first fragment behind it), which takes the rest; with no whole-texel winner the sky
-// takes the rest. Deterministic: the order is total and the sums run in it.
-void hemicube_rasterizer::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
-  const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
-  std::vector<std::uint32_t> order;
-  float* red = out.channel(0);
-  float* green = out.channel(1);
-  float* blue = out.channel(2);
-  for (const edge_group& g : edge_groups_) {
-    order.clear();
-    for (std::uint32_t f = fragment_head_[g.texel]; f != no_triangle; f = fragments_[f].next) order.push_back(f);
-    // The list runs newest first: reversed, it is in the order the fragments were added; a stable
-    // insertion sort by (z descending, draw ascending) then keeps that order for ties.
-    std::reverse(order.begin(), order.end());
-    for (std::size_t i = 1; i < order.size(); ++i) {
-      const std::uint32_t f = order[i];
-      std::size_t j = i;
-      const auto before = [&](std::uint32_t a, std::uint32_t b) {
-        const edge_fragment &fa = fragments_[a], &fb = fragments_[b];
-        return fa.z > fb.z || (fa.z == fb.z && draw_of(fa.id) < draw_of(fb.id));
-      };
-      while (j > 0 && before(f, order[j - 1])) {
-        order[j] = order[j - 1];
-        --j;
-      }
-      order[j] = f;
-    }
-    glm::vec3 sum(0.0f);
-    float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share
-    for (const std::uint32_t f : order) {
-      const edge_fragment& fr = fragments_[f];
-      if (g.full_z > 0.0f && (fr.z < g.full_z || (fr.z == g.full_z && draw_of(fr.id) > draw_of(g.full_id)))) break;
-      const float share = std::min(fr.coverage, left);
-      if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
-      sum += share * fragment_radiance(fr.id, g.texel, fr.z, texture);
-      left -= share;
-      if (!(left > 0.0f)) break;
-    }
-    // The texel's distance: along the centre's direction to the plane of the nearest triangle
-    // with a share of it (not necessarily the one the centre sees; the flags stay the centre's).
-    // The translation gradient's walls move with the nearer texel's distance: a blended texel
-    // at an occluding edge must carry the occluder's distance, or half the edge's radiance step
-    // would move with the surface behind; and one whose centre sees nothing must not be at +inf
-    // (a wall between two texels at +inf contributes nothing).
-    if (nearest > 0.0f && nearest > g.centre_z) out.distance[g.texel] = lengths_[g.texel] / nearest;
-    if (left > 0.0f) {
-      glm::vec3 rest;
-      if (g.full_z > 0.0f)
-        rest = fragment_radiance(g.full_id, g.texel, g.full_z, texture);
-      else if (sky_)
-        rest = glm::vec3(sky_->sample(basis.to_world(directions_[g.texel])));
-      else
-        rest = glm::vec3(shades_[0].r, shades_[0].g, shades_[0].b);
-      sum += left * rest;
-    }
-    red[g.texel] = sum.x;
-    green[g.texel] = sum.y;
-    blue[g.texel] = sum.z;
-  }
-}
-
 void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
                                  const radiance_texture* texture) {
   const char* who = "hemicube_rasterizer::render";
@@ -1713,8 +1391,8 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   if (texture) texture->validate(who);
   prepare(resolution);
   textured_ = texture && scene_->has_lightmap_uvs();
+  if (edge_) edge_mark_hard(position, basis);
   draw_all<mode::depth>(position, basis);
-  if (edge_) edge_resolve_centres();
 
   // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
   // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
@@ -1774,7 +1452,10 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
       blue[i] = l.z;
     }
   }
-  if (edge_) edge_blend(out, basis, textured_ ? texture : nullptr);
+  if (edge_) {
+    edge_group_fragments();
+    edge_blend(out, basis, textured_ ? texture : nullptr);
+  }
 }
 
 void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,

@@ -206,12 +206,30 @@ HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene:
                              _mm256_or_si256(_mm256_cmpgt_epi32(_mm256_sub_epi32(max_x, min_x), limit),
                                              _mm256_cmpgt_epi32(_mm256_sub_epi32(max_y, min_y), limit))))) &
                          todo & ~clipped;
-    // With edge coverage every lane goes through raster_face (which keeps the unsnapped
-    // projected vertices for the partial texels; draw_fixed has those and the whole-texel bias),
-    // with a draw of its own per face (see bind).
-    const unsigned via_face = M == mode::depth && edge_ ? todo : clipped;
-    if (M == mode::depth && edge_)
+    // With edge coverage a lane that touches hard texels goes through raster_face (which keeps
+    // the unsnapped projected vertices for edge_texels); every lane has a draw of its own per
+    // face (see bind).
+    unsigned via_face = clipped;
+    if (M == mode::depth && edge_) {
       for (unsigned m = todo; m; m &= m - 1) draw[__builtin_ctz(m)] = 0;
+      if (hard_faces_ >> f & 1u) {
+        alignas(32) std::int32_t lx[8], hx[8], ly[8], hy[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(lx), min_x);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(hx), max_x);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(ly), min_y);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(hy), max_y);
+        const std::int64_t rows = f == 0 ? n : n / 2;
+        for (unsigned m = todo & ~clipped; m; m &= m - 1) {
+          const unsigned j = static_cast<unsigned>(__builtin_ctz(m));
+          // The texels the lane's box overlaps (draw_fixed's test), clamped to the face.
+          const std::int64_t c0 = std::max<std::int64_t>(floor_sub(std::int64_t(lx[j]) - 1), 0);
+          const std::int64_t c1 = std::min<std::int64_t>(ceil_sub(std::int64_t(hx[j]) + 1) - 1, n - 1);
+          const std::int64_t r0 = std::max<std::int64_t>(floor_sub(std::int64_t(ly[j]) - 1), 0);
+          const std::int64_t r1 = std::min<std::int64_t>(ceil_sub(std::int64_t(hy[j]) + 1) - 1, rows - 1);
+          if (c0 <= c1 && r0 <= r1 && edge_box_is_hard(f, c0, c1, r0, r1)) via_face |= 1u << j;
+        }
+      }
+    }
     // Texels whose centre (k + 1/2) lies in the box, clamped to the face (ceil_sub, floor_sub).
     const __m256i halfi = _mm256_set1_epi32(static_cast<int>(sub_half));
     const __m256i x_begin = _mm256_max_epi32(

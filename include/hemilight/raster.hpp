@@ -129,18 +129,21 @@ struct raster_options {
   /// Shared and immutable; build it with cubemap::from_image (which checks every value); the
   /// constructor throws error(invalid_argument) for an empty or inconsistent map.
   std::shared_ptr<const cubemap> sky = nullptr;
-  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that an edge of a
-  /// triangle crosses gets the exact area of the (projected, clipped) triangle within the texel
-  /// as a fraction of the texel, not the all-or-nothing sample at its centre; the triangles
-  /// sharing a texel are resolved front to back (each takes the smaller of its coverage and what
-  /// is left; the sky, or the triangle that covers the whole texel behind them, the rest), and
-  /// the texel's radiance is the blend. Texels inside a triangle are as without it. flags and
+  /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that a hard edge (a
+  /// mesh boundary, a change of material, a silhouette) may cross gets, from each triangle that
+  /// covers it in part, the exact area of the (projected, clipped) triangle within the texel as a
+  /// fraction of the texel, not the all-or-nothing sample at its centre; the triangles sharing a
+  /// texel are resolved front to back (each takes the smaller of its coverage and what is left;
+  /// the sky, or the triangle that covers the whole texel behind them, the rest), and the
+  /// texel's radiance is the blend. Every other texel (inside a triangle, or crossed only by
+  /// edges between triangles of one material facing the same way) is as without it. flags and
   /// seen_triangle() keep their meaning (what the texel centre sees: bit-identical to a render
   /// without the option); a blended texel's distance is to the plane of the nearest triangle
   /// with a share of it (along the centre's direction), which is the centre's distance unless a
   /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost: 12-36x a render + integration without it at N = 64 (docs/raster.md), so off by
-  /// default.
+  /// path. Cost at N = 64 (render + integration): 1.5x on tessellated rooms, 5x on the Cornell
+  /// box (material changes all around), 15x on a terrain seen from its own surface
+  /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
 };
 
@@ -159,15 +162,18 @@ struct raster_statistics {
   std::size_t fragments = 0;           ///< texels depth-tested (or counted) by the span paths
   std::size_t edge_texels_tested = 0;  ///< edge coverage: texels classified by the partial-texel pass
   std::size_t edge_fragments = 0;      ///< edge coverage: partial (triangle, texel) fragments kept
+  std::size_t edge_hard_edges = 0;     ///< edge coverage: edges needing exact coverage in this view
+  std::size_t edge_hard_texels = 0;    ///< edge coverage: texels such an edge may cross (exact there)
 };
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
 /// direction tables, plus 8 bytes per triangle drawn (~70 with a texture) and 16 bytes per distinct
-/// emission of the scene; kept between renders and grown on demand. With edge coverage, 4 more
-/// bytes per texel and 24 per partial (triangle, texel) fragment (~3,000 per hemicube of the
-/// Cornell box at N = 64, about one per texel in tessellated rooms).
+/// emission of the scene; kept between renders and grown on demand. With edge coverage, 16 bytes
+/// per scene edge that may be hard and per crease triangle, 12 more bytes per texel and 32 per
+/// partial (triangle, texel) fragment (~1,000 per hemicube of the Cornell box at N = 64, under
+/// 100 in tessellated rooms).
 /// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
 /// must not share a line, or the counters one writes slow down the members the other reads.
 class alignas(64) hemicube_rasterizer {
@@ -202,7 +208,8 @@ class alignas(64) hemicube_rasterizer {
   /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
   /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
   /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
-  /// raster_options::edge_coverage add O(partial texels): 12-36x in all at N = 64.
+  /// raster_options::edge_coverage add O(hard edges + the hard texels of the triangles touching
+  /// them): 1.5-15x in all at N = 64 (see the option).
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
@@ -248,7 +255,7 @@ class alignas(64) hemicube_rasterizer {
   void check_arguments(const char* who, const glm::vec3& position, const frame& basis, int resolution) const;
   void prepare(int resolution);
   unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
-                                            const frame& basis) const;
+                                            const frame& basis, bool hard) const;
   template <mode M>
   void draw_all(const glm::vec3& position, const frame& basis);
   template <mode M>
@@ -270,29 +277,53 @@ class alignas(64) hemicube_rasterizer {
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
-  // Exact edge coverage (raster_options::edge_coverage; raster.cpp, "Exact edge coverage").
+  // Exact edge coverage (raster_options::edge_coverage; raster_edge.cpp).
   struct edge_fragment {
     std::uint32_t texel;  // hemicube texel index
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
     float coverage;       // the covered fraction of the texel's weight, [0, 1]
     std::uint32_t id;     // the draw's texel id (as in ids_)
-    std::uint32_t next;   // next fragment of the same texel (no_triangle = none)
-    bool centre;          // the triangle covers the texel centre (the point-sampled test)
   };
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
-                   const face_setup& fs, std::uint32_t draw);
-  void edge_resolve_centres();
+                   const face_setup& fs, std::uint32_t draw, bool back);
+  // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
+  // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
+  struct edge_candidate {
+    std::uint32_t triangle;   // scene_->triangles() position
+    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
+    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
+    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
+  };
+  void edge_find_candidates();
+  void edge_mark_hard(const glm::vec3& position, const frame& basis);
+  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
+  bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
+  std::vector<edge_candidate> edge_candidates_;
+  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
+  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
+  // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
+  // a hard edge may cross texel c (words_per_row_ words a row).
+  std::vector<std::uint64_t> hard_bits_;
+  std::vector<std::uint64_t> silhouette_bits_;  // the same for silhouette edges only
+  std::size_t words_per_row_ = 0;
+  template <class Visit>
+  void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
+  std::vector<float> whole_z_;                // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
+  std::vector<std::uint32_t> whole_id_;       // and its texel id
+  std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
+  std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
+  unsigned hard_faces_ = 0;                   // faces with a hard texel
+  void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
   glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
   bool edge_ = false;
   std::vector<edge_fragment> fragments_;
-  std::vector<std::uint32_t> fragment_head_;    // per texel: first fragment (no_triangle = none)
+  std::vector<std::uint32_t> fragment_count_;   // per texel: its fragments (0 = none)
+  std::vector<edge_fragment> grouped_;          // fragments_ by texel (edge_groups_ ranges)
   std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
   struct edge_group {
     std::uint32_t texel;
-    float full_z;             // the nearest triangle covering the whole texel: 1/w (0 = none)
-    std::uint32_t full_id;    // and its id
-    float centre_z;           // 1/w of what the texel centre sees (0 = nothing)
+    std::uint32_t first, count;  // its fragments in grouped_
   };
   std::vector<edge_group> edge_groups_;
 

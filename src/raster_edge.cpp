@@ -1,0 +1,597 @@
+// Exact edge coverage (raster_options::edge_coverage; docs/raster.md, "Exact edge coverage"): the
+// partial texels of each drawn triangle, their front-to-back resolve and blend.
+#include "hemilight/raster.hpp"
+#include "raster_internal.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace hemilight {
+
+using namespace raster_detail;
+
+// ---------------------------------------------------------------------------------------------
+// Exact edge coverage (raster_options::edge_coverage; docs/raster.md, "Exact edge coverage")
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// square_part_inside (below) for one clipping edge f0 + gx x + gy y >= 0: the polygon's shoelace terms, edge by edge: the inside part of each side of
+// the square (an interval of it: a half-plane cuts a segment once), then the cut itself, from
+// where the boundary leaves the half-plane to where it comes back. Selects, no branches.
+double square_part_inside_one(double f0, double gx, double gy, double wx, double wy) noexcept {
+  const double cx[4] = {-0.5, 0.5, 0.5, -0.5}, cy[4] = {-0.5, -0.5, 0.5, 0.5};  // corners about the centre
+  double value[4];
+  for (int i = 0; i < 4; ++i) value[i] = f0 + gx * (cx[i] + 0.5) + gy * (cy[i] + 0.5);
+  double twice = 0.0, mx = 0.0, my = 0.0;
+  double out_x = 0.0, out_y = 0.0, in_x = 0.0, in_y = 0.0;  // where the boundary leaves and re-enters
+  const auto term = [&](double ax, double ay, double bx, double by) {
+    const double cross = ax * by - bx * ay;
+    twice += cross;
+    mx += (ax + bx) * cross;
+    my += (ay + by) * cross;
+  };
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) & 3;
+    const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
+    const double d = value[i] - value[j];
+    const double t = in_i != in_j ? value[i] / d : 0.0;
+    const double hx = cx[i] + t * (cx[j] - cx[i]), hy = cy[i] + t * (cy[j] - cy[i]);  // the crossing
+    const double ax = in_i ? cx[i] : hx, ay = in_i ? cy[i] : hy;
+    const double bx = in_j ? cx[j] : hx, by = in_j ? cy[j] : hy;
+    if (in_i || in_j) term(ax, ay, bx, by);
+    out_x = in_i && !in_j ? hx : out_x;
+    out_y = in_i && !in_j ? hy : out_y;
+    in_x = !in_i && in_j ? hx : in_x;
+    in_y = !in_i && in_j ? hy : in_y;
+  }
+  term(out_x, out_y, in_x, in_y);  // (zero when the square is all in or all out)
+  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+}
+
+// The part of the unit square [0, 1]^2 (a texel, in texel units) inside the half-planes
+// f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of the edges in `clip` (bit k): Sutherland-Hodgman
+// on the square's polygon (at most 4 + 3 vertices), then the polygon's area and first moments
+// about the square's centre (the shoelace formula and its moment form), weighted by the density
+// 1 + wx (x - 1/2) + wy (y - 1/2). Double precision: within ~1e-15 of the exact value for the
+// snapped triangle. The square's own moments vanish, so the values of two triangles sharing an
+// edge sum to those of their union.
+double square_part_inside(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3], unsigned clip,
+                          double wx, double wy) noexcept {
+  if (clip == 0) return 1.0;  // the whole square (its moments vanish): what the loops below give
+  if ((clip & (clip - 1)) == 0) {  // one edge (most partial texels): the same polygon, branch-free
+    const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
+    return square_part_inside_one(f0[k], gx[k], gy[k], wx, wy);
+  }
+  double ax_[8] = {0.0, 1.0, 1.0, 0.0}, ay_[8] = {0.0, 0.0, 1.0, 1.0};
+  double bx_[8], by_[8];
+  double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;  // the polygon, and the next one (swapped)
+  int count = 4;
+  for (int k = 0; k < 3 && count >= 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    double value[8];
+    for (int i = 0; i < count; ++i) value[i] = f0[k] + gx[k] * px[i] + gy[k] * py[i];
+    int out = 0;
+    for (int i = 0; i < count; ++i) {
+      const int j = i + 1 == count ? 0 : i + 1;
+      const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
+      if (in_i) {
+        qx[out] = px[i];
+        qy[out] = py[i];
+        ++out;
+      }
+      if (in_i != in_j) {
+        const double t = value[i] / (value[i] - value[j]);
+        qx[out] = px[i] + t * (px[j] - px[i]);
+        qy[out] = py[i] + t * (py[j] - py[i]);
+        ++out;
+      }
+    }
+    count = out;
+    std::swap(px, qx);
+    std::swap(py, qy);
+  }
+  if (count < 3) return 0.0;
+  double twice = 0.0, mx = 0.0, my = 0.0;  // 2 area, 6 first moments (about the centre)
+  for (int i = 0; i < count; ++i) {
+    const int j = i + 1 == count ? 0 : i + 1;
+    const double ax = px[i] - 0.5, ay = py[i] - 0.5, bx = px[j] - 0.5, by = py[j] - 0.5;
+    const double cross = ax * by - bx * ay;
+    twice += cross;
+    mx += (ax + bx) * cross;
+    my += (ay + by) * cross;
+  }
+  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Hard edges
+//
+// Exact coverage matters only where what a texel sees changes across an edge: at a mesh's
+// boundary, between different materials, and at a silhouette (one of the edge's triangles faces
+// the point, the other not). Across any other edge (two triangles of one material, consistently
+// wound, both facing the point or both facing away) the two triangles project on either side of
+// it and between them cover both sides: the texel centre's sample is what the texel sees, as far
+// as the emission goes (equal on both sides; a texture's value is continuous across the edge up
+// to its own seams). So only texels that a hard edge may cross get exact coverage; the others
+// keep the centre sample, bit for bit what a render without the option gives.
+//
+// At bind: the scene's edges are matched by their endpoints' bits (shared edges need not share
+// vertex indices). An edge shared by exactly two triangles with opposite windings and equal
+// materials whose planes coincide (same unit normal to 1e-10) is never hard and is dropped; one
+// whose planes differ (a crease) is hard in a view where the triangles' facings differ (or one
+// is seen edge-on); any other edge (one triangle, three or more, equal windings, different
+// materials, a degenerate triangle) is hard in every view. Per render: the facings of the
+// creases' triangles, then each hard edge's texels on each face are marked (edge_mark_segment),
+// conservatively. Cost: O(E log E) at bind for E edges; per render O(creases' triangles +
+// candidate edges + the texels hard edges cross).
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+const glm::vec3& corner(const scene::triangle& t, std::uint32_t k) noexcept {
+  return k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2);
+}
+
+// The index of the lowest set bit of a nonzero word.
+inline int lowest_bit(std::uint64_t word) noexcept {
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctzll(word);
+#else
+  int i = 0;
+  while (!(word & 1u)) {
+    word >>= 1;
+    ++i;
+  }
+  return i;
+#endif
+}
+
+std::uint32_t bits_of(float f) noexcept {
+  std::uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
+}
+
+}  // namespace
+
+void hemicube_rasterizer::edge_find_candidates() {
+  const std::vector<scene::triangle>& tris = scene_->triangles();
+  // Step 1: every edge, keyed by its endpoints' bits in a canonical order.
+  struct half_edge {
+    std::uint32_t key[6];
+    std::uint32_t triangle, k;
+    bool forward;  // the edge runs from the smaller key's endpoint to the larger one
+  };
+  std::vector<half_edge> edges;
+  edges.reserve(3 * tris.size());
+  for (std::uint32_t i = 0; i < tris.size(); ++i)
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const glm::vec3 &a = corner(tris[i], k), &b = corner(tris[i], k == 2 ? 0 : k + 1);
+      const std::uint32_t ka[3] = {bits_of(a.x), bits_of(a.y), bits_of(a.z)};
+      const std::uint32_t kb[3] = {bits_of(b.x), bits_of(b.y), bits_of(b.z)};
+      half_edge h;
+      h.forward = std::lexicographical_compare(ka, ka + 3, kb, kb + 3);
+      const std::uint32_t* lo = h.forward ? ka : kb;
+      const std::uint32_t* hi = h.forward ? kb : ka;
+      std::copy(lo, lo + 3, h.key);
+      std::copy(hi, hi + 3, h.key + 3);
+      h.triangle = i;
+      h.k = k;
+      edges.push_back(h);
+    }
+  const auto key_less = [](const half_edge& a, const half_edge& b) {
+    if (std::lexicographical_compare(a.key, a.key + 6, b.key, b.key + 6)) return true;
+    if (std::lexicographical_compare(b.key, b.key + 6, a.key, a.key + 6)) return false;
+    return a.triangle < b.triangle || (a.triangle == b.triangle && a.k < b.k);  // deterministic order
+  };
+  std::sort(edges.begin(), edges.end(), key_less);
+
+  // Step 2: classify each edge (a run of equal keys).
+  const auto unit_normal = [&](const scene::triangle& t) {
+    const glm::dvec3 v0(t.v0);
+    const glm::dvec3 nrm = glm::cross(glm::dvec3(t.v1) - v0, glm::dvec3(t.v2) - v0);
+    const double len = glm::length(nrm);
+    return len > 0.0 ? nrm / len : glm::dvec3(0.0);
+  };
+  const auto same_material = [&](const scene::triangle& a, const scene::triangle& b) {
+    const material &ma = scene_->triangle_material(a.index), &mb = scene_->triangle_material(b.index);
+    return ma.emission == mb.emission && ma.albedo == mb.albedo && ma.two_sided == mb.two_sided;
+  };
+  std::vector<std::uint32_t> plane_of(tris.size(), no_triangle);
+  edge_planes_.clear();
+  const auto plane_entry = [&](std::uint32_t i) {
+    if (plane_of[i] == no_triangle) {
+      const glm::dvec3 nrm = unit_normal(tris[i]);
+      plane_of[i] = static_cast<std::uint32_t>(edge_planes_.size());
+      edge_planes_.emplace_back(glm::vec3(nrm), static_cast<float>(glm::dot(nrm, glm::dvec3(tris[i].v0))));
+    }
+    return plane_of[i];
+  };
+  for (std::size_t first = 0; first < edges.size();) {
+    std::size_t last = first + 1;
+    while (last < edges.size() && std::equal(edges[first].key, edges[first].key + 6, edges[last].key)) ++last;
+    const half_edge& a = edges[first];
+    edge_candidate c{a.triangle, a.k, no_triangle, no_triangle};
+    if (last - first == 2 && edges[first + 1].forward != a.forward) {
+      const half_edge& b = edges[first + 1];
+      const scene::triangle &ta = tris[a.triangle], &tb = tris[b.triangle];
+      const glm::dvec3 na = unit_normal(ta), nb = unit_normal(tb);
+      const bool degenerate = glm::dot(na, na) == 0.0 || glm::dot(nb, nb) == 0.0;
+      if (!degenerate && same_material(ta, tb)) {
+        if (glm::dot(na, nb) >= 1.0 - 1e-10) {  // one plane: never hard
+          first = last;
+          continue;
+        }
+        c.plane_a = plane_entry(a.triangle);
+        c.plane_b = plane_entry(b.triangle);
+      }
+    }
+    edge_candidates_.push_back(c);
+    first = last;
+  }
+  edge_facing_.assign(edge_planes_.size(), 0);
+}
+
+void hemicube_rasterizer::edge_mark_hard(const glm::vec3& position, const frame& basis) {
+  // Facings of the creases' triangles: the sign of the plane's value at the point, 0 within
+  // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
+  const double px = position.x, py = position.y, pz = position.z;
+  const double scale = std::fabs(px) + std::fabs(py) + std::fabs(pz);
+  for (std::size_t i = 0; i < edge_planes_.size(); ++i) {
+    const glm::vec4& q = edge_planes_[i];
+    const double f = static_cast<double>(q.x) * px + static_cast<double>(q.y) * py + static_cast<double>(q.z) * pz -
+                     static_cast<double>(q.w);
+    const double band = 1e-5 * (scale + std::fabs(static_cast<double>(q.w)));
+    edge_facing_[i] = static_cast<std::int8_t>(f > band ? 1 : (f < -band ? -1 : 0));
+  }
+  const std::vector<scene::triangle>& tris = scene_->triangles();
+  for (const edge_candidate& c : edge_candidates_) {
+    bool silhouette = false;
+    if (c.plane_a != no_triangle) {
+      const std::int8_t fa = edge_facing_[c.plane_a], fb = edge_facing_[c.plane_b];
+      if (fa != 0 && fa == fb) continue;
+      silhouette = fa * fb < 0;
+    }
+    const scene::triangle& t = tris[c.triangle];
+    const glm::vec3 a = basis.to_local(corner(t, c.k) - position);
+    const glm::vec3 b = basis.to_local(corner(t, c.k == 2 ? 0 : c.k + 1) - position);
+    if (a.z < 0.0f && b.z < 0.0f) continue;  // below the tangent plane: on no face
+    ++stats_.edge_hard_edges;
+    edge_mark_segment(a, b, silhouette);
+  }
+  stats_.edge_hard_texels = hard_texels_.size();
+}
+
+// Marks the texels that the segment (a, b) (local frame) may cross on each face: the segment is
+// clipped to the face's frustum widened by a texel (and to w >= near / 2), projected in double,
+// and every texel within 1/16 texel of it is marked. The rasterizer's vertices differ from these
+// by its float set-up and 1/512 texel of snapping, far below the margins, so no texel a hard edge
+// crosses is missed; the margins only add a few texels of exact coverage.
+void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette) {
+  const int n = n_;
+  const double grow = 1.0 + texel_step_, near = 0.5 * static_cast<double>(near_), eps = 1.0 / 16.0;
+  for (int face = 0; face < 5; ++face) {
+    const clip_vertex ca = to_clip(face, a), cb = to_clip(face, b);
+    const glm::dvec3 pa(ca.u, ca.v, ca.w), pb(cb.u, cb.v, cb.w);
+    // Liang-Barsky against g(p) >= 0 for each bounding plane g.
+    double t0 = 0.0, t1 = 1.0;
+    const auto keep = [&](double ga, double gb) {
+      if (ga < 0.0 && gb < 0.0) return false;
+      if (ga < 0.0) t0 = std::max(t0, ga / (ga - gb));
+      else if (gb < 0.0) t1 = std::min(t1, ga / (ga - gb));
+      return t0 <= t1;
+    };
+    const double v_low = face == 0 ? grow : texel_step_;  // side faces: v >= -1 texel
+    if (!keep(pa.z - near, pb.z - near) || !keep(grow * pa.z - pa.x, grow * pb.z - pb.x) ||
+        !keep(grow * pa.z + pa.x, grow * pb.z + pb.x) || !keep(grow * pa.z - pa.y, grow * pb.z - pb.y) ||
+        !keep(v_low * pa.z + pa.y, v_low * pb.z + pb.y))
+      continue;
+    const glm::dvec3 q0 = pa + t0 * (pb - pa), q1 = pa + t1 * (pb - pa);
+    // Texel coordinates (x, y in texels; centres at k + 1/2).
+    const double half = 0.5 * n, v_offset = face == 0 ? 1.0 : 0.0;
+    const double x0 = (q0.x / q0.z + 1.0) * half, y0 = (q0.y / q0.z + v_offset) * half;
+    const double x1 = (q1.x / q1.z + 1.0) * half, y1 = (q1.y / q1.z + v_offset) * half;
+    const int rows = face == 0 ? n : n / 2;
+    const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+    const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(rows);
+    const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
+    const int r_first = std::max(0, static_cast<int>(std::floor(ylo - eps)));
+    const int r_last = std::min(rows - 1, static_cast<int>(std::floor(yhi + eps)));
+    for (int r = r_first; r <= r_last; ++r) {
+      // The segment's x range within the strip [r - eps, r + 1 + eps].
+      double xlo = std::min(x0, x1), xhi = std::max(x0, x1);
+      if (yhi - ylo > 1e-12) {
+        const double s0 = std::max(0.0, std::min(1.0, (static_cast<double>(r) - eps - y0) / (y1 - y0)));
+        const double s1 = std::max(0.0, std::min(1.0, (static_cast<double>(r) + 1.0 + eps - y0) / (y1 - y0)));
+        const double xa = x0 + s0 * (x1 - x0), xb = x0 + s1 * (x1 - x0);
+        xlo = std::min(xa, xb);
+        xhi = std::max(xa, xb);
+      }
+      const int c_first = std::max(0, static_cast<int>(std::floor(xlo - eps)));
+      const int c_last = std::min(n - 1, static_cast<int>(std::floor(xhi + eps)));
+      if (c_first > c_last) continue;
+      std::int32_t& lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
+      std::int32_t& hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
+      lo = std::min(lo, static_cast<std::int32_t>(c_first));
+      hi = std::max(hi, static_cast<std::int32_t>(c_last));
+      const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
+      std::uint64_t* bits = hard_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
+      std::uint64_t* outline = silhouette_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
+      for (int c = c_first; c <= c_last; ++c) {
+        std::uint64_t& word = bits[c >> 6];
+        const std::uint64_t bit = std::uint64_t(1) << (c & 63);
+        if (!(word & bit)) {
+          word |= bit;
+          hard_texels_.push_back(static_cast<std::uint32_t>(row + static_cast<std::size_t>(c)));
+        }
+        if (silhouette) outline[c >> 6] |= bit;
+      }
+      hard_faces_ |= 1u << face;
+    }
+  }
+}
+
+// Whether a hard texel lies in columns c0..c1 of rows r0..r1 of `face` (the rows' hard column
+// ranges, then the texels within them). Cost: O(rows + the texels within the rows' ranges).
+bool hemicube_rasterizer::edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0,
+                                           std::int64_t r1) const noexcept {
+  const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n_) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n_ / 2);
+  for (std::int64_t r = r0; r <= r1; ++r) {
+    const std::size_t row = row_base + static_cast<std::size_t>(r);
+    if (hard_rows_[2 * row] > c1 || hard_rows_[2 * row + 1] < c0) continue;
+    bool any = false;
+    edge_for_hard(row, std::max<std::int64_t>(c0, hard_rows_[2 * row]), std::min<std::int64_t>(c1, hard_rows_[2 * row + 1]),
+                  [&](std::int64_t) { any = true; return false; });
+    if (any) return true;
+  }
+  return false;
+}
+
+// Calls visit(c) for each hard column c in [c0, c1] of face row `row` (hard_bits_), in order,
+// until visit returns false.
+template <class Visit>
+void hemicube_rasterizer::edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const {
+  if (c0 > c1) return;
+  const std::uint64_t* bits = hard_bits_.data() + row * words_per_row_;
+  const std::int64_t w0 = c0 >> 6, w1 = c1 >> 6;
+  for (std::int64_t w = w0; w <= w1; ++w) {
+    std::uint64_t word = bits[w];
+    if (w == w0) word &= ~std::uint64_t(0) << (c0 & 63);
+    if (w == w1 && (c1 & 63) != 63) word &= (std::uint64_t(1) << ((c1 & 63) + 1)) - 1;
+    while (word) {
+      if (!visit(w * 64 + lowest_bit(word))) return;
+      word &= word - 1;
+    }
+  }
+}
+
+// The hard texels (edge_mark_hard) that the snapped triangle (px, py: fixed point, counter-
+// clockwise) touches on `face`. A texel it covers whole makes it the texel's whole-texel
+// candidate (whole_z_, whole_id_: the nearest, ties to the earlier draw); one it covers in part
+// gets a fragment with the exact covered fraction of its weight, unless a triangle drawn earlier
+// covers the whole texel in front of it. Row by row: the rows' hard column ranges, cut to the
+// triangle's x extent within the row's strip (its vertices in the strip and its edges' crossings
+// of the strip's lines), bound the texels to classify; they are classified exactly with the
+// integer edge functions at their corners (outside: an edge leaves every corner at <= 0, i.e. no
+// area in common; whole: every corner of every edge >= 0; else partial). `exact`: the unsnapped
+// vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The coverage paths
+// draw the triangle as without the option (centre samples). Cost: O(rows + the hard texels of
+// its rows within its extent).
+void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
+                                      const double (&exact)[6], const face_setup& fs, std::uint32_t draw,
+                                      bool back) {
+  const int n = n_;
+  const int rows = face == 0 ? n : n / 2;
+  const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+  const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(rows);
+  std::int64_t dx[3], dy[3];
+  for (int k = 0; k < 3; ++k) {
+    const int b = k == 2 ? 0 : k + 1;
+    dx[k] = px[b] - px[k];
+    dy[k] = py[b] - py[k];
+  }
+  const std::int64_t min_y = std::min({py[0], py[1], py[2]}), max_y = std::max({py[0], py[1], py[2]});
+  const std::int64_t min_x = std::min({px[0], px[1], px[2]}), max_x = std::max({px[0], px[1], px[2]});
+  // Texels the box overlaps, grown by the snapping (half a unit) for the unsnapped triangle.
+  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
+  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
+  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
+  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
+
+  // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
+  // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
+  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
+  for (int k = 0; k < 3; ++k) {
+    const int b = k == 2 ? 0 : k + 1;
+    edx[k] = exact[b] - exact[k];
+    edy[k] = exact[3 + b] - exact[3 + k];
+    gx[k] = -edy[k] * static_cast<double>(sub_one);
+    gy[k] = edx[k] * static_cast<double>(sub_one);
+    gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
+    gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
+  }
+  const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
+    ++stats_.edge_texels_tested;
+    const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
+    // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
+    // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's
+    // edges are within ~2 units of the snapped ones over its box, so it has no area there.
+    bool whole = true, far = false;
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
+      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
+      whole = whole && e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0) >= 0;
+      far = far || e + std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0) < -4 * (std::abs(dx[k]) + std::abs(dy[k]));
+    }
+    if (far) return;
+    // The triangle's depth at the texel centre, as the coverage paths compute it.
+    const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
+    float z = zrow + fs.dzdx * static_cast<float>(c);
+    z = z > FLT_MIN ? z : FLT_MIN;
+    if (whole) {
+      if (z > whole_z_[texel]) {
+        whole_z_[texel] = z;
+        whole_id_[texel] = draw;
+      }
+      return;
+    }
+    // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
+    // blend stops at the whole-texel winner, which can only come nearer).
+    if (!(z > whole_z_[texel])) return;
+    // Facing away, in a texel a silhouette crosses: near a silhouette the surface's far sheet
+    // lies behind its near one over the same part of the texel (a ray entering the surface
+    // leaves it through the far sheet), which the blend, taking fragments as side by side,
+    // would count again in place of what lies behind.
+    if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
+    // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
+    // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
+    // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
+    // triangles sharing an edge clip it from the same unsnapped endpoints, so between them they
+    // miss no part of a texel.
+    double f0[3];
+    unsigned clip = 0;  // the unsnapped edges that cut the texel
+    for (int k = 0; k < 3; ++k) {
+      f0[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) - edy[k] * (static_cast<double>(x0) - exact[k]);
+      if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
+      if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
+    }
+    // The integrator weights a texel by the projected solid angle over it; within the texel its
+    // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
+    // centre's, in texel units): the covered fraction of the texel's weight, to second order.
+    // Top face (z = 1): density (1 + u^2 + v^2)^-2; side faces (v = height): v (1 + u^2 + v^2)^-2.
+    const double u = first_centre_ + texel_step_ * static_cast<double>(c);
+    const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
+    const double q = 1.0 + u * u + v * v;
+    const double wx = -4.0 * u / q * texel_step_;
+    const double wy = (face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_;
+    const double area = square_part_inside(f0, gx, gy, clip, wx, wy);
+    if (!(area > 0.0)) return;
+    edge_fragment fr;
+    fr.texel = static_cast<std::uint32_t>(texel);
+    fr.z = z;
+    fr.coverage = static_cast<float>(std::min(area, 1.0));
+    fr.id = draw;
+    if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
+    fragments_.push_back(fr);
+    ++stats_.edge_fragments;
+  };
+
+  for (std::int64_t r = row_lo; r <= row_hi; ++r) {
+    const std::int32_t hard_lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
+    const std::int32_t hard_hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
+    if (hard_lo > col_hi || hard_hi < col_lo) continue;
+    const std::int64_t c0 = std::max<std::int64_t>(col_lo, hard_lo), c1 = std::min<std::int64_t>(col_hi, hard_hi);
+    const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
+    edge_for_hard(row_base + static_cast<std::size_t>(r), c0, c1, [&](std::int64_t c) {
+      classify(c, r, row + static_cast<std::size_t>(c));
+      return true;
+    });
+  }
+}
+
+// After the resolve (which gave every texel its centre sample, as without the option): each
+// hard texel with fragments gets its fragments made contiguous, in the order they were added (a
+// counting sort by texel; the texels in first-touch order). fragment_count_ becomes each
+// texel's end.
+void hemicube_rasterizer::edge_group_fragments() {
+  edge_groups_.reserve(fragment_texels_.size());
+  std::uint32_t offset = 0;
+  for (const std::uint32_t t : fragment_texels_) {
+    edge_groups_.push_back({t, offset, fragment_count_[t]});
+    fragment_count_[t] = offset;
+    offset += edge_groups_.back().count;
+  }
+  grouped_.resize(fragments_.size());
+  for (const edge_fragment& fr : fragments_) grouped_[fragment_count_[fr.texel]++] = fr;
+}
+
+// The radiance a draw (texel id) gives at a texel whose centre direction meets its plane at 1/w
+// = z: the resolve's computation (shade, or the texture at the perspective-correct UV).
+glm::vec3 hemicube_rasterizer::fragment_radiance(std::uint32_t id, std::size_t texel, float z,
+                                                 const radiance_texture* texture) const {
+  const std::uint32_t draw = id >> key_bits_;
+  if (textured_ && draws_[draw].textured) {
+    const draw_record& rec = draws_[draw];
+    const float distance = lengths_[texel] / z;
+    const glm::vec3 q = distance * directions_[texel] - rec.v0;
+    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
+    const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
+    const std::vector<std::uint32_t>& indices = scene_->indices();
+    const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
+    const glm::vec2& uv0 = uvs[indices[tri]];
+    const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+    return texture->sample(uv);
+  }
+  const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];
+  return {sh.r, sh.g, sh.b};
+}
+
+// After the resolve: each texel with fragments gets the blend of what covers it. Its fragments,
+// front to back (1/w at the texel centre, larger first; ties: the earlier draw first, then the
+// order they were added), each take min(coverage, what is left) until the whole-texel winner
+// (or the first fragment behind it), which takes the rest; with no whole-texel winner the sky
+// takes the rest. Deterministic: the order is total and the sums run in it.
+void hemicube_rasterizer::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
+  const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
+  float* red = out.channel(0);
+  float* green = out.channel(1);
+  float* blue = out.channel(2);
+  for (const edge_group& g : edge_groups_) {
+    const float full_z = whole_z_[g.texel];  // the nearest triangle covering the whole texel (0 = none)
+    const std::uint32_t full_id = whole_id_[g.texel];
+    // The group is in the order the fragments were added; a stable insertion sort by
+    // (z descending, draw ascending) keeps that order for ties.
+    edge_fragment* order = grouped_.data() + g.first;
+    for (std::uint32_t i = 1; i < g.count; ++i) {
+      const edge_fragment f = order[i];
+      std::uint32_t j = i;
+      const auto before = [&](const edge_fragment& fa, const edge_fragment& fb) {
+        return fa.z > fb.z || (fa.z == fb.z && draw_of(fa.id) < draw_of(fb.id));
+      };
+      while (j > 0 && before(f, order[j - 1])) {
+        order[j] = order[j - 1];
+        --j;
+      }
+      order[j] = f;
+    }
+    glm::vec3 sum(0.0f);
+    float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share
+    for (std::uint32_t i = 0; i < g.count; ++i) {
+      const edge_fragment& fr = order[i];
+      if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
+      const float share = std::min(fr.coverage, left);
+      if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
+      sum += share * fragment_radiance(fr.id, g.texel, fr.z, texture);
+      left -= share;
+      if (!(left > 0.0f)) break;
+    }
+    // The texel's distance: along the centre's direction to the plane of the nearest triangle
+    // with a share of it (not necessarily the one the centre sees; the flags stay the centre's).
+    // The translation gradient's walls move with the nearer texel's distance: a blended texel
+    // at an occluding edge must carry the occluder's distance, or half the edge's radiance step
+    // would move with the surface behind; and one whose centre sees nothing must not be at +inf
+    // (a wall between two texels at +inf contributes nothing).
+    if (nearest > 0.0f && lengths_[g.texel] / nearest < out.distance[g.texel]) out.distance[g.texel] = lengths_[g.texel] / nearest;
+    if (left > 0.0f) {
+      glm::vec3 rest;
+      if (full_z > 0.0f)
+        rest = fragment_radiance(full_id, g.texel, full_z, texture);
+      else if (sky_)
+        rest = glm::vec3(sky_->sample(basis.to_world(directions_[g.texel])));
+      else
+        rest = glm::vec3(shades_[0].r, shades_[0].g, shades_[0].b);
+      sum += left * rest;
+    }
+    red[g.texel] = sum.x;
+    green[g.texel] = sum.y;
+    blue[g.texel] = sum.z;
+  }
+}
+
+}  // namespace hemilight
