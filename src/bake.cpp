@@ -218,22 +218,6 @@ texel_clip clip_triangle_to_texel(const glm::vec2& a, const glm::vec2& b, const 
   return out;
 }
 
-glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept {
-  // pi Y00 = sqrt(pi) / 2 and (2 pi / 3) Y1 = sqrt(pi / 3): the clamped-cosine kernel's band 0 and
-  // band 1 factors (pi, 2 pi / 3) times the basis functions' constants (integrate.hpp).
-  constexpr float k0 = 0.886226925f;  // sqrt(pi) / 2
-  constexpr float k1 = 1.023326708f;  // sqrt(pi / 3)
-  const glm::vec3 e = k0 * sh[0] + k1 * (d.x * sh[3] + d.y * sh[1] + d.z * sh[2]);
-  return glm::max(e, glm::vec3(0.0f));
-}
-
-std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, const frame& f) noexcept {
-  std::array<glm::vec3, 3> out;
-  for (std::size_t k = 0; k < 3; ++k)
-    out[k] = sh_l1_irradiance(sh, f.to_world(glm::vec3(hl2_basis[k][0], hl2_basis[k][1], hl2_basis[k][2])));
-  return out;
-}
-
 frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], const glm::vec3& n) noexcept {
   const glm::dvec3 e1 = glm::dvec3(p[1]) - glm::dvec3(p[0]), e2 = glm::dvec3(p[2]) - glm::dvec3(p[0]);
   const glm::dvec2 d1 = glm::dvec2(uv[1]) - glm::dvec2(uv[0]), d2 = glm::dvec2(uv[2]) - glm::dvec2(uv[0]);
