@@ -116,106 +116,165 @@ void for_each_texel_in_bounds(const tri_data& t, int w, int h, F&& f) {
     for (int x = x0; x <= x1; ++x) f(x, y, std::size_t(y) * std::size_t(w) + std::size_t(x));
 }
 
-}  // namespace
+// Pass A's sums per covered texel: a slot per texel, made when a triangle first covers it.
+struct coverage_slots {
+  static constexpr std::uint32_t no_slot = 0xffffffffu;
+  std::vector<std::uint32_t> slot_of;  // per texel of the lightmap: its slot, or no_slot
+  std::vector<std::size_t> texel;      // per slot: its texel
+  std::vector<double> sum_area, owner_area;
+  std::vector<glm::dvec2> sum_centroid, owner_centroid;
+  std::vector<std::uint32_t> owner;
+};
 
-sparse_samples compute_sparse_samples(const bake_input& input, int width, int height) {
-  const char* who = "compute_lightmap_samples";
-  check_size(who, width, height);
-  check_input(who, input);
-  const scene_desc& d = input.scene;
-  const std::size_t texels = std::size_t(width) * std::size_t(height);
-  constexpr std::uint32_t none = lightmap_samples::no_triangle;
-
+// The triangles in texel units; a triangle with 3D area but (next to) no UV area would get no
+// texels: a broken unwrap, refused.
+std::vector<tri_data> triangles_in_texels(const char* who, const scene_desc& d, int width, int height) {
   std::vector<tri_data> tris(d.triangle_count);
   for (std::size_t i = 0; i < d.triangle_count; ++i) {
     tris[i] = make_tri(d, i, width, height);
-    // A triangle with 3D area but (next to) no UV area would get no texels: a broken unwrap.
     if (tris[i].drawn && !(tris[i].uv_area > 1e-12 * double(width) * double(height)))
       throw_invalid_argument(std::string(who) + ": triangle " + std::to_string(i) +
                              " has zero area in lightmap UV space (but not in 3D): it would get no texels");
   }
+  return tris;
+}
 
-  // Pass A: coverage sum, area-weighted centroid, owner (largest area, ties to the lower index:
-  // triangles are visited in index order and only a strictly larger area replaces the owner).
-  // Per covered texel: a slot, made when a triangle first covers it (the sums per texel are
-  // formed in triangle order whatever the slot).
-  constexpr std::uint32_t no_slot = 0xffffffffu;
-  std::vector<std::uint32_t> slot_of(texels, no_slot);
-  std::vector<std::size_t> slot_texel;
-  std::vector<double> sum_area, owner_area;
-  std::vector<glm::dvec2> sum_centroid, owner_centroid;
-  std::vector<std::uint32_t> owner;
-  for (std::size_t i = 0; i < d.triangle_count; ++i)
+// Pass A: coverage sum, area-weighted centroid, owner (largest area, ties to the lower index:
+// triangles are visited in index order and only a strictly larger area replaces the owner).
+// Per covered texel: a slot, made when a triangle first covers it (the sums per texel are
+// formed in triangle order whatever the slot).
+coverage_slots accumulate_coverage(const char* who, const std::vector<tri_data>& tris, int width, int height) {
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+  constexpr std::uint32_t no_slot = coverage_slots::no_slot;
+  coverage_slots s;
+  s.slot_of.assign(std::size_t(width) * std::size_t(height), no_slot);
+  for (std::size_t i = 0; i < tris.size(); ++i)
     for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
       const clip_d c = clip_texel(tris[i].t, x, y);
       if (!(c.area > 0.0)) return;
-      std::uint32_t q = slot_of[k];
+      std::uint32_t q = s.slot_of[k];
       if (q == no_slot) {
-        if (slot_texel.size() >= std::size_t(no_slot))
+        if (s.texel.size() >= std::size_t(no_slot))
           throw error(status::out_of_memory, std::string(who) + ": more than 2^32 - 1 covered texels");
-        q = slot_of[k] = std::uint32_t(slot_texel.size());
-        slot_texel.push_back(k);
-        sum_area.push_back(0.0);
-        owner_area.push_back(0.0);
-        sum_centroid.emplace_back(0.0);
-        owner_centroid.emplace_back(0.0);
-        owner.push_back(none);
+        q = s.slot_of[k] = std::uint32_t(s.texel.size());
+        s.texel.push_back(k);
+        s.sum_area.push_back(0.0);
+        s.owner_area.push_back(0.0);
+        s.sum_centroid.emplace_back(0.0);
+        s.owner_centroid.emplace_back(0.0);
+        s.owner.push_back(none);
       }
-      sum_area[q] += c.area;
-      sum_centroid[q] += c.area * c.centroid;
-      if (c.area > owner_area[q]) {
-        owner_area[q] = c.area;
-        owner[q] = std::uint32_t(i);
-        owner_centroid[q] = c.centroid;
+      s.sum_area[q] += c.area;
+      s.sum_centroid[q] += c.area * c.centroid;
+      if (c.area > s.owner_area[q]) {
+        s.owner_area[q] = c.area;
+        s.owner[q] = std::uint32_t(i);
+        s.owner_centroid[q] = c.centroid;
       }
     });
-  // Slots in texel order (the order of the samples downstream), and the map to them.
-  const std::size_t count = slot_texel.size();
+  return s;
+}
+
+// The slots in texel order (the order of the samples downstream), and the map to them.
+void sort_slots_by_texel(coverage_slots& s) {
+  const std::size_t count = s.texel.size();
   std::vector<std::uint32_t> order(count);
   for (std::size_t q = 0; q < count; ++q) order[q] = std::uint32_t(q);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return slot_texel[a] < slot_texel[b]; });
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return s.texel[a] < s.texel[b]; });
   const auto permute = [&](auto& v) {
     std::remove_reference_t<decltype(v)> out(count);
     for (std::size_t n = 0; n < count; ++n) out[n] = v[order[n]];
     v = std::move(out);
   };
-  permute(slot_texel);
-  permute(sum_area);
-  permute(owner_area);
-  permute(sum_centroid);
-  permute(owner_centroid);
-  permute(owner);
-  for (std::size_t n = 0; n < count; ++n) slot_of[slot_texel[n]] = std::uint32_t(n);
-  std::vector<glm::dvec2> centroid(count);
-  for (std::size_t n = 0; n < count; ++n) centroid[n] = sum_centroid[n] / sum_area[n];
-  std::vector<glm::dvec2>().swap(sum_centroid);
+  permute(s.texel);
+  permute(s.sum_area);
+  permute(s.owner_area);
+  permute(s.sum_centroid);
+  permute(s.owner_centroid);
+  permute(s.owner);
+  for (std::size_t n = 0; n < count; ++n) s.slot_of[s.texel[n]] = std::uint32_t(n);
+}
 
-  // Pass B: the triangle the combined centroid is mapped through: the owner if it contains it,
-  // else the covering triangle with the largest area that contains it (ties: lower index).
+// Each covered texel's combined centroid (the area-weighted mean of its clipped pieces); the
+// sums are released.
+std::vector<glm::dvec2> combined_centroids(coverage_slots& s) {
+  std::vector<glm::dvec2> centroid(s.texel.size());
+  for (std::size_t n = 0; n < centroid.size(); ++n) centroid[n] = s.sum_centroid[n] / s.sum_area[n];
+  std::vector<glm::dvec2>().swap(s.sum_centroid);
+  return centroid;
+}
+
+// Pass B: the triangle the combined centroid is mapped through: the owner if it contains it,
+// else the covering triangle with the largest area that contains it (ties: lower index); none
+// where no covering triangle contains it. The texel-to-slot map is released.
+std::vector<std::uint32_t> through_triangles(const std::vector<tri_data>& tris, int width, int height, coverage_slots& s,
+                                             const std::vector<glm::dvec2>& centroid) {
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
   const double eps = 1e-9;
-  std::vector<std::uint32_t> through(count, none);
-  std::vector<double> through_area(count, 0.0);
-  for (std::size_t i = 0; i < d.triangle_count; ++i)
+  std::vector<std::uint32_t> through(s.texel.size(), none);
+  std::vector<double> through_area(s.texel.size(), 0.0);
+  for (std::size_t i = 0; i < tris.size(); ++i)
     for_each_texel_in_bounds(tris[i], width, height, [&](int x, int y, std::size_t k) {
-      const std::uint32_t q = slot_of[k];
-      if (q == no_slot || through[q] == owner[q]) return;
+      const std::uint32_t q = s.slot_of[k];
+      if (q == coverage_slots::no_slot || through[q] == s.owner[q]) return;
       double b1, b2;
       if (!barycentric(tris[i].t, centroid[q], b1, b2) || b1 < -eps || b2 < -eps || b1 + b2 > 1.0 + eps) return;
       const clip_d c = clip_texel(tris[i].t, x, y);
       if (!(c.area > 0.0)) return;
-      if (std::uint32_t(i) == owner[q] || through[q] == none || c.area > through_area[q]) {
+      if (std::uint32_t(i) == s.owner[q] || through[q] == none || c.area > through_area[q]) {
         through[q] = std::uint32_t(i);
         through_area[q] = c.area;
       }
     });
-  std::vector<std::uint32_t>().swap(slot_of);
+  std::vector<std::uint32_t>().swap(s.slot_of);
+  return through;
+}
 
+// The sample of covered texel n: the point of triangle ti at texel-unit position q (clamped into
+// the triangle), its interpolated normal (or the face's), texel size and lightmap tangent frame.
+void set_sample(const bake_input& input, const tri_data& t, std::uint32_t ti, glm::dvec2 q, std::size_t n, sparse_samples& s) {
+  const scene_desc& d = input.scene;
+  double b1 = 0, b2 = 0;
+  barycentric(t.t, q, b1, b2);
+  // Clamp to the triangle (the point is inside up to rounding).
+  b1 = std::clamp(b1, 0.0, 1.0);
+  b2 = std::clamp(b2, 0.0, 1.0 - b1);
+  const double b0 = 1.0 - b1 - b2;
+  const std::uint32_t* idx = d.indices + 3 * std::size_t(ti);
+  const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
+  const glm::dvec3 face = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  glm::dvec3 nrm = face;
+  if (input.normals) {
+    const glm::dvec3 ni =
+        b0 * glm::dvec3(input.normals[idx[0]]) + b1 * glm::dvec3(input.normals[idx[1]]) + b2 * glm::dvec3(input.normals[idx[2]]);
+    const double len = glm::length(ni);
+    if (len > 1e-6) nrm = ni / len;
+  }
+  s.sample_triangle[n] = ti;
+  s.centroid[n] = glm::vec2(float(q.x / s.width), float(q.y / s.height));
+  s.position[n] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
+  s.normal[n] = glm::vec3(nrm);
+  s.texel_world_size[n] = float(std::sqrt(t.area3 / t.uv_area));
+  const glm::vec3 tp[3] = {d.positions[idx[0]], d.positions[idx[1]], d.positions[idx[2]]};
+  const glm::vec2 tuv[3] = {d.lightmap_uvs[idx[0]], d.lightmap_uvs[idx[1]], d.lightmap_uvs[idx[2]]};
+  const frame f = lightmap_tangent_frame(tp, tuv, s.normal[n]);
+  s.tangent[n] = f.t;
+  s.bitangent[n] = f.b;
+}
+
+// The samples of the covered texels: coverage, owner and, through each texel's triangle (the
+// owner's own centroid where the combined centroid lies on no covering triangle), its point.
+sparse_samples make_samples(const bake_input& input, const std::vector<tri_data>& tris, int width, int height,
+                            coverage_slots& slots, const std::vector<glm::dvec2>& centroid,
+                            const std::vector<std::uint32_t>& through) {
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+  const std::size_t count = slots.texel.size();
   sparse_samples s;
   s.width = width;
   s.height = height;
-  s.texel = std::move(slot_texel);
+  s.texel = std::move(slots.texel);
   s.coverage.resize(count);
-  s.owner = std::move(owner);
+  s.owner = std::move(slots.owner);
   s.sample_triangle.resize(count);
   s.centroid.resize(count);
   s.position.resize(count);
@@ -224,43 +283,31 @@ sparse_samples compute_sparse_samples(const bake_input& input, int width, int he
   s.tangent.resize(count);
   s.bitangent.resize(count);
   for (std::size_t n = 0; n < count; ++n) {
-    s.coverage[n] = float(std::min(1.0, sum_area[n]));
-    if (sum_area[n] > 1.001) ++s.overlapping_texels;
+    s.coverage[n] = float(std::min(1.0, slots.sum_area[n]));
+    if (slots.sum_area[n] > 1.001) ++s.overlapping_texels;
     std::uint32_t ti = through[n];
     glm::dvec2 q = centroid[n];
     if (ti == none) {  // the combined centroid lies on no covering triangle: the owner's own centroid
       ti = s.owner[n];
-      q = owner_centroid[n];
+      q = slots.owner_centroid[n];
     }
-    const tri_data& t = tris[ti];
-    double b1 = 0, b2 = 0;
-    barycentric(t.t, q, b1, b2);
-    // Clamp to the triangle (the point is inside up to rounding).
-    b1 = std::clamp(b1, 0.0, 1.0);
-    b2 = std::clamp(b2, 0.0, 1.0 - b1);
-    const double b0 = 1.0 - b1 - b2;
-    const std::uint32_t* idx = d.indices + 3 * std::size_t(ti);
-    const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
-    const glm::dvec3 face = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    glm::dvec3 nrm = face;
-    if (input.normals) {
-      const glm::dvec3 ni =
-          b0 * glm::dvec3(input.normals[idx[0]]) + b1 * glm::dvec3(input.normals[idx[1]]) + b2 * glm::dvec3(input.normals[idx[2]]);
-      const double len = glm::length(ni);
-      if (len > 1e-6) nrm = ni / len;
-    }
-    s.sample_triangle[n] = ti;
-    s.centroid[n] = glm::vec2(float(q.x / width), float(q.y / height));
-    s.position[n] = glm::vec3(b0 * p0 + b1 * p1 + b2 * p2);
-    s.normal[n] = glm::vec3(nrm);
-    s.texel_world_size[n] = float(std::sqrt(t.area3 / t.uv_area));
-    const glm::vec3 tp[3] = {d.positions[idx[0]], d.positions[idx[1]], d.positions[idx[2]]};
-    const glm::vec2 tuv[3] = {d.lightmap_uvs[idx[0]], d.lightmap_uvs[idx[1]], d.lightmap_uvs[idx[2]]};
-    const frame f = lightmap_tangent_frame(tp, tuv, s.normal[n]);
-    s.tangent[n] = f.t;
-    s.bitangent[n] = f.b;
+    set_sample(input, tris[ti], ti, q, n, s);
   }
   return s;
+}
+
+}  // namespace
+
+sparse_samples compute_sparse_samples(const bake_input& input, int width, int height) {
+  const char* who = "compute_lightmap_samples";
+  check_size(who, width, height);
+  check_input(who, input);
+  const std::vector<tri_data> tris = triangles_in_texels(who, input.scene, width, height);
+  coverage_slots slots = accumulate_coverage(who, tris, width, height);
+  sort_slots_by_texel(slots);
+  const std::vector<glm::dvec2> centroid = combined_centroids(slots);
+  const std::vector<std::uint32_t> through = through_triangles(tris, width, height, slots, centroid);
+  return make_samples(input, tris, width, height, slots, centroid, through);
 }
 
 }  // namespace bake_detail
