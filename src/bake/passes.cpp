@@ -201,60 +201,84 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
   return v;
 }
 
-}  // namespace
+// The bake's progress through the callback (if any): the cache's fraction can step back between
+// rounds; the bake reports the running maximum.
+class bake_progress {
+ public:
+  explicit bake_progress(const std::function<bool(float)>& callback) : callback_(callback) {}
+  explicit operator bool() const { return bool(callback_); }
+  // Reports min(f, 1) (or what was reported before, if more); false: the caller cancels.
+  bool operator()(float f) {
+    reported_ = std::max(reported_, std::min(f, 1.0f));
+    return callback_(reported_);
+  }
+  // Reports f, throwing error(cancelled) if the callback returns false (nothing if there is none).
+  void check(float f) {
+    if (callback_ && !(*this)(f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+  }
 
-bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
-                         const bake_layout& layout, std::chrono::steady_clock::time_point t0,
-                         std::vector<std::uint8_t>& filled) {
-  bake_result r;
-  r.stats.texels = std::size_t(layout.width) * std::size_t(layout.height);
-  r.stats.coverage_seconds = seconds_since(t0);
-  r.stats.overlapping_texels = s.overlapping_texels;
-  const sample_points pts = place_samples(s, *sc, o, layout, r);
+ private:
+  const std::function<bool(float)>& callback_;
+  float reported_ = 0.0f;
+};
+
+// Step 3b with its timing: the lights' values at every sample, or nothing without lights.
+direct_values lights_at_samples(const sample_points& pts, const scene& sc, const light_set& lights, const bake_options& o,
+                                bake_stats& stats) {
+  direct_values direct;
+  if (lights.empty()) return direct;
+  const auto td = std::chrono::steady_clock::now();
+  // The ray structure now, so that an Embree failure is an error here, not a slower fallback.
+  prepare_rays(sc);
+  std::function<bool()> keep_going;
+  if (o.progress) keep_going = [&] { return o.progress(0.0f); };
+  direct = direct_pass(pts, sc, lights, o, keep_going);
+  stats.direct_seconds = seconds_since(td);
+  return direct;
+}
+
+// How pass `pass`'s hemicubes are rendered and integrated (the radiance texture aside).
+// Directional integration only where its result is used: the last pass, and the first when the
+// indirect part is wanted (last minus first).
+hemicube_sampler_options pass_sampler_options(const bake_options& o, bool pass_directional) {
+  hemicube_sampler_options so;
+  so.resolution = o.resolution;
+  so.roll = true;
+  so.raster.sky = o.environment;
+  so.raster.edge_coverage = o.edge_coverage;
+  so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
+  so.hl2_cone = pass_directional && o.output_hl2;
+  return so;
+}
+
+// What the bounce passes leave: the last pass's values, the first's (with indirect_only), and
+// per sample whether every pass found it valid (outside geometry).
+struct bounce_values {
+  pass_values last, first;
+  std::vector<std::uint8_t> valid;
+};
+
+// Step 3 and 4: o.bounces passes, each through the cache (or a hemicube per sample) over the
+// radiance texture of the previous pass's values (pass 1: the scene's emission, or the layout's
+// emission images), plus the lights, with samples inside geometry filled from their chart.
+bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<const scene>& sc, const bake_options& o,
+                            const bake_layout& layout, const direct_values* direct, bake_progress& report, bake_stats& stats) {
   const std::size_t count = pts.texel_of.size();
-  s = sparse_samples{};  // what the passes need is in pts now
-
   const int workers = resolve_thread_count(o.thread_count);
   const bool directional = o.output_sh_l1 || o.output_hl2;
   cache_options co = o.cache;
   co.thread_count = o.thread_count;
   co.progress = nullptr;
-  std::vector<std::uint8_t> valid(count, 1);
+  bounce_values out;
+  out.valid.assign(count, 1);
   std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass
-  pass_values current, first;
-  const light_set lights(o.lights.data(), o.lights.size());
-  direct_values direct;
-  if (!lights.empty()) {
-    const auto td = std::chrono::steady_clock::now();
-    // The ray structure now, so that an Embree failure is an error here, not a slower fallback.
-    prepare_rays(*sc);
-    std::function<bool()> keep_going;
-    if (o.progress) keep_going = [&] { return o.progress(0.0f); };
-    direct = direct_pass(pts, *sc, lights, o, keep_going);
-    r.stats.direct_seconds = seconds_since(td);
-  }
+  pass_values& current = out.last;
   image texture;
   radiance_texture texture_view;
-
-  // The cache's fraction can step back between rounds; the bake reports the running maximum.
-  float reported = 0.0f;
-  const auto report = [&](float f) {
-    reported = std::max(reported, std::min(f, 1.0f));
-    return o.progress(reported);
-  };
   for (int pass = 0; pass < o.bounces; ++pass) {
-    if (o.progress && !report(float(pass) / float(o.bounces)))
-      throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
-    // Directional integration only where its result is used: the last pass, and the first
-    // when the indirect part is wanted (last minus first).
+    report.check(float(pass) / float(o.bounces));
     const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
-    hemicube_sampler_options so;
-    so.resolution = o.resolution;
-    so.roll = true;
-    so.raster.sky = o.environment;
-    so.raster.edge_coverage = o.edge_coverage;
-    so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
-    so.hl2_cone = pass_directional && o.output_hl2;
+    hemicube_sampler_options so = pass_sampler_options(o, pass_directional);
     if (pass > 0 || layout.textured_first_pass) {
       texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
       texture_view = radiance_texture(texture);
@@ -263,24 +287,41 @@ bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& s
     const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
     std::function<bool(float)> pass_progress;
-    if (o.progress) pass_progress = [&](float f) { return report(base + span * f); };
+    if (report) pass_progress = [&](float f) { return report(base + span * f); };
     // Points an earlier pass found inside geometry are inside in this one too (the geometry is
     // the same): the cache renders no hemicube for them.
     if (pass > 0) {
-      for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(valid[i] ? 0 : 1);
+      for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(out.valid[i] ? 0 : 1);
       co.known_inside = inside.data();
     }
-    current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, r.stats)
-                          : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, r.stats);
-    if (!lights.empty()) add_direct(direct, current);
+    current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, stats)
+                          : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, stats);
+    if (direct) add_direct(*direct, current);
     fill_invalid_samples(pts, current, layout);
-    for (std::size_t i = 0; i < count; ++i) valid[i] = std::uint8_t(valid[i] & (current.invalid[i] ? 0 : 1));
-    if (pass == 0 && o.indirect_only) first = current;
+    for (std::size_t i = 0; i < count; ++i) out.valid[i] = std::uint8_t(out.valid[i] & (current.invalid[i] ? 0 : 1));
+    if (pass == 0 && o.indirect_only) out.first = current;
   }
-  if (o.progress && !report(1.0f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
-  if (!lights.empty()) fill_direct_outputs(pts, valid, layout, direct);
-  write_outputs(pts, current, o.indirect_only ? &first : nullptr, lights.empty() ? nullptr : &direct, valid, o, layout, r,
-                filled);
+  return out;
+}
+
+}  // namespace
+
+bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
+                         const bake_layout& layout, std::chrono::steady_clock::time_point t0, std::vector<std::uint8_t>& filled) {
+  bake_result r;
+  r.stats.texels = std::size_t(layout.width) * std::size_t(layout.height);
+  r.stats.coverage_seconds = seconds_since(t0);
+  r.stats.overlapping_texels = s.overlapping_texels;
+  const sample_points pts = place_samples(s, *sc, o, layout, r);
+  s = sparse_samples{};  // what the passes need is in pts now
+  const light_set lights(o.lights.data(), o.lights.size());
+  direct_values direct = lights_at_samples(pts, *sc, lights, o, r.stats);
+  const direct_values* lit = lights.empty() ? nullptr : &direct;
+  bake_progress report(o.progress);
+  const bounce_values v = bounce_passes(pts, sc, o, layout, lit, report, r.stats);
+  report.check(1.0f);
+  if (lit) fill_direct_outputs(pts, v.valid, layout, direct);
+  write_outputs(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.valid, o, layout, r, filled);
   r.stats.seconds = seconds_since(t0);
   return r;
 }
