@@ -1,5 +1,8 @@
 // bake_scene (bake.hpp): several lightmap pages baked as one atlas (pages stacked with guard
-// rows, occluder-only meshes as 2 x 2 blocks of their material).
+// rows, occluder-only meshes as 2 x 2 blocks of their material), as a chain of named stages:
+//   check_scene_input -> make_scene_geometry -> make_scene_atlas -> combined_scene (atlas_uvs)
+//   -> atlas_samples (per page: page_triangles, compute_sparse_samples, append_page_samples)
+//   -> page_materials -> bake_samples -> crop_page per page
 #include "checks.hpp"
 #include "coverage.hpp"
 #include "pipeline.hpp"
@@ -187,16 +190,10 @@ scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) 
   return g;
 }
 
-}  // namespace
-
-}  // namespace bake_detail
-
-scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& o) {
-  using namespace bake_detail;
-  const char* who = "bake_scene";
-  const auto t0 = std::chrono::steady_clock::now();
+// A scene bake's input: the options (their size aside), each page's size and images, the
+// geometry (UVs finite only: the meshes' scale and offset map them into pages) and the sky.
+void check_scene_input(const char* who, const scene_bake_input& input, const bake_options& o) {
   check_options(o, who, false);
-  const scene_desc& d = input.geometry.scene;
   if (input.pages.empty()) throw_invalid_argument(std::string(who) + ": there are no pages (scene_bake_input::pages is empty)");
   for (std::size_t p = 0; p < input.pages.size(); ++p) {
     const lightmap_page& page = input.pages[p];
@@ -206,86 +203,64 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   }
   check_input(who, input.geometry, false);
   check_environment(who, o);
-  const scene_geometry g = make_scene_geometry(who, input);
+}
 
-  // The atlas, and the occluders' UVs at the centre of their material's block.
+// The atlas of the pages, its occluder blocks holding their materials.
+scene_atlas make_scene_atlas(const char* who, const scene_bake_input& input, const scene_geometry& g) {
   scene_atlas atlas = make_atlas(input.pages, g.occluder_materials.size());
   bake_layout& layout = atlas.layout;
   layout.who = who;
   layout.occluders_reflect = input.occluders == occluder_radiance::emission_plus_mean_bounce;
-  const std::size_t W = std::size_t(layout.width);
   for (std::size_t b = 0; b < g.occluder_materials.size(); ++b) {
     layout.occluders[b].emission = g.occluder_materials[b].emission;
     layout.occluders[b].albedo = g.occluder_materials[b].albedo;
   }
-  std::vector<glm::vec2> atlas_uvs(g.positions.size());
-  const std::size_t T = d.triangle_count;
-  for (std::size_t t = 0; t < T; ++t)
+  return atlas;
+}
+
+// Every vertex's lightmap UV in the atlas: its page UV in the page's rows, or, for occluders,
+// the centre of their material's block.
+std::vector<glm::vec2> atlas_uvs(const scene_bake_input& input, const scene_geometry& g, const scene_atlas& atlas) {
+  const bake_layout& layout = atlas.layout;
+  const std::size_t W = std::size_t(layout.width);
+  std::vector<glm::vec2> uvs(g.positions.size());
+  for (std::size_t t = 0; t < g.triangle_page.size(); ++t)
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t v = g.indices[3 * t + std::size_t(c)];
       const int p = g.triangle_page[t];
       if (p < 0) {
         const std::size_t k = layout.occluders[g.triangle_block[t]].texels[0];
-        atlas_uvs[v] = glm::vec2(float(double(k % W + 1) / double(W)), float(double(k / W + 1) / double(layout.height)));
+        uvs[v] = glm::vec2(float(double(k % W + 1) / double(W)), float(double(k / W + 1) / double(layout.height)));
       } else {
         const lightmap_page& page = input.pages[std::size_t(p)];
         const glm::vec2 q = g.page_uvs[v];
-        atlas_uvs[v] = glm::vec2(float(double(q.x) * page.width / double(W)),
-                                 float((double(q.y) * page.height + atlas.page_y[std::size_t(p)]) / double(layout.height)));
+        uvs[v] = glm::vec2(float(double(q.x) * page.width / double(W)),
+                           float((double(q.y) * page.height + atlas.page_y[std::size_t(p)]) / double(layout.height)));
       }
     }
+  return uvs;
+}
+
+// The scene the hemicubes see: the input's triangles and materials over the combined vertices,
+// with their atlas UVs.
+std::shared_ptr<const scene> combined_scene(const scene_desc& d, const scene_geometry& g, const std::vector<glm::vec2>& uvs) {
   scene_desc combined = d;
   combined.positions = g.positions.data();
   combined.vertex_count = g.positions.size();
   combined.indices = g.indices.data();
-  combined.lightmap_uvs = atlas_uvs.data();
-  const std::shared_ptr<const scene> sc = scene::create(combined);
+  combined.lightmap_uvs = uvs.data();
+  return scene::create(combined);
+}
 
-  // Step 1 per page, in the page's own texel grid (its UVs), merged into the atlas (pages in
-  // order: the atlas texel indices stay increasing).
-  sparse_samples s;
-  const std::size_t texels = W * std::size_t(layout.height);
-  constexpr std::uint32_t none = lightmap_samples::no_triangle;
-  s.width = layout.width;
-  s.height = layout.height;
-  std::vector<std::size_t> page_overlapping(input.pages.size(), 0);
-  for (std::size_t p = 0; p < input.pages.size(); ++p) {
-    const lightmap_page& page = input.pages[p];
-    // The page's triangles with compact vertex arrays.
-    std::vector<std::uint32_t> tris, remap(g.positions.size(), none), idx;
-    std::vector<glm::vec3> pos, nrm;
-    std::vector<glm::vec2> uvs;
-    std::vector<material> mats;
-    std::size_t mesh = 0;
-    for (std::size_t t = 0; t < T; ++t) {
-      if (g.triangle_page[t] != int(p)) continue;
-      while (t >= input.meshes[mesh].first_triangle + input.meshes[mesh].triangle_count) ++mesh;
-      const std::uint32_t* ti = g.indices.data() + 3 * t;
-      // A triangle with 3D area but none in the page (the test compute_lightmap_samples makes),
-      // named by its mesh.
-      const glm::dvec2 a = glm::dvec2(g.page_uvs[ti[0]]) * glm::dvec2(page.width, page.height);
-      const glm::dvec2 b = glm::dvec2(g.page_uvs[ti[1]]) * glm::dvec2(page.width, page.height);
-      const glm::dvec2 c = glm::dvec2(g.page_uvs[ti[2]]) * glm::dvec2(page.width, page.height);
-      const glm::dvec3 p0(g.positions[ti[0]]), p1(g.positions[ti[1]]), p2(g.positions[ti[2]]);
-      if (glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0 &&
-          !(0.5 * std::fabs(cross2(a, b, c)) > 1e-12 * double(page.width) * double(page.height)))
-        throw_invalid_argument(std::string(who) + ": meshes[" + std::to_string(mesh) + "] triangle " +
-                               std::to_string(t - input.meshes[mesh].first_triangle) + " (scene triangle " + std::to_string(t) +
-                               ") has zero area in its page's UV space (but not in 3D): it would get no texels");
-      tris.push_back(std::uint32_t(t));
-      mats.push_back(d.materials ? d.materials[t] : material{});
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = ti[k];
-        if (remap[v] == none) {
-          remap[v] = std::uint32_t(pos.size());
-          pos.push_back(g.positions[v]);
-          uvs.push_back(g.page_uvs[v]);
-          if (!g.normals.empty()) nrm.push_back(g.normals[v]);
-        }
-        idx.push_back(remap[v]);
-      }
-    }
-    if (tris.empty()) continue;  // an empty page: all dilation (nothing to fill from)
+// One page's triangles as a mesh of their own (compact vertex arrays, page UVs), with the scene
+// triangle of each.
+struct page_mesh {
+  std::vector<std::uint32_t> tris, idx;  // scene triangle of each; indices into the arrays below
+  std::vector<glm::vec3> pos, nrm;
+  std::vector<glm::vec2> uvs;
+  std::vector<material> mats;
+
+  bake_input input() const {
     bake_input sub;
     sub.scene.positions = pos.data();
     sub.scene.vertex_count = pos.size();
@@ -294,109 +269,197 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
     sub.scene.materials = mats.data();
     sub.scene.lightmap_uvs = uvs.data();
     sub.normals = nrm.empty() ? nullptr : nrm.data();
-    sparse_samples ps = compute_sparse_samples(sub, page.width, page.height);
-    page_overlapping[p] = ps.overlapping_texels;
-    s.overlapping_texels += ps.overlapping_texels;
-    const std::size_t y0 = std::size_t(atlas.page_y[p]);
-    if (s.size() == 0 && y0 == 0 && std::size_t(page.width) == W) {
-      // The first page at the atlas's origin with its width: its texel indices are the atlas's;
-      // taken over in place (no second copy of the samples at the peak).
-      sparse_samples moved = std::move(ps);
-      for (std::size_t n = 0; n < moved.size(); ++n) {
-        moved.owner[n] = tris[moved.owner[n]];
-        moved.sample_triangle[n] = moved.sample_triangle[n] == none ? none : tris[moved.sample_triangle[n]];
-        moved.centroid[n] = glm::vec2(float(double(moved.centroid[n].x) * page.width / double(W)),
-                                      float((double(moved.centroid[n].y) * page.height) / double(layout.height)));
+    return sub;
+  }
+};
+
+// Page p's triangles; a triangle with 3D area but none in the page (the test
+// compute_lightmap_samples makes) is refused, named by its mesh.
+page_mesh page_triangles(const char* who, const scene_bake_input& input, const scene_geometry& g, std::size_t p) {
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+  const lightmap_page& page = input.pages[p];
+  const scene_desc& d = input.geometry.scene;
+  page_mesh m;
+  std::vector<std::uint32_t> remap(g.positions.size(), none);
+  std::size_t mesh = 0;
+  for (std::size_t t = 0; t < d.triangle_count; ++t) {
+    if (g.triangle_page[t] != int(p)) continue;
+    while (t >= input.meshes[mesh].first_triangle + input.meshes[mesh].triangle_count) ++mesh;
+    const std::uint32_t* ti = g.indices.data() + 3 * t;
+    const glm::dvec2 a = glm::dvec2(g.page_uvs[ti[0]]) * glm::dvec2(page.width, page.height);
+    const glm::dvec2 b = glm::dvec2(g.page_uvs[ti[1]]) * glm::dvec2(page.width, page.height);
+    const glm::dvec2 c = glm::dvec2(g.page_uvs[ti[2]]) * glm::dvec2(page.width, page.height);
+    const glm::dvec3 p0(g.positions[ti[0]]), p1(g.positions[ti[1]]), p2(g.positions[ti[2]]);
+    if (glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0 &&
+        !(0.5 * std::fabs(cross2(a, b, c)) > 1e-12 * double(page.width) * double(page.height)))
+      throw_invalid_argument(std::string(who) + ": meshes[" + std::to_string(mesh) + "] triangle " +
+                             std::to_string(t - input.meshes[mesh].first_triangle) + " (scene triangle " + std::to_string(t) +
+                             ") has zero area in its page's UV space (but not in 3D): it would get no texels");
+    m.tris.push_back(std::uint32_t(t));
+    m.mats.push_back(d.materials ? d.materials[t] : material{});
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = ti[k];
+      if (remap[v] == none) {
+        remap[v] = std::uint32_t(m.pos.size());
+        m.pos.push_back(g.positions[v]);
+        m.uvs.push_back(g.page_uvs[v]);
+        if (!g.normals.empty()) m.nrm.push_back(g.normals[v]);
       }
-      moved.width = layout.width;
-      moved.height = layout.height;
-      s = std::move(moved);
-      continue;
-    }
-    for (std::size_t n = 0; n < ps.size(); ++n) {
-      const std::size_t j = ps.texel[n], x = j % std::size_t(page.width), y = j / std::size_t(page.width);
-      s.texel.push_back((y0 + y) * W + x);
-      s.coverage.push_back(ps.coverage[n]);
-      s.owner.push_back(tris[ps.owner[n]]);
-      s.sample_triangle.push_back(ps.sample_triangle[n] == none ? none : tris[ps.sample_triangle[n]]);
-      s.centroid.emplace_back(float(double(ps.centroid[n].x) * page.width / double(W)),
-                              float((double(ps.centroid[n].y) * page.height + double(y0)) / double(layout.height)));
-      s.position.push_back(ps.position[n]);
-      s.normal.push_back(ps.normal[n]);
-      s.texel_world_size.push_back(ps.texel_world_size[n]);
-      s.tangent.push_back(ps.tangent[n]);
-      s.bitangent.push_back(ps.bitangent[n]);
+      m.idx.push_back(remap[v]);
     }
   }
+  return m;
+}
 
-  // Per-texel materials where a page has images (the other pages: their owners' materials).
+// Appends a page's samples `ps` (its own texel grid and triangle numbers) to the atlas's `s`:
+// texels, centroids and triangles mapped into the atlas (the page's first row: y0).
+void append_page_samples(sparse_samples& s, sparse_samples&& ps, const std::vector<std::uint32_t>& tris,
+                         const lightmap_page& page, std::size_t y0, const bake_layout& layout) {
+  constexpr std::uint32_t none = lightmap_samples::no_triangle;
+  const std::size_t W = std::size_t(layout.width);
+  if (s.size() == 0 && y0 == 0 && std::size_t(page.width) == W) {
+    // The first page at the atlas's origin with its width: its texel indices are the atlas's;
+    // taken over in place (no second copy of the samples at the peak).
+    const std::size_t overlapping = s.overlapping_texels;
+    sparse_samples moved = std::move(ps);
+    for (std::size_t n = 0; n < moved.size(); ++n) {
+      moved.owner[n] = tris[moved.owner[n]];
+      moved.sample_triangle[n] = moved.sample_triangle[n] == none ? none : tris[moved.sample_triangle[n]];
+      moved.centroid[n] = glm::vec2(float(double(moved.centroid[n].x) * page.width / double(W)),
+                                    float((double(moved.centroid[n].y) * page.height) / double(layout.height)));
+    }
+    moved.width = layout.width;
+    moved.height = layout.height;
+    moved.overlapping_texels = overlapping;
+    s = std::move(moved);
+    return;
+  }
+  for (std::size_t n = 0; n < ps.size(); ++n) {
+    const std::size_t j = ps.texel[n], x = j % std::size_t(page.width), y = j / std::size_t(page.width);
+    s.texel.push_back((y0 + y) * W + x);
+    s.coverage.push_back(ps.coverage[n]);
+    s.owner.push_back(tris[ps.owner[n]]);
+    s.sample_triangle.push_back(ps.sample_triangle[n] == none ? none : tris[ps.sample_triangle[n]]);
+    s.centroid.emplace_back(float(double(ps.centroid[n].x) * page.width / double(W)),
+                            float((double(ps.centroid[n].y) * page.height + double(y0)) / double(layout.height)));
+    s.position.push_back(ps.position[n]);
+    s.normal.push_back(ps.normal[n]);
+    s.texel_world_size.push_back(ps.texel_world_size[n]);
+    s.tangent.push_back(ps.tangent[n]);
+    s.bitangent.push_back(ps.bitangent[n]);
+  }
+}
+
+// Step 1 per page, in the page's own texel grid (its UVs), merged into the atlas (pages in
+// order: the atlas texel indices stay increasing). page_overlapping receives each page's
+// overlapping texels.
+sparse_samples atlas_samples(const char* who, const scene_bake_input& input, const scene_geometry& g, const scene_atlas& atlas,
+                             std::vector<std::size_t>& page_overlapping) {
+  sparse_samples s;
+  s.width = atlas.layout.width;
+  s.height = atlas.layout.height;
+  page_overlapping.assign(input.pages.size(), 0);
+  for (std::size_t p = 0; p < input.pages.size(); ++p) {
+    const page_mesh m = page_triangles(who, input, g, p);
+    if (m.tris.empty()) continue;  // an empty page: all dilation (nothing to fill from)
+    sparse_samples ps = compute_sparse_samples(m.input(), input.pages[p].width, input.pages[p].height);
+    page_overlapping[p] = ps.overlapping_texels;
+    s.overlapping_texels += ps.overlapping_texels;
+    append_page_samples(s, std::move(ps), m.tris, input.pages[p], std::size_t(atlas.page_y[p]), atlas.layout);
+  }
+  return s;
+}
+
+// Per-texel materials where a page has images (the other pages: their owners' materials).
+void page_materials(const scene_bake_input& input, const scene_atlas& atlas, const sparse_samples& s, bake_layout& layout) {
+  const scene_desc& d = input.geometry.scene;
+  const std::size_t W = std::size_t(layout.width), texels = W * std::size_t(layout.height);
   const bool any_albedo = std::any_of(input.pages.begin(), input.pages.end(), [](const lightmap_page& p) { return p.albedo.width > 0; });
   const bool any_emission = std::any_of(input.pages.begin(), input.pages.end(), [](const lightmap_page& p) { return p.emission.width > 0; });
   if (any_albedo) layout.albedo.assign(texels, glm::vec3(0.0f));
   if (any_emission) layout.emission.assign(texels, glm::vec3(0.0f));
   layout.textured_first_pass = any_emission;
-  if (any_albedo || any_emission) {
-    // The page of every atlas row (-1: a guard or the occluders' blocks).
-    std::vector<int> row_page(std::size_t(layout.height), -1);
-    for (std::size_t p = 0; p < input.pages.size(); ++p)
-      for (int y = 0; y < input.pages[p].height; ++y) row_page[std::size_t(atlas.page_y[p] + y)] = int(p);
-    for (std::size_t n = 0; n < s.size(); ++n) {
-      const std::size_t k = s.texel[n];
-      const int p = row_page[k / W];
-      const lightmap_page& page = input.pages[std::size_t(p)];
-      const int x = int(k % W), y = int(k / W) - atlas.page_y[std::size_t(p)];
-      const material m = d.materials ? d.materials[s.owner[n]] : material{};
-      if (any_albedo)
-        layout.albedo[k] = page.albedo.width > 0 ? glm::vec3(page.albedo.at(x, y)[0], page.albedo.at(x, y)[1], page.albedo.at(x, y)[2])
-                                                 : m.albedo;
-      if (any_emission)
-        layout.emission[k] = page.emission.width > 0
-                                 ? glm::vec3(page.emission.at(x, y)[0], page.emission.at(x, y)[1], page.emission.at(x, y)[2])
-                                 : m.emission;
-    }
+  if (!any_albedo && !any_emission) return;
+  // The page of every atlas row (-1: a guard or the occluders' blocks).
+  std::vector<int> row_page(std::size_t(layout.height), -1);
+  for (std::size_t p = 0; p < input.pages.size(); ++p)
+    for (int y = 0; y < input.pages[p].height; ++y) row_page[std::size_t(atlas.page_y[p] + y)] = int(p);
+  for (std::size_t n = 0; n < s.size(); ++n) {
+    const std::size_t k = s.texel[n];
+    const int p = row_page[k / W];
+    const lightmap_page& page = input.pages[std::size_t(p)];
+    const int x = int(k % W), y = int(k / W) - atlas.page_y[std::size_t(p)];
+    const material m = d.materials ? d.materials[s.owner[n]] : material{};
+    if (any_albedo)
+      layout.albedo[k] = page.albedo.width > 0 ? glm::vec3(page.albedo.at(x, y)[0], page.albedo.at(x, y)[1], page.albedo.at(x, y)[2])
+                                               : m.albedo;
+    if (any_emission)
+      layout.emission[k] = page.emission.width > 0
+                               ? glm::vec3(page.emission.at(x, y)[0], page.emission.at(x, y)[1], page.emission.at(x, y)[2])
+                               : m.emission;
   }
+}
 
+// Page p's result: the atlas rows of the page (images, per-texel arrays) and its statistics.
+bake_result crop_page(const bake_result& all, const std::vector<std::uint8_t>& filled, const scene_atlas& atlas,
+                      const lightmap_page& page, std::size_t p, std::size_t overlapping) {
+  bake_result r;
+  const std::size_t W = std::size_t(atlas.layout.width);
+  const std::size_t y0 = std::size_t(atlas.page_y[p]), pw = std::size_t(page.width), ph = std::size_t(page.height);
+  const auto crop = [&](const image& img) {
+    if (img.width == 0) return image{};
+    image c = image::make(page.width, page.height, img.channels);
+    const std::size_t ch = std::size_t(img.channels);
+    for (std::size_t y = 0; y < ph; ++y)
+      std::memcpy(c.pixels.data() + y * pw * ch, img.pixels.data() + ((y0 + y) * W) * ch, pw * ch * sizeof(float));
+    return c;
+  };
+  const auto crop_bytes = [&](const auto& v) {
+    std::remove_cv_t<std::remove_reference_t<decltype(v)>> c(pw * ph);
+    for (std::size_t y = 0; y < ph; ++y)
+      std::copy_n(v.begin() + std::ptrdiff_t((y0 + y) * W), pw, c.begin() + std::ptrdiff_t(y * pw));
+    return c;
+  };
+  r.irradiance = crop(all.irradiance);
+  r.coverage = crop_bytes(all.coverage);
+  r.valid = crop_bytes(all.valid);
+  r.sampled = crop_bytes(all.sampled);
+  for (std::size_t j = 0; j < 4; ++j) r.sh_l1[j] = crop(all.sh_l1[j]);
+  for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = crop(all.hl2[j]);
+  r.shadow_mask = crop(all.shadow_mask);
+  const std::vector<std::uint8_t> page_filled = crop_bytes(filled);
+  r.stats.texels = pw * ph;
+  r.stats.overlapping_texels = overlapping;
+  for (std::size_t k = 0; k < pw * ph; ++k) {
+    if (r.coverage[k] > 0.0f) ++r.stats.covered_texels;
+    if (r.sampled[k]) ++r.stats.sampled_texels;
+    if (r.sampled[k] && !r.valid[k]) ++r.stats.invalid_texels;
+    if (!r.sampled[k] && page_filled[k]) ++r.stats.dilated_texels;
+  }
+  return r;
+}
+
+}  // namespace
+
+}  // namespace bake_detail
+
+scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& o) {
+  using namespace bake_detail;
+  const char* who = "bake_scene";
+  const auto t0 = std::chrono::steady_clock::now();
+  check_scene_input(who, input, o);
+  const scene_geometry g = make_scene_geometry(who, input);
+  scene_atlas atlas = make_scene_atlas(who, input, g);
+  const std::shared_ptr<const scene> sc = combined_scene(input.geometry.scene, g, atlas_uvs(input, g, atlas));
+  std::vector<std::size_t> page_overlapping;
+  sparse_samples s = atlas_samples(who, input, g, atlas, page_overlapping);
+  page_materials(input, atlas, s, atlas.layout);
   std::vector<std::uint8_t> filled;
-  bake_result all = bake_samples(std::move(s), sc, o, layout, t0, filled);
-
-  // Per page: the atlas rows of the page.
+  bake_result all = bake_samples(std::move(s), sc, o, atlas.layout, t0, filled);
   scene_bake_result out;
   out.pages.resize(input.pages.size());
-  for (std::size_t p = 0; p < input.pages.size(); ++p) {
-    const lightmap_page& page = input.pages[p];
-    bake_result& r = out.pages[p];
-    const std::size_t y0 = std::size_t(atlas.page_y[p]), pw = std::size_t(page.width), ph = std::size_t(page.height);
-    const auto crop = [&](const image& img) {
-      if (img.width == 0) return image{};
-      image c = image::make(page.width, page.height, img.channels);
-      const std::size_t ch = std::size_t(img.channels);
-      for (std::size_t y = 0; y < ph; ++y)
-        std::memcpy(c.pixels.data() + y * pw * ch, img.pixels.data() + ((y0 + y) * W) * ch, pw * ch * sizeof(float));
-      return c;
-    };
-    const auto crop_bytes = [&](const auto& v) {
-      std::remove_cv_t<std::remove_reference_t<decltype(v)>> c(pw * ph);
-      for (std::size_t y = 0; y < ph; ++y)
-        std::copy_n(v.begin() + std::ptrdiff_t((y0 + y) * W), pw, c.begin() + std::ptrdiff_t(y * pw));
-      return c;
-    };
-    r.irradiance = crop(all.irradiance);
-    r.coverage = crop_bytes(all.coverage);
-    r.valid = crop_bytes(all.valid);
-    r.sampled = crop_bytes(all.sampled);
-    for (std::size_t j = 0; j < 4; ++j) r.sh_l1[j] = crop(all.sh_l1[j]);
-    for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = crop(all.hl2[j]);
-    r.shadow_mask = crop(all.shadow_mask);
-    const std::vector<std::uint8_t> page_filled = crop_bytes(filled);
-    r.stats.texels = pw * ph;
-    r.stats.overlapping_texels = page_overlapping[p];
-    for (std::size_t k = 0; k < pw * ph; ++k) {
-      if (r.coverage[k] > 0.0f) ++r.stats.covered_texels;
-      if (r.sampled[k]) ++r.stats.sampled_texels;
-      if (r.sampled[k] && !r.valid[k]) ++r.stats.invalid_texels;
-      if (!r.sampled[k] && page_filled[k]) ++r.stats.dilated_texels;
-    }
-  }
+  for (std::size_t p = 0; p < input.pages.size(); ++p)
+    out.pages[p] = crop_page(all, filled, atlas, input.pages[p], p, page_overlapping[p]);
   out.stats = std::move(all.stats);
   out.stats.texels = 0;
   for (const bake_result& r : out.pages) out.stats.texels += r.stats.texels;
