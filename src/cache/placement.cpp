@@ -612,19 +612,32 @@ class placement {
   // the new radii.
   void limit_radii(std::size_t first_new) {
     if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return;
-    const float a = o_.error_threshold;
-    // The pairs of each new record i: the records j of every leaf of bvh_ (built over all records
-    // with the radii before this stage) whose box holds x_i, in record order, with their distance
-    // and whether their first-order predictions of each other disagree by more than a (neither
-    // depends on the radii, so both are found first, in parallel).
-    struct pair {
-      std::uint32_t j;
-      bool disagree;
-      float d;
-    };
-    const bool shrink = o_.shrink_disagreeing;
     bvh_.build(records_, o_, threads_);
-    std::vector<std::vector<pair>> candidates(records_.size() - first_new);
+    const std::vector<std::vector<neighbour_pair>> pairs = neighbour_pairs(first_new);
+    clamp_radii(first_new, pairs);
+    for (std::size_t j = 0; j < records_.size(); ++j)
+      if (radius_[j] != radius_of(j)) {
+        records_[j].radius = radius_[j];
+        lists_.set_radius(j, radius_[j]);
+      }
+  }
+
+  // A neighbour j of a new record (limit_radii): its distance and whether their first-order
+  // predictions of each other disagree by more than a.
+  struct neighbour_pair {
+    std::uint32_t j;
+    bool disagree;
+    float d;
+  };
+
+  // 5a. The pairs of each new record i: the records j of every leaf of bvh_ (built over all
+  // records with the radii before this stage) whose box holds x_i, in record order, with their
+  // distance and whether they disagree (neither depends on the radii, so both are found first, in
+  // parallel).
+  std::vector<std::vector<neighbour_pair>> neighbour_pairs(std::size_t first_new) const {
+    const float a = o_.error_threshold;
+    const bool shrink = o_.shrink_disagreeing;
+    std::vector<std::vector<neighbour_pair>> candidates(records_.size() - first_new);
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         const std::size_t i = first_new + k;
@@ -636,15 +649,15 @@ class placement {
         // the clamp R_j <= R_i + d is the stronger limit on R_j, and R_i is already inside the
         // gap); R_i only shrinks in the pass below, so that holds there too (1% margin for float
         // rounding). Only those pairs read the two records' models.
-        std::vector<pair>& near = candidates[k];
+        std::vector<neighbour_pair>& near = candidates[k];
         bvh_.query(mi.position, [&](const record_bvh::key& key) {
           if (std::size_t(key.index) == i) return;
           const float d = glm::length(mi.position - key.position);
           const bool moot = o_.neighbour_clamp && ri + d <= 0.99f * (0.4f * d / a);
           near.push_back({key.index, shrink && !moot && d > 0.0f && glm::dot(mi.normal, key.normal) > 0.9f, d});
         });
-        std::sort(near.begin(), near.end(), [](const pair& x, const pair& y) { return x.j < y.j; });
-        for (pair& q : near) {
+        std::sort(near.begin(), near.end(), [](const neighbour_pair& x, const neighbour_pair& y) { return x.j < y.j; });
+        for (neighbour_pair& q : near) {
           if (!q.disagree) continue;  // (holds "to be tested" until here)
           const linear_model& mj = models_[q.j];
           // Each record's first-order prediction of the other's irradiance (luminance).
@@ -656,7 +669,13 @@ class placement {
         }
       }
     });
-    // The sequential pass works on a compact copy of the radii (the lists' keys hold them).
+    return candidates;
+  }
+
+  // 5b. The sequential pass over the pairs, in record order, on a compact copy of the radii
+  // (radius_; the lists' keys hold the current ones).
+  void clamp_radii(std::size_t first_new, const std::vector<std::vector<neighbour_pair>>& candidates) {
+    const float a = o_.error_threshold;
     radius_.resize(records_.size());
     for (std::size_t j = 0; j < records_.size(); ++j) radius_[j] = radius_of(j);
     // At the finest spacing, neighbour clamping does not shrink older records (only the new ones,
@@ -665,7 +684,7 @@ class placement {
     const bool clamp_older = spacing_ > finest_;
     for (std::size_t i = first_new; i < records_.size(); ++i) {
       float& ri = radius_[i];
-      for (const pair& q : candidates[i - first_new]) {
+      for (const neighbour_pair& q : candidates[i - first_new]) {
         float& rj = radius_[q.j];
         const float d = q.d;
         if (o_.neighbour_clamp) {
@@ -680,24 +699,28 @@ class placement {
         }
       }
     }
-    for (std::size_t j = 0; j < records_.size(); ++j)
-      if (radius_[j] != radius_of(j)) {
-        records_[j].radius = radius_[j];
-        lists_.set_radius(j, radius_[j]);
-      }
   }
 
-  // 6. Points whose coverage this round's records can have changed (in a new record's sphere, or
-  // in the old sphere of a shrunk one, which holds its new one, or within nearby_opinion's reach
-  // of a new record) are re-checked in the next coverage pass; the new records join the lists of
-  // the points their spheres hold (after the limits: their final radii).
+  // 6. Points whose coverage this round's records can have changed are re-checked in the next
+  // coverage pass; the new records join the lists of the points their spheres hold (after the
+  // limits: their final radii) or the tree of large records.
   void mark_dirty(std::size_t first_new) {
+    mark_changed_points(first_new);
+    const std::vector<std::uint32_t> listed = split_listed_records(first_new);
+    list_records(listed);
+  }
+
+  // The reach within which record j's sphere holds a point (1e-4 wider: the weights measure
+  // distance with glm::length, the grid with a squared one).
+  float reach_of(std::size_t j) const { return o_.error_threshold * radius_of(j) * 1.0001f; }
+
+  // 6a. The changed points (in a new record's sphere, or in the old sphere of a shrunk one, which
+  // holds its new one, or within nearby_opinion's reach of a new record) become dirty. Each
+  // worker marks its own flags and lists what it marked (merged into dirty_list_ after: which
+  // points are dirty does not depend on which worker marked what), and counts each new record's
+  // points (listed_points_).
+  void mark_changed_points(std::size_t first_new) {
     const float a = o_.error_threshold;
-    // (1e-4 wider: the weights measure distance with glm::length, the grid with a squared one.)
-    const auto reach_of = [&](std::size_t j) { return a * radius_of(j) * 1.0001f; };
-    // a. Each worker marks its own flags and lists what it marked (merged into dirty_list_ after:
-    // which points are dirty does not depend on which worker marked what), and counts each new
-    // record's points.
     marks_.resize(std::size_t(threads_));
     for (worker_marks& m : marks_) m.flag.resize(count_, 0);
     listed_points_.resize(records_.size(), 0);
@@ -736,9 +759,13 @@ class placement {
       }
       m.list.clear();
     }
-    // b. Which new records are listed, in record order (deterministic): those of at most
-    // max_listed_points points while the lists' entries stay within the budget; the others are
-    // large and kept in a tree of their own (with the radii as they are now).
+  }
+
+  // 6b. Which new records are listed, in record order (deterministic): those of at most
+  // max_listed_points points while the lists' entries stay within the budget; the others are
+  // large and kept in a tree of their own (rebuilt here, with the radii as they are now).
+  // Returns the listed ones.
+  std::vector<std::uint32_t> split_listed_records(std::size_t first_new) {
     std::vector<std::uint32_t> listed;
     for (std::size_t j = first_new; j < records_.size(); ++j) {
       const bool is_listed = listed_points_[j] <= max_listed_points && listed_entries_ + listed_points_[j] <= list_budget_;
@@ -750,9 +777,13 @@ class placement {
       }
     }
     large_tree_.build(records_, o_, threads_, &large_records_);
-    // c. The listed records join the lists of their points: their (record, point) pairs found in
-    // parallel, then appended by the owner of each point (owners in parallel); in batches of at
-    // most about one pair per point, so the pairs in flight take no more memory than that.
+    return listed;
+  }
+
+  // 6c. The listed records join the lists of their points: their (record, point) pairs found in
+  // parallel, then appended by the owner of each point (owners in parallel); in batches of at
+  // most about one pair per point, so the pairs in flight take no more memory than that.
+  void list_records(const std::vector<std::uint32_t>& listed) {
     for (std::size_t first = 0; first < listed.size();) {
       std::size_t last = first, pairs = 0;
       while (last < listed.size() && (last == first || pairs + listed_points_[listed[last]] <= count_)) pairs += listed_points_[listed[last++]];
