@@ -109,11 +109,10 @@ struct scene_geometry {
 
 std::string uv_text(const glm::vec2& v) { return "(" + num(v.x) + ", " + num(v.y) + ")"; }
 
-// Checks the meshes (ranges, pages, scale/offset) and maps every vertex of every mesh to its
-// page, naming the mesh in every error.
-scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) {
-  const scene_desc& d = in.geometry.scene;
-  const std::size_t T = d.triangle_count;
+// Checks the meshes: each starts where the previous one ends, the meshes cover the scene's
+// triangles, pages are -1 or a page index, scale and offset are finite (naming the mesh).
+void check_meshes(const char* who, const scene_bake_input& in) {
+  const std::size_t T = in.geometry.scene.triangle_count;
   std::size_t next = 0;
   for (std::size_t m = 0; m < in.meshes.size(); ++m) {
     const bake_mesh& mesh = in.meshes[m];
@@ -137,7 +136,14 @@ scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) 
   if (next != T)
     throw_invalid_argument(std::string(who) + ": the meshes cover " + std::to_string(next) + " of the scene's " + std::to_string(T) +
                            " triangles: every triangle must belong to a mesh");
+}
 
+// Checks the meshes (check_meshes) and maps every vertex of every mesh to its page (uv_scale,
+// uv_offset; the result in [0, 1]), naming the mesh in every error.
+scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) {
+  check_meshes(who, in);
+  const scene_desc& d = in.geometry.scene;
+  const std::size_t T = d.triangle_count;
   scene_geometry g;
   constexpr std::uint32_t none = 0xffffffffu;
   // Meshes come in triangle order, so a vertex's copy for its latest user is all that is needed.
