@@ -1,6 +1,8 @@
 // The builds of the cache's search structures (record_index.hpp).
 #include "record_index.hpp"
 
+#include "weights.hpp"
+
 #include "hemilight/parallel.hpp"
 
 #include <algorithm>

@@ -4,8 +4,6 @@
 // placement's hot loops); the builds are in record_index.cpp.
 #pragma once
 
-#include "weights.hpp"
-
 #include "hemilight/cache.hpp"
 
 #include <algorithm>
