@@ -14,11 +14,11 @@
 // With cache_weight::ward_continuous each such record is weighted w_i - 1/a instead, which falls
 // to 0 at the edge of its reach (the coverage tests still use w_i).
 //
-// Radii: R_i = the hemicube's harmonic mean distance (split sphere), then, each switchable so its
-// effect can be measured: clamped to [min_radius, max_radius]; limited by the translation
-// gradient, R_i <= E_i / |g_t,i| (on luminance); neighbour clamping R_i <= R_j + |x_i - x_j|;
-// and shrinking of neighbours whose gradients disagree (each predicts the other's irradiance
-// worse than a allows), so that a record is placed between them.
+// Radii: R_i = the hemicube's harmonic mean distance (split sphere), clamped to [min_radius,
+// max_radius] and limited by (each a switch of cache_options): the translation gradient,
+// R_i <= E_i / |g_t,i| (on luminance); neighbour clamping R_i <= R_j + |x_i - x_j|; and
+// shrinking of neighbours whose gradients disagree (each predicts the other's irradiance worse
+// than a allows), so that a record is placed between them.
 //
 // Placement is deterministic: the same input gives bitwise the same output for any thread count.
 // It runs in rounds. Each round finds the points no record covers, picks among them, in a fixed
@@ -124,8 +124,7 @@ enum class cache_weight {
   /// as with `ward` (placement and statistics are identical), but a record's weight falls to 0 at
   /// the edge of its reach instead of jumping from 1/a to 0 there, so the interpolated irradiance
   /// is continuous where a record's reach ends. Ward's own weight (and its jump) remains inside
-  /// the coverage tests. docs/cache.md ("Measured"): Cornell box N = 512, a = 0.5, 1.16% -> 1.02%
-  /// RMS at the same 10.6% of the points; hexagon ceiling a = 0.5, 1.28% -> 1.03%.
+  /// the coverage tests. docs/cache.md gives its measured effect on the error.
   ward_continuous,  // last, so the earlier values stay as they were (and match the C ABI's numbering)
 };
 
@@ -160,8 +159,7 @@ struct cache_options {
   /// edge between two rows of points, E falling to 0 at an emitter's plane (a second derivative
   /// the gradient cannot see). Mostly hits records at min_radius, which cover their grid
   /// neighbours at exactly the threshold weight. Dimensionless, >= 0; 0 = off. Default 0.25
-  /// (docs/cache.md: Cornell box walls on a 128 x 128 grid, N = 256, a = 0.2: 7.6% -> 1.3% RMS
-  /// for 20% instead of 16% of the points).
+  /// (docs/cache.md: its error against the share of points given a hemicube).
   float second_opinion = 0.25f;
   /// Opinion of nearby records for points covered by a single record (other than its own point):
   /// such a point counts as uncovered while some record within nearby_opinion x a x min_radius of
@@ -169,18 +167,16 @@ struct cache_options {
   /// with a similar normal (n . n_j > 0.9) and not behind, predicts there (E_j plus its gradient
   /// terms, clamped at 0) a luminance that differs from the covering record's prediction by more
   /// than a x max(that prediction, 5% of the mean record E). The covering record's gradient cannot
-  /// see a hard shadow edge crossed between two rows of points (docs/cache.md: a floor point in a
-  /// block's umbra covered by a lit record one row away, 1059% error at N = 512); a record on the
-  /// other side of the edge can. Dimensionless, in [0, 16]; 0 = off. Default 2 (records one or
-  /// two rows of points away).
+  /// see a hard shadow edge crossed between two rows of points (a floor point in a block's umbra
+  /// covered by a lit record one row away); a record on the other side of the edge can.
+  /// Dimensionless, in [0, 16]; 0 = off. Default 2 (records one or two rows of points away).
   float nearby_opinion = 2.0f;
   /// A point covered by a single record (other than its own point) counts as covered only inside
   /// this fraction of that record's reach: Ward weight >= 1 / (sole_record_reach x a) (ignored with
   /// the Tabellion-Lamorlette weight). At the automatic min_radius = spacing / a the grid neighbours
   /// of a record at min_radius lie exactly on its reach (weight 1/a), where float rounding decided
-  /// whether that one record alone, with no second opinion, extrapolated to them (docs/cache.md: the
-  /// Cornell box wall tops at N = 512, 2.9% -> 0.8% RMS at a = 0.3). Points covered by two or more
-  /// records are unaffected. Dimensionless, in (0, 1]; 1 = off. Default 0.99.
+  /// whether that one record alone, with no second opinion, extrapolated to them. Points covered
+  /// by two or more records are unaffected. Dimensionless, in (0, 1]; 1 = off. Default 0.99.
   float sole_record_reach = 0.99f;
   cache_weight weight = cache_weight::ward;
   /// Second-order interpolation (needs use_gradients): after placement, each record gets a Hessian
@@ -189,11 +185,9 @@ struct cache_options {
   /// Placement and statistics are unchanged (the same records); only the final values differ.
   /// First-order predictions all miss a curved E the same way (below it where E is convex), so
   /// averaging them does not cancel that error. The term is clamped to +-a E_i per channel.
-  /// docs/cache.md ("Measured"): Cornell box N = 512, a = 0.5, 1.16% -> 0.82% RMS against a
-  /// hemicube at every point, at the same 10.65% of the points; hexagon ceiling 1.28% -> 0.62%;
-  /// lower RMS in every row measured (N = 64 to 1024). Off when use_gradients is off.
-  /// Cost: about 3 us per record once (0.1 s for 35,824 records on 2 cores), and 3 quadratic
-  /// forms per covering record and point.
+  /// docs/cache.md gives its measured effect on the error. Off when use_gradients is off.
+  /// Cost: O(records x neighbours) once after placement (a few microseconds per record), and 3
+  /// quadratic forms per covering record and point.
   bool second_order = true;
   float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
   /// Give the points that are not interpolated (inside geometry: cache_result::valid = 0) the

@@ -1,0 +1,95 @@
+// The baker's checks (checks.hpp).
+#include "checks.hpp"
+
+#include "hemilight/lights.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace hemilight::bake_detail {
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+void check_size(const char* who, int width, int height) {
+  if (width < 1 || width > max_lightmap_size || height < 1 || height > max_lightmap_size)
+    throw_invalid_argument(std::string(who) + ": lightmap size " + std::to_string(width) + " x " + std::to_string(height) +
+                           " is invalid: width and height must be in [1, " + std::to_string(max_lightmap_size) + "]");
+}
+
+void check_input(const char* who, const bake_input& in, bool uvs_in_unit_square) {
+  const scene_desc& d = in.scene;
+  if (d.triangle_count > 0 && !d.indices) throw_invalid_argument(std::string(who) + ": indices is null");
+  if (d.vertex_count > 0 && !d.positions) throw_invalid_argument(std::string(who) + ": positions is null");
+  if (!d.lightmap_uvs)
+    throw_invalid_argument(std::string(who) + ": the scene has no lightmap UVs (scene_desc::lightmap_uvs is null)");
+  // Albedo above 1 would make the bounces diverge (scene::create only rejects negative values).
+  if (d.materials)
+    for (std::size_t i = 0; i < d.triangle_count; ++i)
+      for (int c = 0; c < 3; ++c)
+        if (!(d.materials[i].albedo[c] >= 0.0f && d.materials[i].albedo[c] <= 1.0f))
+          throw_invalid_argument(std::string(who) + ": materials[" + std::to_string(i) + "].albedo = " +
+                                 num(d.materials[i].albedo[c]) + " is outside [0, 1]");
+  for (std::size_t i = 0; i < 3 * d.triangle_count; ++i)
+    if (d.indices[i] >= d.vertex_count)
+      throw_invalid_argument(std::string(who) + ": indices[" + std::to_string(i) + "] = " + std::to_string(d.indices[i]) +
+                             " is out of range: " + std::to_string(d.vertex_count) + " vertices");
+  for (std::size_t i = 0; i < d.vertex_count; ++i) {
+    const glm::vec2 uv = d.lightmap_uvs[i];
+    for (int c = 0; c < 2; ++c)
+      if (uvs_in_unit_square ? !(uv[c] >= 0.0f && uv[c] <= 1.0f) : !std::isfinite(uv[c]))
+        throw_invalid_argument(std::string(who) + ": lightmap_uvs[" + std::to_string(i) + "]." + (c ? "v" : "u") + " = " +
+                               num(uv[c]) + (uvs_in_unit_square ? " is outside [0, 1]" : " is not finite"));
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(d.positions[i][c]))
+        throw_invalid_argument(std::string(who) + ": positions[" + std::to_string(i) + "] is not finite");
+    if (in.normals)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(in.normals[i][c]))
+          throw_invalid_argument(std::string(who) + ": normals[" + std::to_string(i) + "] is not finite");
+  }
+}
+
+void check_options(const bake_options& o, const char* who, bool size) {
+  if (size) check_size(who, o.width, o.height);
+  if (!is_valid_hemicube_resolution(o.resolution))
+    throw_invalid_argument(std::string(who) + ": resolution " + std::to_string(o.resolution) +
+                           " is invalid: it must be even and in [2, 4096]");
+  if (o.bounces < 1 || o.bounces > 64)
+    throw_invalid_argument(std::string(who) + ": bounces " + std::to_string(o.bounces) + " is not in [1, 64]");
+  if (!(o.min_coverage >= 0.0f && o.min_coverage <= 1.0f))
+    throw_invalid_argument(std::string(who) + ": min_coverage " + num(o.min_coverage) + " is not in [0, 1]");
+  if (!(o.offset_texels >= 0.0f) || !std::isfinite(o.offset_texels))
+    throw_invalid_argument(std::string(who) + ": offset_texels " + num(o.offset_texels) + " must be finite and >= 0");
+  if (o.dilation < -1)
+    throw_invalid_argument(std::string(who) + ": dilation " + std::to_string(o.dilation) + " must be >= -1");
+  if (o.thread_count < 0)
+    throw_invalid_argument(std::string(who) + ": thread_count " + std::to_string(o.thread_count) + " must be >= 0");
+  validate_cache_options(o.cache, std::string(who) + ": cache");  // whatever use_cache says
+  try {
+    validate_lights(o.lights.data(), o.lights.size());
+    validate_direct_options(o.direct);
+  } catch (const error& e) {
+    throw_invalid_argument(std::string(who) + ": " + e.what());
+  }
+  for (std::size_t c = 0; c < o.shadow_mask_lights.size(); ++c) {
+    const int l = o.shadow_mask_lights[c];
+    if (l < -1 || (l >= 0 && std::size_t(l) >= o.lights.size()))
+      throw_invalid_argument(std::string(who) + ": shadow_mask_lights[" + std::to_string(c) + "] = " + std::to_string(l) +
+                             " is not -1 or a light index (there are " + std::to_string(o.lights.size()) + " lights)");
+  }
+}
+
+void check_environment(const char* who, const bake_options& o) {
+  if (!o.environment) return;
+  try {
+    o.environment->validate();
+  } catch (const error& e) {
+    throw_invalid_argument(std::string(who) + ": environment: " + e.what());
+  }
+}
+
+}  // namespace hemilight::bake_detail

@@ -1,0 +1,366 @@
+// The baker's passes (pipeline.hpp: steps 2-4 and the chain bake_samples) and bake_lightmap,
+// bake_radiance_texture (bake.hpp).
+#include "checks.hpp"
+#include "dilate.hpp"
+#include "pipeline.hpp"
+
+#include "hemilight/parallel.hpp"
+#include "hemilight/raster.hpp"
+#include "hemilight/rays.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace hemilight {
+
+namespace bake_detail {
+
+namespace {
+
+constexpr float pi_f = 3.14159265358979323846f;
+
+}  // namespace
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Step 2 of bake.hpp: the sampled texels, offset along their normals.
+sample_points place_samples(const sparse_samples& s, const scene& sc, const bake_options& o, const bake_layout& layout,
+                            bake_result& r) {
+  const std::size_t texels = std::size_t(layout.width) * std::size_t(layout.height);
+  const float min_offset = 2.0f * default_near_distance(sc);
+  sample_points out;
+  r.coverage.assign(texels, 0.0f);
+  r.sampled.assign(texels, 0);
+  for (std::size_t n = 0; n < s.size(); ++n) {
+    const std::size_t k = s.texel[n];
+    r.coverage[k] = s.coverage[n];
+    if (s.coverage[n] > 0.0f) ++r.stats.covered_texels;
+    if (s.sample_triangle[n] == lightmap_samples::no_triangle || !(s.coverage[n] >= o.min_coverage) || !(s.coverage[n] > 0.0f))
+      continue;
+    r.sampled[k] = 1;
+    out.texel_of.push_back(k);
+    const float offset = std::max(min_offset, o.offset_texels * s.texel_world_size[n]);
+    out.positions.push_back(s.position[n] + offset * s.normal[n]);
+    out.normals.push_back(s.normal[n]);
+    out.owner.push_back(s.owner[n]);
+    out.tangents.push_back(s.tangent[n]);
+    out.bitangents.push_back(s.bitangent[n]);
+  }
+  r.stats.sampled_texels = out.texel_of.size();
+  if (out.texel_of.empty())
+    throw_invalid_argument(std::string(layout.who) + ": no texel is covered by a triangle (coverage >= min_coverage): nothing to bake");
+  return out;
+}
+
+invalid_filler::invalid_filler(const sample_points& pts, const std::vector<std::uint8_t>& invalid, const bake_layout& layout)
+    : pts_(pts), invalid_(invalid), layout_(layout), filled_(std::size_t(layout.width) * std::size_t(layout.height), 0) {
+  for (std::size_t i = 0; i < invalid.size(); ++i) {
+    if (!invalid[i]) filled_[pts.texel_of[i]] = 1;
+    any_ = any_ || invalid[i];
+  }
+}
+
+void invalid_filler::operator()(std::vector<glm::vec3>& values) const {
+  if (!any_) return;
+  const std::size_t count = pts_.texel_of.size();
+  image tmp = image::make(layout_.width, layout_.height, 3);
+  for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * pts_.texel_of[i], &values[i], sizeof(glm::vec3));
+  std::vector<std::uint8_t> f = filled_;
+  dilate_masked(tmp, f, -1, layout_.blocked_mask());
+  for (std::size_t i = 0; i < count; ++i)
+    if (invalid_[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts_.texel_of[i], sizeof(glm::vec3));
+}
+
+
+namespace {
+
+// Samples inside geometry get the values of the valid texels around them (invalid_filler). Used
+// by both modes.
+void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_layout& layout) {
+  const invalid_filler fill(pts, v.invalid, layout);
+  if (!fill.needed()) return;
+  const std::size_t count = pts.texel_of.size();
+  fill(v.e);
+  for (auto& plane : v.sh)
+    if (!plane.empty()) fill(plane);
+  if (!v.cone.empty()) {
+    // Cone coefficients term by term (neighbours on a chart share the normal and so the
+    // reference tangent).
+    std::vector<glm::vec3> plane(count);
+    for (std::size_t t = 0; t < std::size_t(hl2_cone_terms); ++t) {
+      for (std::size_t i = 0; i < count; ++i) plane[i] = v.cone[i].coefficients[t];
+      fill(plane);
+      for (std::size_t i = 0; i < count; ++i) v.cone[i].coefficients[t] = plane[i];
+    }
+  }
+}
+
+// Step 4's radiance texture for pass k > 1: emission + albedo E_{k-1} / pi of each texel's owner
+// (or of the layout's per-texel images), dilated (at least 2 rings) so that hemicubes looking at
+// chart borders do not see black; then the occluder blocks and the guards. With e = null (pass 1
+// of a bake with emission images): the emission alone.
+image pass_radiance_texture(const scene& sc, const sample_points& pts, const std::vector<glm::vec3>* e, const bake_options& o,
+                            const bake_layout& layout) {
+  image texture = image::make(layout.width, layout.height, 3);
+  std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
+  for (std::size_t i = 0; i < pts.texel_of.size(); ++i) {
+    const std::size_t k = pts.texel_of[i];
+    const material& m = sc.triangle_material(pts.owner[i]);
+    const glm::vec3 emission = layout.emission.empty() ? m.emission : layout.emission[k];
+    const glm::vec3 albedo = layout.albedo.empty() ? m.albedo : layout.albedo[k];
+    const glm::vec3 l = e ? emission + albedo * (*e)[i] / pi_f : emission;
+    std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
+    filled[k] = 1;
+  }
+  dilate_masked(texture, filled, o.dilation < 0 ? -1 : std::max(o.dilation, 2), layout.blocked_mask());
+  if (!layout.occluders.empty()) {
+    // The occluders' coarse estimate: the mean irradiance of the samples of the previous pass.
+    glm::dvec3 sum(0.0);
+    if (e && layout.occluders_reflect)
+      for (const glm::vec3& v : *e) sum += glm::dvec3(v);
+    const glm::vec3 mean = pts.texel_of.empty() ? glm::vec3(0.0f) : glm::vec3(sum / double(pts.texel_of.size()));
+    for (const occluder_block& b : layout.occluders) {
+      const glm::vec3 l = b.emission + b.albedo * mean / pi_f;
+      for (std::size_t k : b.texels) std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
+    }
+  }
+  for (const auto& g : layout.guards)
+    std::memcpy(texture.pixels.data() + 3 * g.first, texture.pixels.data() + 3 * g.second, 3 * sizeof(float));
+  return texture;
+}
+
+// One pass through the cache (bake_options::use_cache).
+pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, cache_options co, bool directional,
+                        const std::function<bool(float)>& progress, bake_stats& stats) {
+  const std::size_t count = pts.texel_of.size();
+  co.directional = directional;
+  co.fill_invalid = false;  // fill_invalid_samples dilates valid texels into them instead
+  if (progress) co.progress = progress;
+  cache_result cr = cache_irradiance(pts.positions.data(), pts.normals.data(), count, sampler, co);
+  pass_values v;
+  v.e = std::move(cr.irradiance);
+  v.invalid.resize(count);
+  for (std::size_t i = 0; i < count; ++i) v.invalid[i] = cr.valid[i] ? 0 : 1;
+  if (directional) {
+    for (auto& plane : v.sh) plane.resize(count);
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = cr.sh_l1[i][c];
+    v.cone = std::move(cr.cone);
+  }
+  stats.hemicubes += cr.stats.hemicubes;
+  stats.records += cr.stats.records;
+  stats.passes.push_back(cr.stats);
+  return v;
+}
+
+// One pass with a hemicube at every sample (use_cache = false: the reference), in blocks so that
+// progress and cancellation stay live.
+pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& sampler, const bake_options& o,
+                           bool directional, const std::function<bool(float)>& progress, bake_stats& stats) {
+  const auto tp = std::chrono::steady_clock::now();
+  const std::size_t count = pts.texel_of.size();
+  pass_values v;
+  v.e.resize(count);
+  v.invalid.assign(count, 0);
+  if (directional) {
+    for (auto& plane : v.sh) plane.assign(count, glm::vec3(0.0f));
+    v.cone.assign(count, hl2_cone{});
+  }
+  const std::size_t block = 2048;
+  for (std::size_t b = 0; b < count; b += block) {
+    if (progress && !progress(float(b) / float(count)))
+      throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+    const std::size_t end = std::min(count, b + block);
+    parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
+      for (std::size_t i = b + lo; i < b + hi; ++i) {
+        const cache_sample smp = sampler(worker, pts.positions[i], pts.normals[i]);
+        v.e[i] = smp.irradiance;
+        v.invalid[i] = smp.backface_fraction > o.cache.invalid_backface_fraction ? 1 : 0;
+        if (directional) {
+          for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = smp.sh_l1[c];
+          v.cone[i] = rotate_hl2_cone(smp.cone, pts.normals[i], make_frame(pts.normals[i]).t);
+        }
+      }
+    });
+  }
+  std::size_t invalid = 0;
+  for (std::uint8_t f : v.invalid) invalid += f;
+  cache_stats cs;
+  cs.hemicubes = count;
+  cs.records = count;
+  cs.invalid_samples = invalid;
+  cs.invalid_points = invalid;
+  cs.seconds = seconds_since(tp);
+  stats.hemicubes += count;
+  stats.records += count;
+  stats.passes.push_back(cs);
+  return v;
+}
+
+// The bake's progress through the callback (if any): the cache's fraction can step back between
+// rounds; the bake reports the running maximum.
+class bake_progress {
+ public:
+  explicit bake_progress(const std::function<bool(float)>& callback) : callback_(callback) {}
+  explicit operator bool() const { return bool(callback_); }
+  // Reports min(f, 1) (or what was reported before, if more); false: the caller cancels.
+  bool operator()(float f) {
+    reported_ = std::max(reported_, std::min(f, 1.0f));
+    return callback_(reported_);
+  }
+  // Reports f, throwing error(cancelled) if the callback returns false (nothing if there is none).
+  void check(float f) {
+    if (callback_ && !(*this)(f)) throw error(status::cancelled, "bake_lightmap: cancelled by the progress callback");
+  }
+
+ private:
+  const std::function<bool(float)>& callback_;
+  float reported_ = 0.0f;
+};
+
+// Step 3b with its timing: the lights' values at every sample, or nothing without lights.
+direct_values lights_at_samples(const sample_points& pts, const scene& sc, const light_set& lights, const bake_options& o,
+                                bake_stats& stats) {
+  direct_values direct;
+  if (lights.empty()) return direct;
+  const auto td = std::chrono::steady_clock::now();
+  // The ray structure now, so that an Embree failure is an error here, not a slower fallback.
+  prepare_rays(sc);
+  std::function<bool()> keep_going;
+  if (o.progress) keep_going = [&] { return o.progress(0.0f); };
+  direct = direct_pass(pts, sc, lights, o, keep_going);
+  stats.direct_seconds = seconds_since(td);
+  return direct;
+}
+
+// How pass `pass`'s hemicubes are rendered and integrated (the radiance texture aside).
+// Directional integration only where its result is used: the last pass, and the first when the
+// indirect part is wanted (last minus first).
+hemicube_sampler_options pass_sampler_options(const bake_options& o, bool pass_directional) {
+  hemicube_sampler_options so;
+  so.resolution = o.resolution;
+  so.roll = true;
+  so.raster.sky = o.environment;
+  so.raster.edge_coverage = o.edge_coverage;
+  so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
+  so.hl2_cone = pass_directional && o.output_hl2;
+  return so;
+}
+
+// What the bounce passes leave: the last pass's values, the first's (with indirect_only), and
+// per sample whether every pass found it valid (outside geometry).
+struct bounce_values {
+  pass_values last, first;
+  std::vector<std::uint8_t> valid;
+};
+
+// Step 3 and 4: o.bounces passes, each through the cache (or a hemicube per sample) over the
+// radiance texture of the previous pass's values (pass 1: the scene's emission, or the layout's
+// emission images), plus the lights, with samples inside geometry filled from their chart.
+bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<const scene>& sc, const bake_options& o,
+                            const bake_layout& layout, const direct_values* direct, bake_progress& report, bake_stats& stats) {
+  const std::size_t count = pts.texel_of.size();
+  const int workers = resolve_thread_count(o.thread_count);
+  const bool directional = o.output_sh_l1 || o.output_hl2;
+  cache_options co = o.cache;
+  co.thread_count = o.thread_count;
+  co.progress = nullptr;
+  bounce_values out;
+  out.valid.assign(count, 1);
+  std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass
+  pass_values& current = out.last;
+  image texture;
+  radiance_texture texture_view;
+  for (int pass = 0; pass < o.bounces; ++pass) {
+    report.check(float(pass) / float(o.bounces));
+    const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
+    hemicube_sampler_options so = pass_sampler_options(o, pass_directional);
+    if (pass > 0 || layout.textured_first_pass) {
+      texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
+      texture_view = radiance_texture(texture);
+      so.texture = &texture_view;
+    }
+    const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
+    const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
+    std::function<bool(float)> pass_progress;
+    if (report) pass_progress = [&](float f) { return report(base + span * f); };
+    // Points an earlier pass found inside geometry are inside in this one too (the geometry is
+    // the same): the cache renders no hemicube for them.
+    if (pass > 0) {
+      for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(out.valid[i] ? 0 : 1);
+      co.known_inside = inside.data();
+    }
+    current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, stats)
+                          : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, stats);
+    if (direct) add_direct(*direct, current);
+    fill_invalid_samples(pts, current, layout);
+    for (std::size_t i = 0; i < count; ++i) out.valid[i] = std::uint8_t(out.valid[i] & (current.invalid[i] ? 0 : 1));
+    if (pass == 0 && o.indirect_only) out.first = current;
+  }
+  return out;
+}
+
+}  // namespace
+
+bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
+                         const bake_layout& layout, std::chrono::steady_clock::time_point t0, std::vector<std::uint8_t>& filled) {
+  bake_result r;
+  r.stats.texels = std::size_t(layout.width) * std::size_t(layout.height);
+  r.stats.coverage_seconds = seconds_since(t0);
+  r.stats.overlapping_texels = s.overlapping_texels;
+  const sample_points pts = place_samples(s, *sc, o, layout, r);
+  s = sparse_samples{};  // what the passes need is in pts now
+  const light_set lights(o.lights.data(), o.lights.size());
+  direct_values direct = lights_at_samples(pts, *sc, lights, o, r.stats);
+  const direct_values* lit = lights.empty() ? nullptr : &direct;
+  bake_progress report(o.progress);
+  const bounce_values v = bounce_passes(pts, sc, o, layout, lit, report, r.stats);
+  report.check(1.0f);
+  if (lit) fill_direct_outputs(pts, v.valid, layout, direct);
+  write_outputs(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.valid, o, layout, r, filled);
+  r.stats.seconds = seconds_since(t0);
+  return r;
+}
+
+}  // namespace bake_detail
+
+image bake_radiance_texture(const bake_input& input, const bake_options& o, const bake_result& r) {
+  if (o.indirect_only)
+    throw_invalid_argument("bake_radiance_texture: the bake is indirect_only: its irradiance lacks the first bounce");
+  if (r.irradiance.width != o.width || r.irradiance.height != o.height || r.sampled.size() != std::size_t(o.width) * std::size_t(o.height))
+    throw_invalid_argument("bake_radiance_texture: the result's size does not match options (" + std::to_string(o.width) + " x " +
+                           std::to_string(o.height) + ")");
+  const bake_detail::sparse_samples s = bake_detail::compute_sparse_samples(input, o.width, o.height);
+  image texture = image::make(o.width, o.height, 3);
+  std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
+  for (std::size_t n = 0; n < s.size(); ++n) {
+    const std::size_t k = s.texel[n];
+    if (!r.sampled[k]) continue;
+    const material m = input.scene.materials ? input.scene.materials[s.owner[n]] : material{};
+    const glm::vec3 e(r.irradiance.pixels[3 * k], r.irradiance.pixels[3 * k + 1], r.irradiance.pixels[3 * k + 2]);
+    const glm::vec3 l = m.emission + m.albedo * e / bake_detail::pi_f;
+    std::memcpy(texture.pixels.data() + 3 * k, &l, sizeof l);
+    filled[k] = 1;
+  }
+  dilate(texture, filled, o.dilation < 0 ? -1 : std::max(o.dilation, 2));
+  return texture;
+}
+
+bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  bake_detail::check_options(o);
+  bake_detail::check_input("bake_lightmap", input);
+  const std::shared_ptr<const scene> sc = scene::create(input.scene);
+  bake_detail::check_environment("bake_lightmap", o);
+  bake_detail::bake_layout layout;
+  layout.width = o.width;
+  layout.height = o.height;
+  std::vector<std::uint8_t> filled;
+  return bake_detail::bake_samples(bake_detail::compute_sparse_samples(input, o.width, o.height), sc, o, layout, t0, filled);
+}
+
+}  // namespace hemilight

@@ -1,0 +1,132 @@
+// Steps 2-6 of the baker (internal, not installed): the per-sample state of a bake and its
+// stages (bake.hpp, "pipeline"), shared by bake_lightmap and bake_scene:
+//   place_samples -> [direct_pass] -> { pass_radiance_texture -> cached_pass | per_texel_pass
+//   -> add_direct -> fill_invalid_samples }* -> fill_direct_outputs -> write_outputs
+// bake_samples runs the chain (passes.cpp); direct.cpp holds the lights' stages, outputs.cpp
+// the images.
+#pragma once
+
+#include "coverage.hpp"
+
+#include "hemilight/bake.hpp"
+#include "hemilight/lights.hpp"
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace hemilight::bake_detail {
+
+// The per-sample state of a bake (bake_lightmap's stages below), for sampled texels only.
+struct sample_points {
+  std::vector<std::size_t> texel_of;     // texel index of each sample
+  std::vector<glm::vec3> positions, normals;
+  std::vector<std::uint32_t> owner;      // the texel's owner triangle (its material)
+  std::vector<glm::vec3> tangents, bitangents;  // the texel's lightmap tangent frame (with normals)
+};
+
+// A 2 x 2 block of texels of a scene bake's atlas that holds the radiance of the occluder-only
+// triangles of one material (their UVs all point at the block's centre, where bilinear lookups
+// read only the block).
+struct occluder_block {
+  std::array<std::size_t, 4> texels{};
+  glm::vec3 emission{0.0f}, albedo{0.0f};
+};
+
+// Where the samples' values go: the texel grid of the bake (one lightmap, or the atlas of a scene
+// bake's pages) and what its radiance textures hold besides the sampled texels. A plain
+// bake_lightmap uses the grid alone (everything else empty: today's bake, bit for bit).
+struct bake_layout {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> blocked;  // per texel, 1: never filled by dilation (outside every page); empty: none
+  // (destination, source) texel pairs copied after dilation into radiance textures: the guard
+  // rows and columns around each page repeat its edge, so that bilinear lookups near a page's
+  // border read what clamp-to-edge would in a texture of its own.
+  std::vector<std::pair<std::size_t, std::size_t>> guards;
+  std::vector<glm::vec3> albedo, emission;  // per texel, or empty: the owner triangle's material
+  std::vector<occluder_block> occluders;
+  bool occluders_reflect = false;  // occluders add albedo x the mean irradiance / pi to their emission
+  bool textured_first_pass = false;  // pass 1 sees the emission through a texture (emission images)
+  const char* who = "bake_lightmap";
+
+  const std::uint8_t* blocked_mask() const { return blocked.empty() ? nullptr : blocked.data(); }
+};
+
+// L1 SH per sample, coefficient-major (sh[k][i]).
+using sh_planes = std::array<std::vector<glm::vec3>, 4>;
+
+// What one pass gives per sample.
+struct pass_values {
+  std::vector<glm::vec3> e;
+  sh_planes sh;                 // with directional outputs in this pass
+  std::vector<hl2_cone> cone;   // with output_hl2 in this pass (reference make_frame(normal).t)
+  std::vector<std::uint8_t> invalid;  // 1: the sample is inside geometry (filled, not computed)
+};
+
+// What the lights give per sample (step 3b), computed once: e and sh are added to every pass
+// before its invalid samples are filled; hl2 (in the texel's lightmap frame) and the shadow mask
+// are filled once after the passes and written with the outputs.
+struct direct_values {
+  std::vector<glm::vec3> e;
+  sh_planes sh;                                // with output_sh_l1
+  std::array<std::vector<glm::vec3>, 3> hl2;   // with output_hl2
+  std::array<std::vector<glm::vec3>, 2> mask;  // with a shadow mask: channels (0, 1, 2) and (3, -, -)
+};
+
+// Per-sample values at samples inside geometry (invalid[i] = 1) replaced by those of the valid
+// texels around them in the lightmap (texel dilation until every such texel is reached): the same
+// chart, so the same side of the same surface, never a record across a wall.
+class invalid_filler {
+ public:
+  invalid_filler(const sample_points& pts, const std::vector<std::uint8_t>& invalid, const bake_layout& layout);
+  bool needed() const { return any_; }
+  void operator()(std::vector<glm::vec3>& values) const;
+
+ private:
+  const sample_points& pts_;
+  const std::vector<std::uint8_t>& invalid_;
+  const bake_layout& layout_;
+  std::vector<std::uint8_t> filled_;
+  bool any_ = false;
+};
+
+// Wall time since t0, in seconds.
+double seconds_since(std::chrono::steady_clock::time_point t0);
+
+// Step 2: the sampled texels (coverage >= min_coverage), offset along their normals by
+// max(2 x the scene's near distance, offset_texels x texel size); fills r's coverage, sampled and
+// their statistics. Throws error(invalid_argument) when no texel is sampled.
+sample_points place_samples(const sparse_samples& s, const scene& sc, const bake_options& o, const bake_layout& layout,
+                            bake_result& r);
+
+// Step 3b: the lights' direct irradiance (and SH, HL2, shadow-mask visibility as the options ask)
+// at every sample; keep_going (may be empty) is polled between blocks (false: error(cancelled)).
+direct_values direct_pass(const sample_points& pts, const scene& sc, const light_set& lights, const bake_options& o,
+                          const std::function<bool()>& keep_going);
+
+// A pass's irradiance (and SH, where the pass computed it) plus the lights'.
+void add_direct(const direct_values& d, pass_values& v);
+
+// The lights' HL2 values and shadow mask at samples inside geometry (valid = 0 after all passes)
+// from the valid texels around them, as the passes' values are.
+void fill_direct_outputs(const sample_points& pts, const std::vector<std::uint8_t>& valid, const bake_layout& layout,
+                         direct_values& d);
+
+// Steps 5 and 6: the lightmap images from the last pass (less `first` with indirect_only), with
+// the lights' HL2 and shadow mask, dilated around every chart. `filled` receives the texels
+// written or dilated.
+void write_outputs(const sample_points& pts, const pass_values& last, const pass_values* first, const direct_values* direct,
+                   const std::vector<std::uint8_t>& valid, const bake_options& o, const bake_layout& layout, bake_result& r,
+                   std::vector<std::uint8_t>& filled);
+
+// Steps 2-6 of bake.hpp on the samples of a layout (one lightmap, or a scene bake's atlas):
+// the passes, the lights, the outputs. `filled` receives the texels written or dilated; t0 is
+// the start of the bake (its statistics' times). Cost: the passes' hemicubes dominate.
+bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
+                         const bake_layout& layout, std::chrono::steady_clock::time_point t0, std::vector<std::uint8_t>& filled);
+
+}  // namespace hemilight::bake_detail
