@@ -65,7 +65,7 @@ std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name,
       if (!std::isfinite(mesh.normals[i]))
         return name + ".normals[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
                std::to_string(mesh.normals[i]) + "; it must be finite";
-  // A triangle with 3D area but no UV area: the baker's own test (bake.cpp, make_tri), computed the
+  // A triangle with 3D area but no UV area: the baker's own test (src/bake/coverage.cpp, make_tri), computed the
   // same way, so that the message names the mesh and the triangle within it.
   for (std::size_t t = 0; t < mesh.triangle_count && !target.occluder(); ++t) {
     const std::uint32_t* idx = mesh.indices + 3 * t;

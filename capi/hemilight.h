@@ -62,7 +62,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 13
+#define HEMILIGHT_VERSION_MINOR 14
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {
@@ -407,11 +407,13 @@ typedef struct hemilight_cache_options {
                                      records and hemicubes, lower error (docs/cache.md) (default 1) */
   int reserved0;                  /* padding, not read: keeps edge_coverage past the earlier layout's
                                      sizeof on every ABI (its tail padding is not the caller's to fill) */
-  int edge_coverage;              /* since 0.14; 0 or 1: the hemicubes give a texel an edge crosses the
-                                     exact covered fraction of its weight instead of what its centre sees
-                                     (no edge aliasing: an emitter's irradiance to about 1e-4 where point
+  int edge_coverage;              /* since 0.14; 0 or 1: the hemicubes give a texel that a hard edge (a
+                                     boundary, a change of material, a silhouette) crosses the exact
+                                     covered fraction of its weight instead of what its centre sees (no
+                                     edge aliasing: an emitter's irradiance to about 1e-4 where point
                                      sampling is off by up to 18% at N = 16; docs/raster.md, "Exact edge
-                                     coverage"). Costs several times the render time (default 0) */
+                                     coverage"). Render time 1.5x on tessellated rooms to 15x on terrain
+                                     seen from itself at N = 64 (default 0) */
 } hemilight_cache_options;
 
 /* Fills the first struct_size bytes of options with the defaults above and sets

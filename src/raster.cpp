@@ -747,9 +747,7 @@ void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& posi
                              "; the frame must be orthonormal (tolerance 1e-3)");
   if (!(glm::dot(glm::cross(basis.t, basis.b), basis.n) > 0.0f))
     throw_invalid_argument(w + ": basis is left-handed ((t x b) . n < 0); it must be right-handed");
-  if (!is_valid_hemicube_resolution(resolution))
-    throw_invalid_argument(w + ": resolution " + std::to_string(resolution) +
-                           " is invalid: it must be even and in [2, 4096]");
+  check_hemicube_resolution(resolution, who);
 }
 
 void hemicube_rasterizer::prepare(int resolution) {

@@ -27,7 +27,7 @@ enum class table_kind : int {
   integration = 1,       ///< integration_table (integrate.hpp)
   sh9_texel = 2,         ///< the probes' SH9 texel weights (probes.cpp)
   cube_face = 3,         ///< cube-map face table (cubemap_internal.hpp)
-  cone_weights = 4,      ///< the cache's HL2 cone weights (cache.cpp)
+  cone_weights = 4,      ///< the cache's HL2 cone weights (src/directional/hl2_cone.cpp)
 };
 
 /// Untyped core of cached_table: the shared table of (kind, n), built by `build` if no live one

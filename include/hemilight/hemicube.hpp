@@ -42,9 +42,7 @@ struct hemicube_buffer {
   /// Sizes the arrays for resolution N (contents unspecified). Throws error(invalid_argument)
   /// for an invalid N.
   void resize(int n) {
-    if (!is_valid_hemicube_resolution(n))
-      throw_invalid_argument("hemicube_buffer::resize: resolution " + std::to_string(n) +
-                             " is invalid: it must be even and in [2, 4096]");
+    check_hemicube_resolution(n, "hemicube_buffer::resize");
     const std::size_t count = hemicube_texel_count(n);
     resolution = n;
     radiance.resize(3 * count);

@@ -55,9 +55,7 @@ void check_input(const char* who, const bake_input& in, bool uvs_in_unit_square)
 
 void check_options(const bake_options& o, const char* who, bool size) {
   if (size) check_size(who, o.width, o.height);
-  if (!is_valid_hemicube_resolution(o.resolution))
-    throw_invalid_argument(std::string(who) + ": resolution " + std::to_string(o.resolution) +
-                           " is invalid: it must be even and in [2, 4096]");
+  check_hemicube_resolution(o.resolution, who);
   if (o.bounces < 1 || o.bounces > 64)
     throw_invalid_argument(std::string(who) + ": bounces " + std::to_string(o.bounces) + " is not in [1, 64]");
   if (!(o.min_coverage >= 0.0f && o.min_coverage <= 1.0f))

@@ -29,9 +29,7 @@ void check_sampler_options(const std::shared_ptr<const scene>& s, const hemicube
 // each worker on its first call).
 void check_context_options(const std::shared_ptr<const scene>& s, const hemicube_sampler_options& o) {
   { hemicube_rasterizer check(s, o.raster); }
-  if (!is_valid_hemicube_resolution(o.resolution))
-    throw_invalid_argument("make_hemicube_sampler: resolution " + std::to_string(o.resolution) +
-                           " is invalid: it must be even and in [2, 4096]");
+  check_hemicube_resolution(o.resolution, "make_hemicube_sampler");
   if (!(o.integrate.min_wall_distance >= 0.0f) || !std::isfinite(o.integrate.min_wall_distance))  // as hemicube_integrator
     throw_invalid_argument("make_hemicube_sampler: integrate.min_wall_distance is " + std::to_string(o.integrate.min_wall_distance) +
                            "; it must be finite and >= 0 (0 = automatic)");
