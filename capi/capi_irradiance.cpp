@@ -95,16 +95,15 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     // The C++ rules (one statement of each), named from here: "hemilight_cache_irradiance:
     // options: min_radius is -1.000000; ...".
     hemilight::validate_cache_options(o, std::string(fn) + ": options");
-    // Step 2: the sampler and the cache. The points are checked by cache_irradiance
-    // (positions[i], normals[i]: the C arrays' names too); its message reaches the caller under
-    // this function's name (guarded, c_message).
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
+    const auto* p = reinterpret_cast<const glm::vec3*>(positions);
+    const auto* n = reinterpret_cast<const glm::vec3*>(normals);
+    hemilight::validate_cache_points(p, n, count, fn);  // "hemilight_cache_irradiance: positions[3] = ..."
+    // Step 2: the sampler and the cache.
     hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
     so.raster.sky = scene->sky;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
-    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be packed");
-    const auto* p = reinterpret_cast<const glm::vec3*>(positions);
-    const auto* n = reinterpret_cast<const glm::vec3*>(normals);
     hemilight::cache_result r = hemilight::cache_irradiance(p, n, count, sampler, o);
     // Step 3: the lights' direct part.
     if (scene->lights) add_direct_light(*scene, p, n, count, o.thread_count, r.irradiance);

@@ -64,12 +64,9 @@ hemilight_status to_lights(const char* function, const char* what, const hemilig
     l.casts_shadows = c.casts_shadows == 1;
   }
   try {
-    validate_lights(ls.data(), ls.size());
+    validate_lights(ls.data(), ls.size(), what);  // names the C array: "what[2].spot_outer = ..."
   } catch (const error& e) {
-    // "lights[2].spot_outer = ..." -> "function: what[2].spot_outer = ..."
-    std::string m = e.what();
-    if (m.compare(0, 6, "lights") == 0) m = what + m.substr(6);
-    return set_error(to_c(e.code()), std::string(function) + ": " + m);
+    return set_error(to_c(e.code()), std::string(function) + ": " + e.what());
   }
   out = std::move(ls);
   return HEMILIGHT_OK;

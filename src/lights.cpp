@@ -30,7 +30,9 @@ std::string number(float v) {
   return buf;
 }
 
-std::string field(std::size_t i, const char* name) { return "lights[" + std::to_string(i) + "]." + name; }
+std::string field(const char* array, std::size_t i, const char* name) {
+  return std::string(array) + "[" + std::to_string(i) + "]." + name;
+}
 
 // v scaled by its largest |component| first, then normalised: works for subnormal and huge
 // finite vectors alike. Returns 0 for a zero vector.
@@ -41,14 +43,14 @@ glm::vec3 normalize_robust(const glm::vec3& v) noexcept {
   return s / std::sqrt(glm::dot(s, s));
 }
 
-void check_finite(std::size_t i, const char* name, float v) {
-  if (!std::isfinite(v)) throw_invalid_argument(field(i, name) + " is " + (std::isnan(v) ? "nan" : number(v)));
+void check_finite(const char* array, std::size_t i, const char* name, float v) {
+  if (!std::isfinite(v)) throw_invalid_argument(field(array, i, name) + " is " + (std::isnan(v) ? "nan" : number(v)));
 }
 
-void check_finite(std::size_t i, const char* name, const glm::vec3& v, const char* axes) {
+void check_finite(const char* array, std::size_t i, const char* name, const glm::vec3& v, const char* axes) {
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(v[c]))
-      throw_invalid_argument(field(i, name) + "." + axes[c] + " is " + (std::isnan(v[c]) ? "nan" : number(v[c])));
+      throw_invalid_argument(field(array, i, name) + "." + axes[c] + " is " + (std::isnan(v[c]) ? "nan" : number(v[c])));
 }
 
 // The cone of directions of half-angle a (sin^2 a = sin2a) around an axis at angle theta from the
@@ -343,54 +345,54 @@ light_geometry closed_form(const light_set::prepared& L, const glm::vec3& p, con
 
 // ---- validation ---------------------------------------------------------------------------------
 
-void validate_lights(const light* lights, std::size_t count) {
-  if (count > 0 && !lights) throw_invalid_argument("lights is null but count is " + std::to_string(count));
+void validate_lights(const light* lights, std::size_t count, const char* array) {
+  if (count > 0 && !lights) throw_invalid_argument(std::string(array) + " is null but count is " + std::to_string(count));
   for (std::size_t i = 0; i < count; ++i) {
     const light& l = lights[i];
     const int type = static_cast<int>(l.type);
-    if (type < 0 || type > 3) throw_invalid_argument(field(i, "type") + " = " + std::to_string(type) + " is unknown");
-    check_finite(i, "color", l.color, "rgb");
-    check_finite(i, "position", l.position, "xyz");
+    if (type < 0 || type > 3) throw_invalid_argument(field(array, i, "type") + " = " + std::to_string(type) + " is unknown");
+    check_finite(array, i, "color", l.color, "rgb");
+    check_finite(array, i, "position", l.position, "xyz");
     for (int c = 0; c < 3; ++c)
       if (std::fabs(l.position[c]) > max_coordinate)
-        throw_invalid_argument(field(i, "position") + "." + "xyz"[c] + " = " + number(l.position[c]) +
+        throw_invalid_argument(field(array, i, "position") + "." + "xyz"[c] + " = " + number(l.position[c]) +
                                " is beyond 1e18 (max_coordinate)");
-    check_finite(i, "direction", l.direction, "xyz");
-    check_finite(i, "tangent", l.tangent, "xyz");
-    check_finite(i, "width", l.width);
-    check_finite(i, "height", l.height);
-    check_finite(i, "radius", l.radius);
-    check_finite(i, "spot_inner", l.spot_inner);
-    check_finite(i, "spot_outer", l.spot_outer);
+    check_finite(array, i, "direction", l.direction, "xyz");
+    check_finite(array, i, "tangent", l.tangent, "xyz");
+    check_finite(array, i, "width", l.width);
+    check_finite(array, i, "height", l.height);
+    check_finite(array, i, "radius", l.radius);
+    check_finite(array, i, "spot_inner", l.spot_inner);
+    check_finite(array, i, "spot_outer", l.spot_outer);
     for (int c = 0; c < 3; ++c)
       if (l.color[c] < 0.0f)
-        throw_invalid_argument(field(i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) + " is negative");
+        throw_invalid_argument(field(array, i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) + " is negative");
       else if (l.color[c] > max_radiance)
-        throw_invalid_argument(field(i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) +
+        throw_invalid_argument(field(array, i, "color") + "." + "rgb"[c] + " = " + number(l.color[c]) +
                                " is over 1e30 (max_radiance: sums of it must stay finite)");
     if (l.type != light_type::point && normalize_robust(l.direction) == glm::vec3(0.0f))
-      throw_invalid_argument(field(i, "direction") + " is zero");
+      throw_invalid_argument(field(array, i, "direction") + " is zero");
     if (l.type != light_type::rect && l.radius < 0.0f)
-      throw_invalid_argument(field(i, "radius") + " = " + number(l.radius) + " is negative");
+      throw_invalid_argument(field(array, i, "radius") + " = " + number(l.radius) + " is negative");
     if (l.type == light_type::directional && l.radius > half_pi_f)
-      throw_invalid_argument(field(i, "radius") + " = " + number(l.radius) + " is past pi/2");
+      throw_invalid_argument(field(array, i, "radius") + " = " + number(l.radius) + " is past pi/2");
     if (l.type == light_type::spot) {
       if (l.spot_inner < 0.0f)
-        throw_invalid_argument(field(i, "spot_inner") + " = " + number(l.spot_inner) + " is negative");
+        throw_invalid_argument(field(array, i, "spot_inner") + " = " + number(l.spot_inner) + " is negative");
       if (l.spot_outer > half_pi_f)
-        throw_invalid_argument(field(i, "spot_outer") + " = " + number(l.spot_outer) + " is past pi/2");
+        throw_invalid_argument(field(array, i, "spot_outer") + " = " + number(l.spot_outer) + " is past pi/2");
       if (l.spot_inner > l.spot_outer)
-        throw_invalid_argument(field(i, "spot_inner") + " = " + number(l.spot_inner) + " is greater than spot_outer = " +
+        throw_invalid_argument(field(array, i, "spot_inner") + " = " + number(l.spot_inner) + " is greater than spot_outer = " +
                                number(l.spot_outer));
     }
     if (l.type == light_type::rect) {
-      if (!(l.width > 0.0f)) throw_invalid_argument(field(i, "width") + " = " + number(l.width) + " is not positive");
-      if (!(l.height > 0.0f)) throw_invalid_argument(field(i, "height") + " = " + number(l.height) + " is not positive");
+      if (!(l.width > 0.0f)) throw_invalid_argument(field(array, i, "width") + " = " + number(l.width) + " is not positive");
+      if (!(l.height > 0.0f)) throw_invalid_argument(field(array, i, "height") + " = " + number(l.height) + " is not positive");
       const glm::vec3 t = normalize_robust(l.tangent), nl = normalize_robust(l.direction);
-      if (t == glm::vec3(0.0f)) throw_invalid_argument(field(i, "tangent") + " is zero");
+      if (t == glm::vec3(0.0f)) throw_invalid_argument(field(array, i, "tangent") + " is zero");
       // |t x n| = sin of the angle between them: within 1e-3 rad of parallel is rejected.
       if (glm::length(glm::cross(t, nl)) < 1e-3f)
-        throw_invalid_argument(field(i, "tangent") + " is parallel to direction (the rect's normal)");
+        throw_invalid_argument(field(array, i, "tangent") + " is parallel to direction (the rect's normal)");
     }
   }
 }

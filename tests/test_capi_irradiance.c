@@ -146,7 +146,7 @@ static void test_cache(void) {
   CHECK_FAILS(hemilight_cache_irradiance(NULL, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, NULL, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "options is NULL");
   nrm[5] = 3.0f;
-  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "normals[1]");
+  CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_cache_irradiance: normals[1] = ");
   nrm[5] = 1.0f;
   o.error_threshold = 0.0f;
   CHECK_FAILS(hemilight_cache_irradiance(empty, pos, nrm, count, &o, out, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "error_threshold");
@@ -447,7 +447,7 @@ static void test_lights(void) {
   hemilight_light_init(&l[0], HEMILIGHT_LIGHT_POINT);
   hemilight_light_init(&l[1], HEMILIGHT_LIGHT_SPOT);
   l[1].position[1] = NAN;
-  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights[1].position.y is nan");
+  CHECK_FAILS(hemilight_scene_with_lights(empty, l, 2, &lit2), HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_scene_with_lights: lights[1].position.y is nan");
   l[1].position[1] = 0.0f;
   l[1].spot_inner = 0.5f;
   l[1].spot_outer = 0.4f;

@@ -331,6 +331,13 @@ struct cache_result {
 /// "bake_lightmap: error_threshold is nan; ..."). Bakes call it whatever use_cache says. Cost: O(1).
 void validate_cache_options(const cache_options& options, const std::string& who);
 
+/// Checks the points as cache_irradiance does and throws error(invalid_argument) for the first bad
+/// one, the message starting with `who` and naming the array and index ("who: positions[3] =
+/// (nan, 0, 0) is not finite or beyond 1e18", "normals[5] ... must be a unit vector"): count 0, a
+/// null array, a position not finite or beyond max_coordinate, a normal whose length is not within
+/// 1e-3 of 1, points spanning more than max_point_extent. Cost: O(count).
+void validate_cache_points(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const std::string& who);
+
 /// Largest extent (bounding-box diagonal, scene units) of the points cache_irradiance takes: the
 /// cache squares distances between points in float.
 inline constexpr double max_point_extent = 1e18;

@@ -109,8 +109,9 @@ struct light {
 ///   radius past pi/2; spot_inner < 0, spot_inner > spot_outer, spot_outer past pi/2; rect
 ///   width or height <= 0, a zero tangent, or a tangent within 1e-3 rad of parallel to the
 ///   normal. Direction lengths are judged after scaling by the largest |component|, so tiny
-///   (even subnormal) and huge finite vectors are fine. Cost: O(count).
-void validate_lights(const light* lights, std::size_t count);
+///   (even subnormal) and huge finite vectors are fine. `array`: the name the message gives the
+///   array (a caller's own, e.g. "options->lights"). Cost: O(count).
+void validate_lights(const light* lights, std::size_t count, const char* array = "lights");
 
 /// Options of direct_irradiance. The defaults are what bakes use.
 struct direct_options {

@@ -35,7 +35,14 @@ void validate_cache_options(const cache_options& o, const std::string& who) {
 namespace cache_detail {
 
 void validate_cache_input(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const cache_options& o) {
-  const std::string fn = "cache_irradiance: ";
+  validate_cache_points(positions, normals, count, "cache_irradiance");
+  validate_cache_options(o, "cache_irradiance");
+}
+
+}  // namespace cache_detail
+
+void validate_cache_points(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const std::string& who) {
+  const std::string fn = who + ": ";
   if (count == 0) throw_invalid_argument(fn + "count is 0: there are no points");
   if (!positions) throw_invalid_argument(fn + "positions is NULL");
   if (!normals) throw_invalid_argument(fn + "normals is NULL");
@@ -43,12 +50,12 @@ void validate_cache_input(const glm::vec3* positions, const glm::vec3* normals, 
   for (std::size_t i = 0; i < count; ++i) {
     const glm::vec3 &p = positions[i], &n = normals[i];
     if (!(std::fabs(p.x) <= max_coordinate && std::fabs(p.y) <= max_coordinate && std::fabs(p.z) <= max_coordinate))
-      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + vec_str(p) + " is not finite or beyond 1e18");
+      throw_invalid_argument(fn + "positions[" + std::to_string(i) + "] = " + cache_detail::vec_str(p) + " is not finite or beyond 1e18");
     lo = glm::min(lo, glm::dvec3(p));
     hi = glm::max(hi, glm::dvec3(p));
     const float len = glm::length(n);
     if (!(std::fabs(len - 1.0f) <= 1e-3f))
-      throw_invalid_argument(fn + "normals[" + std::to_string(i) + "] = " + vec_str(n) + " has length " +
+      throw_invalid_argument(fn + "normals[" + std::to_string(i) + "] = " + cache_detail::vec_str(n) + " has length " +
                              std::to_string(len) + "; it must be a unit vector");
   }
   // Distances between points are squared in float (weights, grids): the extent must keep them finite.
@@ -56,9 +63,6 @@ void validate_cache_input(const glm::vec3* positions, const glm::vec3* normals, 
   if (diagonal > max_point_extent)
     throw_invalid_argument(fn + "the points span " + std::to_string(diagonal) + " units (bounding-box diagonal); at most " +
                            std::to_string(max_point_extent) + " is supported (squared distances must fit in float)");
-  validate_cache_options(o, "cache_irradiance");
 }
-
-}  // namespace cache_detail
 
 }  // namespace hemilight
