@@ -50,6 +50,7 @@
 // relative error (luminance; relative to max(E_ref, 5% of the mean E_ref), so umbra points do not
 // divide by ~0) against both references, wall time, and the 1-minute load average at the start of
 // the run (the machine may be shared: times are indicative).
+#include "bench_util.hpp"
 #include "hemilight/cache.hpp"
 #include "hemilight/parallel.hpp"
 #include "hemilight/reference_scenes.hpp"
@@ -76,31 +77,14 @@ struct point_set {
   std::vector<glm::vec3> p, n;
 };
 
-// Grid of k x k points on the parallelogram o + s u + t v (s, t in (0, 1)), normal n, offset 1 mm
-// along n so the points sit just off their surface.
+// k x k points on the parallelogram o + s u + t v, normal n (bench::grid_points).
 void grid(point_set& ps, glm::vec3 o, glm::vec3 u, glm::vec3 v, glm::vec3 n, int k) {
-  for (int j = 0; j < k; ++j)
-    for (int i = 0; i < k; ++i) {
-      const float s = (float(i) + 0.5f) / float(k), t = (float(j) + 0.5f) / float(k);
-      ps.p.push_back(o + s * u + t * v + 1e-3f * n);
-      ps.n.push_back(n);
-    }
+  bench::grid_points(ps.p, ps.n, o, u, v, n, k);
 }
 
-float lum(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double loadavg() {
-  double l = -1.0;
-  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf", &l) != 1) l = -1.0;
-    std::fclose(f);
-  }
-  return l;
-}
+using bench::lum;
+using bench::loadavg;
+using bench::seconds_since;
 
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
@@ -110,16 +94,7 @@ double loadavg() {
   std::exit(2);
 }
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t b = 0;
-  while (b <= s.size()) {
-    const std::size_t e = std::min(s.find(',', b), s.size());
-    if (e > b) out.push_back(s.substr(b, e - b));
-    b = e + 1;
-  }
-  return out;
-}
+using bench::split;
 
 int to_int(const std::string& s, const char* what) {
   char* end = nullptr;
@@ -302,11 +277,7 @@ int main(int argc, char** argv) {
     if (key == "cornell") {
       ps.name = "cornell box";
       ps.mesh = cornell_box();
-      const float W = 0.556f, H = 0.5488f, D = 0.5592f;
-      grid(ps, {0, 0, 0}, {W, 0, 0}, {0, 0, D}, {0, 1, 0}, k);   // floor
-      grid(ps, {0, 0, D}, {W, 0, 0}, {0, H, 0}, {0, 0, -1}, k);  // back wall
-      grid(ps, {0, 0, 0}, {0, 0, D}, {0, H, 0}, {1, 0, 0}, k);   // green wall (x = 0)
-      grid(ps, {W, 0, 0}, {0, 0, D}, {0, H, 0}, {-1, 0, 0}, k);  // red wall
+      bench::cornell_box_grid(ps.p, ps.n, k);
     } else if (key == "hexagon") {
       ps.name = "hexagon room ceiling";
       ps.mesh = hexagon_room();
