@@ -290,7 +290,7 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 #endif
 
 // A texel's id -> its entry in shades: the low `bits` bits of the id when the rasterizer packs
-// the key there (hemicube_rasterizer::key_bits_), else keys[id] (keys: per draw).
+// the key there (rasterizer_impl::key_bits_), else keys[id] (keys: per draw).
 struct key_map {
   const std::uint32_t* keys;
   std::uint32_t bits;
@@ -299,10 +299,10 @@ struct key_map {
 
 // The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
 // the shade (keys[k] indexes shades) copied to the radiance planes and flags.
-inline void copy_shades(const std::uint32_t* keys, std::size_t count, const hemicube_rasterizer::shade* shades,
+inline void copy_shades(const std::uint32_t* keys, std::size_t count, const shade* shades,
                         float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
   for (std::size_t k = 0; k < count; ++k) {
-    const hemicube_rasterizer::shade& sh = shades[keys[k]];
+    const shade& sh = shades[keys[k]];
     red[k] = sh.r;
     green[k] = sh.g;
     blue[k] = sh.b;
@@ -473,7 +473,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
 template <bool packed>
 HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
-                                               const hemicube_rasterizer::shade* __restrict shades,
+                                               const shade* __restrict shades,
                                                const std::uint32_t* __restrict keys, std::uint32_t bits,
                                                float* __restrict distance,
                                                float* __restrict red, float* __restrict green,
@@ -520,8 +520,8 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
         // first lane's and the last lane's, blended.
         const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
         if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
-          const hemicube_rasterizer::shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-          const hemicube_rasterizer::shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
+          const shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+          const shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
           const __m256 m = _mm256_castsi256_ps(is_first);
           _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
           _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
@@ -548,7 +548,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
       // A new run of shade key `first`.
       run_key = first;
       run_id = this_run;
-      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+      const shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
       run_r = _mm256_set1_ps(sh.r);
       run_g = _mm256_set1_ps(sh.g);
       run_b = _mm256_set1_ps(sh.b);
@@ -567,7 +567,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
 // stale): they are set to draw 0, the sky. keys[id]: the draw's entry in shades. The radiance is
 // planar (hemicube_buffer).
 void resolve_texels(std::size_t count, float* __restrict depth, const float* __restrict lengths,
-                    std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
+                    std::uint32_t* __restrict ids, const shade* __restrict shades,
                     key_map key_of, float* __restrict distance, float* __restrict red, float* __restrict green,
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
@@ -593,7 +593,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
         const __m128i first = _mm_shuffle_epi32(id, 0);
         if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
           run_id = first;
-          const hemicube_rasterizer::shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
+          const shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
           run_r = _mm_set1_ps(sh.r);
           run_g = _mm_set1_ps(sh.g);
           run_b = _mm_set1_ps(sh.b);
@@ -671,16 +671,79 @@ float default_near_distance(const scene& s) noexcept {
 // hemicube_rasterizer
 // ---------------------------------------------------------------------------------------------
 
-hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options) {
-  bind(std::move(s), options);
+hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options)
+    : impl_(std::make_unique<rasterizer_impl>()) {
+  impl_->bind(std::move(s), options);
+}
+
+hemicube_rasterizer::hemicube_rasterizer(const hemicube_rasterizer& other)
+    : impl_(other.impl_ ? std::make_unique<rasterizer_impl>(*other.impl_) : nullptr) {}
+hemicube_rasterizer::hemicube_rasterizer(hemicube_rasterizer&& other) noexcept = default;
+hemicube_rasterizer& hemicube_rasterizer::operator=(const hemicube_rasterizer& other) {
+  if (this != &other) impl_ = other.impl_ ? std::make_unique<rasterizer_impl>(*other.impl_) : nullptr;
+  return *this;
+}
+hemicube_rasterizer& hemicube_rasterizer::operator=(hemicube_rasterizer&& other) noexcept = default;
+hemicube_rasterizer::~hemicube_rasterizer() = default;
+
+void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_options& options) {
+  if (impl_) {
+    impl_->bind(std::move(s), options);
+    return;
+  }
+  // A moved-from rasterizer: a new state, kept only if the bind succeeds.
+  auto fresh = std::make_unique<rasterizer_impl>();
+  fresh->bind(std::move(s), options);
+  impl_ = std::move(fresh);
 }
 
 void hemicube_rasterizer::unbind() noexcept {
+  if (impl_) impl_->unbind();
+}
+
+// A moved-from rasterizer has no state: it renders nothing, like an unbound one.
+static rasterizer_impl& bound_state(const std::unique_ptr<rasterizer_impl>& impl, const char* who) {
+  if (!impl) throw_invalid_argument(std::string(who) + ": no scene (the rasterizer was moved from; bind() one first)");
+  return *impl;
+}
+
+void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+                                 const radiance_texture* texture) {
+  bound_state(impl_, "hemicube_rasterizer::render").render(position, basis, resolution, out, texture);
+}
+
+void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+                                          std::vector<std::uint32_t>& counts) {
+  bound_state(impl_, "hemicube_rasterizer::render_coverage").render_coverage(position, basis, resolution, counts);
+}
+
+std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
+  assert(impl_);
+  return impl_->seen_triangle(texel);
+}
+
+float hemicube_rasterizer::near_distance() const noexcept { return impl_ ? impl_->near_distance() : 0.0f; }
+
+const raster_statistics& hemicube_rasterizer::statistics() const noexcept {
+  static const raster_statistics none{};
+  return impl_ ? impl_->statistics() : none;
+}
+
+const std::shared_ptr<const scene>& hemicube_rasterizer::scene_ptr() const noexcept {
+  static const std::shared_ptr<const scene> none;
+  return impl_ ? impl_->scene_ptr() : none;
+}
+
+// ---------------------------------------------------------------------------------------------
+// rasterizer_impl: set-up
+// ---------------------------------------------------------------------------------------------
+
+void raster_detail::rasterizer_impl::unbind() noexcept {
   scene_.reset();
   sky_.reset();
 }
 
-void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_options& options) {
+void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const raster_options& options) {
   // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
   if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
   if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
@@ -724,7 +787,7 @@ void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_opti
   if (edge_) edge_find_candidates();
 }
 
-void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
+void raster_detail::rasterizer_impl::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
                                           int resolution) const {
   const std::string w(who);
   if (!scene_) throw_invalid_argument(w + ": no scene (unbind() was called; bind() one first)");
@@ -750,7 +813,7 @@ void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& posi
   check_hemicube_resolution(resolution, who);
 }
 
-void hemicube_rasterizer::prepare(int resolution) {
+void raster_detail::rasterizer_impl::prepare(int resolution) {
   const std::size_t count = hemicube_texel_count(resolution);
   if (n_ != resolution) {
     directions_.resize(count);
@@ -808,12 +871,12 @@ void hemicube_rasterizer::prepare(int resolution) {
   }
 }
 
-std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
+std::uint32_t raster_detail::rasterizer_impl::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < hemicube_texel_count(n_));
   return draw_triangles_[ids_[texel] >> key_bits_];  // the resolve set unwritten texels to draw 0
 }
 
-unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
+unsigned raster_detail::rasterizer_impl::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
                                                                const glm::vec3& position, const frame& basis,
                                                                bool hard) const {
   // A node far away compared with its size may fall between texel centres on every face it
@@ -883,7 +946,7 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
 #if HEMILIGHT_RASTER_AVX2
 // The position and the frame's axes, broadcast once per render for draw_leaf_avx2, and the
 // scene's per-coordinate vertex arrays.
-struct hemicube_rasterizer::simd_frame {
+struct raster_detail::simd_frame {
   __m256 p[3];              // each component of the position in all eight lanes
   __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
   const float* coordinates[3][3];  // scene::vertex_coordinates(vertex, axis)
@@ -916,8 +979,8 @@ HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
 
 #endif
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis) {
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const frame& basis) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
   if (nodes.empty()) return;
   const std::vector<scene::triangle>& tris = scene_->triangles();
@@ -961,8 +1024,8 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
   }
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
                                         const frame& basis) {
   ++stats_.triangles_tested;
   const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
@@ -1018,7 +1081,7 @@ __attribute__((always_inline))
 // A new draw for `tri` (its plane: `plane`; `rec`: its record, needed in a textured render only).
 // The shade is the scene's emission index, or the back-face entry: no radiance is copied or
 // compared per draw.
-inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene::triangle& tri,
+inline std::uint32_t raster_detail::rasterizer_impl::commit_record(float plane, const scene::triangle& tri,
                                                         const draw_record* rec, const frame& basis) {
   const bool back = plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
   const auto draw = static_cast<std::uint32_t>(draw_keys_.size());
@@ -1039,8 +1102,8 @@ inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene
   return key_bits_ ? draw << key_bits_ | key : draw;
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
                                       const frame& basis, const scene::triangle& tri) {
   const int n = n_;
   const float near = near_;
@@ -1106,8 +1169,8 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
   }
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
                                      face_setup& fs, draw_record& rec, std::uint32_t& draw, const frame& basis,
                                      const scene::triangle& tri, const double* exact) {
   const int n = n_;
@@ -1382,7 +1445,7 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
   walk_rows_of(nl, nr, left, right, y_first, y_last, x_begin, x_end, span);
 }
 
-void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+void raster_detail::rasterizer_impl::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
                                  const radiance_texture* texture) {
   const char* who = "hemicube_rasterizer::render";
   check_arguments(who, position, basis, resolution);
@@ -1456,7 +1519,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   }
 }
 
-void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+void raster_detail::rasterizer_impl::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
                                           std::vector<std::uint32_t>& counts) {
   check_arguments("hemicube_rasterizer::render_coverage", position, basis, resolution);
   prepare(resolution);
