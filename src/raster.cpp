@@ -1,6 +1,8 @@
 #include "hemilight/raster.hpp"
 #include "raster_internal.hpp"
 
+#include "hemilight/cubemap.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cfloat>

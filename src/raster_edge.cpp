@@ -3,6 +3,8 @@
 #include "hemilight/raster.hpp"
 #include "raster_internal.hpp"
 
+#include "hemilight/cubemap.hpp"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>

@@ -4,7 +4,6 @@
 // and exact edge coverage (raster_edge.cpp). Not installed.
 #pragma once
 
-#include "hemilight/cubemap.hpp"
 #include "hemilight/raster.hpp"
 
 #include <cstdint>

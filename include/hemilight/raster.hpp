@@ -69,7 +69,6 @@
 // same exact float comparisons, four per instruction.) Other targets use the scalar path.
 #pragma once
 
-#include "hemilight/cubemap.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
@@ -80,6 +79,10 @@
 #include <vector>
 
 namespace hemilight {
+
+// The environment sky of raster_options (hemilight/cubemap.hpp, a module above this one: include
+// it to build or sample one).
+struct cubemap;
 
 /// A read-only view of an RGB(A) float radiance texture over the scene's lightmap UVs. Sampled
 /// bilinearly with clamp-to-edge; texel (x, y) (x = column, y = row of `pixels`) has its centre at
