@@ -47,6 +47,24 @@ inline clip_vertex to_clip(int face, const glm::vec3& p) noexcept {
 inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >> sub_bits; }
 inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
 
+// A point of a face's fixed-point grid (1/2^sub_bits texel; x: columns, y: rows).
+struct fixed_point {
+  std::int64_t x, y;
+};
+
+// A triangle of the fixed-point grid, counter-clockwise (positive area), as draw_fixed sets it up.
+struct fixed_triangle {
+  fixed_point p[3];
+  double unsnapped[6];                      // x0 x1 x2 y0 y1 y2 before snapping, in p's order
+  std::int64_t min_x, max_x, min_y, max_y;  // bounds of p
+};
+
+// The texels of a face whose centre lies in a box: columns x_begin..x_end, rows y_begin..y_end
+// (empty when a begin exceeds its end).
+struct texel_box {
+  std::int64_t x_begin, x_end, y_begin, y_end;
+};
+
 /// A triangle drawn in the current hemicube, in the local frame. The clipping and big-triangle
 /// paths use its geometry; a textured render keeps one per draw for the UV pass.
 struct draw_record {
@@ -129,6 +147,8 @@ class alignas(64) rasterizer_impl {
   void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
                   draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
                   const double* exact = nullptr);
+  bool draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs, draw_record& rec, std::uint32_t& draw,
+                        const frame& basis, const scene::triangle& tri);
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis);
