@@ -757,10 +757,10 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   // Step 2: the scene, the options, and the shades (the direction tables and scratch stay).
   scene_ = std::move(s);
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
-  simd_ = options.simd;
+  simd_ = options.diagnostics.simd;
 #if HEMILIGHT_RASTER_AVX2
-  avx2_ = options.simd && options.avx2 && __builtin_cpu_supports("avx2");
-  avx512_ = avx2_ && options.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+  avx2_ = options.diagnostics.simd && options.diagnostics.avx2 && __builtin_cpu_supports("avx2");
+  avx512_ = avx2_ && options.diagnostics.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
 #endif
   sky_ = options.sky;

@@ -481,8 +481,8 @@ TEST_CASE("raster: every texel gets the emission of the triangle it sees, with f
     const auto s = scene::create(m.desc());
     CHECK(s->emissions().size() == (kinds ? 5u : m.triangle_count()));
     raster_options scalar, sse2;
-    scalar.simd = false;
-    sse2.avx2 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
     hemicube_rasterizer paths[] = {hemicube_rasterizer(s), hemicube_rasterizer(s, sse2), hemicube_rasterizer(s, scalar)};
     const glm::vec3 centre = 0.5f * (s->bounds_lo() + s->bounds_hi());
     const float height = 0.2f * s->size();
@@ -783,9 +783,9 @@ TEST_CASE("raster: the SIMD paths (AVX-512 and AVX2 where the CPU has them, SSE2
   for (const scene_mesh& m : scenes) {
     const auto s = scene::create(m.desc());
     raster_options scalar, sse2, avx2;
-    scalar.simd = false;
-    sse2.avx2 = false;     // the SSE2 kernels even on an AVX2 machine
-    avx2.avx512 = false;   // the AVX2 build of the set-up even on an AVX-512 machine
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;     // the SSE2 kernels even on an AVX2 machine
+    avx2.diagnostics.avx512 = false;   // the AVX2 build of the set-up even on an AVX-512 machine
     hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
     hemicube_buffer a, b, c, e;
     std::vector<std::uint32_t> ca, cb, cc, ce;
@@ -888,9 +888,9 @@ TEST_CASE("raster: edges through texel centres (exact ties) give the same covera
       }
     const auto s = scene::create(m.desc());
     raster_options scalar, sse2, avx2;
-    scalar.simd = false;
-    sse2.avx2 = false;
-    avx2.avx512 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
+    avx2.diagnostics.avx512 = false;
     hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
     const frame f{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     std::vector<std::uint32_t> ca, cb, cc, ce;
@@ -1189,9 +1189,9 @@ TEST_CASE("raster: exact edge coverage keeps the texel centres' flags and triang
     const auto s = scene::create(m.desc());
     raster_options point, edge, scalar, sse2, avx2;
     edge.edge_coverage = scalar.edge_coverage = sse2.edge_coverage = avx2.edge_coverage = true;
-    scalar.simd = false;
-    sse2.avx2 = false;
-    avx2.avx512 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
+    avx2.diagnostics.avx512 = false;
     hemicube_rasterizer rp(s, point), re(s, edge), rs(s, scalar), r2(s, sse2), ra(s, avx2);
     hemicube_buffer bp, be, bs, b2, ba, again;
     for (int k = 0; k < 5; ++k) {

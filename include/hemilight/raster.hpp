@@ -62,10 +62,10 @@
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
 //     a per-render shade key, so the two triangles of a quad make one run) as broadcast stores.
 //     Where the CPU has AVX-512 (F, VL, BW, DQ) the set-up runs as an AVX-512 build of the same
-//     code (32 registers; raster_options::avx512).
+//     code (32 registers; raster_options::diagnostics.avx512).
 //   - SSE2 (every x86-64): the same for triangles up to 32 texels across, four texels at a time.
-// raster_options::simd = false selects the scalar reference path; raster_options::avx2 = false
-// keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
+// raster_options::diagnostics.simd = false selects the scalar reference path;
+// raster_options::diagnostics.avx2 = false keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
 // same exact float comparisons, four per instruction.) Other targets use the scalar path.
 #pragma once
 
@@ -116,16 +116,6 @@ struct raster_options {
   /// Near-plane distance along each face's forward axis (scene units). 0 = the default,
   /// default_near_distance(scene). Must be finite and >= 0.
   float near_distance = 0.0f;
-  /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it; see the top of this
-  /// header). false selects the scalar reference path; all give bit-identical buffers (tested).
-  bool simd = true;
-  /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked at
-  /// run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine. Bit-identical.
-  bool avx2 = true;
-  /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
-  /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
-  /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build. Bit-identical.
-  bool avx512 = true;
   /// Optional environment sky: texels that hit nothing get sky->sample(world direction of the
   /// texel centre) (seamless bilinear, top level; cubemap.hpp) instead of the scene's constant
   /// sky radiance. The cube map's directions are the scene's world axes (OpenGL face table).
@@ -148,6 +138,24 @@ struct raster_options {
   /// box (material changes all around), 15x on a terrain seen from its own surface
   /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
+
+  /// Diagnostic switches, for comparisons and tests only (not for tuning): every setting gives
+  /// bit-identical buffers (tested), only the speed differs. The defaults pick the fastest kernels
+  /// the CPU has; an engine leaves them alone.
+  struct diagnostic_switches {
+    /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it; see the top of
+    /// this header). false selects the scalar reference path.
+    bool simd = true;
+    /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked
+    /// at run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine.
+    bool avx2 = true;
+    /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
+    /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
+    /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build.
+    bool avx512 = true;
+  };
+  /// Diagnostic switches (see diagnostic_switches): for comparisons only.
+  diagnostic_switches diagnostics = {};
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
