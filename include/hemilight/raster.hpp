@@ -238,20 +238,21 @@ class hemicube_rasterizer {
   /// After render(): the scene triangle (scene_desc numbering) seen through a texel, or
   /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). A debugging and
   /// testing aid; the buffer itself does not carry triangle numbers.
-  /// Precondition: texel < 3 N^2 of the last render (asserted).
+  /// Precondition: texel < 3 N^2 of the last render, and not moved from since (asserted).
   std::uint32_t seen_triangle(std::size_t texel) const noexcept;
 
-  /// The near distance in use (the option, or the scene's default).
-  /// (0 for a moved-from rasterizer.) Cost: O(1).
+  /// The near distance in use (the option, or the scene's default). Cost: O(1).
   float near_distance() const noexcept;
   /// Counters of the last render (raster_statistics). Cost: O(1).
   const raster_statistics& statistics() const noexcept;
   /// The scene bound (null after unbind() or a move). Cost: O(1).
   const std::shared_ptr<const scene>& scene_ptr() const noexcept;
 
-  /// Copies and moves: a copy renders bitwise as the original (it copies the scratch memory);
-  /// a moved-from rasterizer holds nothing: render() and render_coverage() throw
-  /// error(invalid_argument) until bind() gives it a scene again.
+  /// Copies and moves: a copy renders bitwise as the original; it allocates and copies the
+  /// tables and scratch memory (see Memory above; std::bad_alloc if that fails), so copy a
+  /// rasterizer once per thread, not per render. A move is O(1). A moved-from rasterizer holds
+  /// nothing: render() and render_coverage() throw error(invalid_argument) until bind() gives it
+  /// a scene again; near_distance() is 0, statistics() all zero, scene_ptr() null.
   hemicube_rasterizer(const hemicube_rasterizer& other);
   hemicube_rasterizer(hemicube_rasterizer&& other) noexcept;
   hemicube_rasterizer& operator=(const hemicube_rasterizer& other);
