@@ -1458,8 +1458,12 @@ inline void set_up_edge_walks(const edge_functions& e, std::int64_t y_first, edg
 // Step 2 (edge coverage hook): the hard texels (those a hard edge may cross) that t's box
 // overlaps get the triangle's exact share (edge_texels), committing the draw if needed; the
 // coverage paths then draw it as without the option. Returns false when the box misses the
-// face (nothing to draw at all).
-bool raster_detail::rasterizer_impl::draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs,
+// face (nothing to draw at all). Inlined into draw_fixed (its only caller): out of line, t would
+// have to be stored for every triangle drawn.
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+inline bool raster_detail::rasterizer_impl::draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs,
                                                       draw_record& rec, std::uint32_t& draw, const frame& basis,
                                                       const scene::triangle& tri) {
   const int rows = face == 0 ? n_ : n_ / 2;
