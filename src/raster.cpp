@@ -1,6 +1,8 @@
 #include "hemilight/raster.hpp"
 #include "raster_internal.hpp"
 
+#include "hemilight/cubemap.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cfloat>
@@ -148,10 +150,6 @@ inline std::int64_t round_to_int(double x) noexcept {
   return static_cast<std::int64_t>(x >= 0.0 ? x + 0.5 : x - 0.5);
 }
 
-struct fixed_point {
-  std::int64_t x, y;
-};
-
 // One edge of the exact span walk: the bound on x (left: x >= bound, right: x <= bound) of the
 // current row as quotient and remainder, and their steps per row (see draw_fixed).
 struct edge_walk {
@@ -290,7 +288,7 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
 #endif
 
 // A texel's id -> its entry in shades: the low `bits` bits of the id when the rasterizer packs
-// the key there (hemicube_rasterizer::key_bits_), else keys[id] (keys: per draw).
+// the key there (rasterizer_impl::key_bits_), else keys[id] (keys: per draw).
 struct key_map {
   const std::uint32_t* keys;
   std::uint32_t bits;
@@ -299,10 +297,10 @@ struct key_map {
 
 // The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
 // the shade (keys[k] indexes shades) copied to the radiance planes and flags.
-inline void copy_shades(const std::uint32_t* keys, std::size_t count, const hemicube_rasterizer::shade* shades,
+inline void copy_shades(const std::uint32_t* keys, std::size_t count, const shade* shades,
                         float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
   for (std::size_t k = 0; k < count; ++k) {
-    const hemicube_rasterizer::shade& sh = shades[keys[k]];
+    const shade& sh = shades[keys[k]];
     red[k] = sh.r;
     green[k] = sh.g;
     blue[k] = sh.b;
@@ -473,7 +471,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
 template <bool packed>
 HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
                                                const float* __restrict lengths, std::uint32_t* __restrict ids,
-                                               const hemicube_rasterizer::shade* __restrict shades,
+                                               const shade* __restrict shades,
                                                const std::uint32_t* __restrict keys, std::uint32_t bits,
                                                float* __restrict distance,
                                                float* __restrict red, float* __restrict green,
@@ -520,8 +518,8 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
         // first lane's and the last lane's, blended.
         const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
         if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
-          const hemicube_rasterizer::shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-          const hemicube_rasterizer::shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
+          const shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+          const shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
           const __m256 m = _mm256_castsi256_ps(is_first);
           _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
           _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
@@ -548,7 +546,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
       // A new run of shade key `first`.
       run_key = first;
       run_id = this_run;
-      const hemicube_rasterizer::shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
+      const shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
       run_r = _mm256_set1_ps(sh.r);
       run_g = _mm256_set1_ps(sh.g);
       run_b = _mm256_set1_ps(sh.b);
@@ -567,7 +565,7 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
 // stale): they are set to draw 0, the sky. keys[id]: the draw's entry in shades. The radiance is
 // planar (hemicube_buffer).
 void resolve_texels(std::size_t count, float* __restrict depth, const float* __restrict lengths,
-                    std::uint32_t* __restrict ids, const hemicube_rasterizer::shade* __restrict shades,
+                    std::uint32_t* __restrict ids, const shade* __restrict shades,
                     key_map key_of, float* __restrict distance, float* __restrict red, float* __restrict green,
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
@@ -593,7 +591,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
         const __m128i first = _mm_shuffle_epi32(id, 0);
         if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
           run_id = first;
-          const hemicube_rasterizer::shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
+          const shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
           run_r = _mm_set1_ps(sh.r);
           run_g = _mm_set1_ps(sh.g);
           run_b = _mm_set1_ps(sh.b);
@@ -671,16 +669,79 @@ float default_near_distance(const scene& s) noexcept {
 // hemicube_rasterizer
 // ---------------------------------------------------------------------------------------------
 
-hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options) {
-  bind(std::move(s), options);
+hemicube_rasterizer::hemicube_rasterizer(std::shared_ptr<const scene> s, raster_options options)
+    : impl_(std::make_unique<rasterizer_impl>()) {
+  impl_->bind(std::move(s), options);
+}
+
+hemicube_rasterizer::hemicube_rasterizer(const hemicube_rasterizer& other)
+    : impl_(other.impl_ ? std::make_unique<rasterizer_impl>(*other.impl_) : nullptr) {}
+hemicube_rasterizer::hemicube_rasterizer(hemicube_rasterizer&& other) noexcept = default;
+hemicube_rasterizer& hemicube_rasterizer::operator=(const hemicube_rasterizer& other) {
+  if (this != &other) impl_ = other.impl_ ? std::make_unique<rasterizer_impl>(*other.impl_) : nullptr;
+  return *this;
+}
+hemicube_rasterizer& hemicube_rasterizer::operator=(hemicube_rasterizer&& other) noexcept = default;
+hemicube_rasterizer::~hemicube_rasterizer() = default;
+
+void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_options& options) {
+  if (impl_) {
+    impl_->bind(std::move(s), options);
+    return;
+  }
+  // A moved-from rasterizer: a new state, kept only if the bind succeeds.
+  auto fresh = std::make_unique<rasterizer_impl>();
+  fresh->bind(std::move(s), options);
+  impl_ = std::move(fresh);
 }
 
 void hemicube_rasterizer::unbind() noexcept {
+  if (impl_) impl_->unbind();
+}
+
+// A moved-from rasterizer has no state: it renders nothing, like an unbound one.
+static rasterizer_impl& bound_state(const std::unique_ptr<rasterizer_impl>& impl, const char* who) {
+  if (!impl) throw_invalid_argument(std::string(who) + ": no scene (the rasterizer was moved from; bind() one first)");
+  return *impl;
+}
+
+void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+                                 const radiance_texture* texture) {
+  bound_state(impl_, "hemicube_rasterizer::render").render(position, basis, resolution, out, texture);
+}
+
+void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+                                          std::vector<std::uint32_t>& counts) {
+  bound_state(impl_, "hemicube_rasterizer::render_coverage").render_coverage(position, basis, resolution, counts);
+}
+
+std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
+  assert(impl_);
+  return impl_->seen_triangle(texel);
+}
+
+float hemicube_rasterizer::near_distance() const noexcept { return impl_ ? impl_->near_distance() : 0.0f; }
+
+const raster_statistics& hemicube_rasterizer::statistics() const noexcept {
+  static const raster_statistics none{};
+  return impl_ ? impl_->statistics() : none;
+}
+
+const std::shared_ptr<const scene>& hemicube_rasterizer::scene_ptr() const noexcept {
+  static const std::shared_ptr<const scene> none;
+  return impl_ ? impl_->scene_ptr() : none;
+}
+
+// ---------------------------------------------------------------------------------------------
+// rasterizer_impl: set-up
+// ---------------------------------------------------------------------------------------------
+
+void raster_detail::rasterizer_impl::unbind() noexcept {
   scene_.reset();
   sky_.reset();
 }
 
-void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_options& options) {
+void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const raster_options& options) {
   // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
   if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
   if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
@@ -696,10 +757,10 @@ void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_opti
   // Step 2: the scene, the options, and the shades (the direction tables and scratch stay).
   scene_ = std::move(s);
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
-  simd_ = options.simd;
+  simd_ = options.diagnostics.simd;
 #if HEMILIGHT_RASTER_AVX2
-  avx2_ = options.simd && options.avx2 && __builtin_cpu_supports("avx2");
-  avx512_ = avx2_ && options.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+  avx2_ = options.diagnostics.simd && options.diagnostics.avx2 && __builtin_cpu_supports("avx2");
+  avx512_ = avx2_ && options.diagnostics.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
 #endif
   sky_ = options.sky;
@@ -724,7 +785,7 @@ void hemicube_rasterizer::bind(std::shared_ptr<const scene> s, const raster_opti
   if (edge_) edge_find_candidates();
 }
 
-void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
+void raster_detail::rasterizer_impl::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
                                           int resolution) const {
   const std::string w(who);
   if (!scene_) throw_invalid_argument(w + ": no scene (unbind() was called; bind() one first)");
@@ -750,7 +811,7 @@ void hemicube_rasterizer::check_arguments(const char* who, const glm::vec3& posi
   check_hemicube_resolution(resolution, who);
 }
 
-void hemicube_rasterizer::prepare(int resolution) {
+void raster_detail::rasterizer_impl::prepare(int resolution) {
   const std::size_t count = hemicube_texel_count(resolution);
   if (n_ != resolution) {
     directions_.resize(count);
@@ -808,12 +869,12 @@ void hemicube_rasterizer::prepare(int resolution) {
   }
 }
 
-std::uint32_t hemicube_rasterizer::seen_triangle(std::size_t texel) const noexcept {
+std::uint32_t raster_detail::rasterizer_impl::seen_triangle(std::size_t texel) const noexcept {
   assert(texel < hemicube_texel_count(n_));
   return draw_triangles_[ids_[texel] >> key_bits_];  // the resolve set unwritten texels to draw 0
 }
 
-unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
+unsigned raster_detail::rasterizer_impl::drop_faces_between_texel_centres(const bvh_node& node, unsigned mask,
                                                                const glm::vec3& position, const frame& basis,
                                                                bool hard) const {
   // A node far away compared with its size may fall between texel centres on every face it
@@ -883,7 +944,7 @@ unsigned hemicube_rasterizer::drop_faces_between_texel_centres(const bvh_node& n
 #if HEMILIGHT_RASTER_AVX2
 // The position and the frame's axes, broadcast once per render for draw_leaf_avx2, and the
 // scene's per-coordinate vertex arrays.
-struct hemicube_rasterizer::simd_frame {
+struct raster_detail::simd_frame {
   __m256 p[3];              // each component of the position in all eight lanes
   __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
   const float* coordinates[3][3];  // scene::vertex_coordinates(vertex, axis)
@@ -916,8 +977,8 @@ HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
 
 #endif
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis) {
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const frame& basis) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
   if (nodes.empty()) return;
   const std::vector<scene::triangle>& tris = scene_->triangles();
@@ -961,8 +1022,8 @@ void hemicube_rasterizer::draw_all(const glm::vec3& position, const frame& basis
   }
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
                                         const frame& basis) {
   ++stats_.triangles_tested;
   const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
@@ -1018,7 +1079,7 @@ __attribute__((always_inline))
 // A new draw for `tri` (its plane: `plane`; `rec`: its record, needed in a textured render only).
 // The shade is the scene's emission index, or the back-face entry: no radiance is copied or
 // compared per draw.
-inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene::triangle& tri,
+inline std::uint32_t raster_detail::rasterizer_impl::commit_record(float plane, const scene::triangle& tri,
                                                         const draw_record* rec, const frame& basis) {
   const bool back = plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
   const auto draw = static_cast<std::uint32_t>(draw_keys_.size());
@@ -1039,8 +1100,8 @@ inline std::uint32_t hemicube_rasterizer::commit_record(float plane, const scene
   return key_bits_ ? draw << key_bits_ | key : draw;
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
                                       const frame& basis, const scene::triangle& tri) {
   const int n = n_;
   const float near = near_;
@@ -1106,92 +1167,99 @@ void hemicube_rasterizer::raster_face(int face, const glm::vec3 (&local)[3], dra
   }
 }
 
-template <hemicube_rasterizer::mode M>
-void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
-                                     face_setup& fs, draw_record& rec, std::uint32_t& draw, const frame& basis,
-                                     const scene::triangle& tri, const double* exact) {
-  const int n = n_;
-  const int rows = face == 0 ? n : n / 2;
-  fixed_point p[3] = {{px[0], py[0]}, {px[1], py[1]}, {px[2], py[2]}};
+// ---------------------------------------------------------------------------------------------
+// draw_fixed: one triangle of the fixed-point grid on one face, as a chain of named steps
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// Step 1 (set-up): the snapped vertices px, py ordered counter-clockwise into t.p, the unsnapped
+// ones (exact: x0 x1 x2 y0 y1 y2 in px's order; null: the snapped ones) in the same order, and
+// the bounds. Returns false for a triangle without area (it covers nothing).
+inline bool set_up_fixed_triangle(const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double* exact,
+                                  fixed_triangle& t) noexcept {
+  fixed_point* p = t.p;
+  p[0] = {px[0], py[0]};
+  p[1] = {px[1], py[1]};
+  p[2] = {px[2], py[2]};
   const std::int64_t area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
-  if (area == 0) return;
+  if (area == 0) return false;
   if (area < 0) std::swap(p[1], p[2]);
-  // The unsnapped projected vertices (edge coverage), in the same order as p.
-  double unsnapped[6] = {};
   if (exact) {
     const int order[3] = {0, area < 0 ? 2 : 1, area < 0 ? 1 : 2};
     for (int k = 0; k < 3; ++k) {
-      unsnapped[k] = exact[order[k]];
-      unsnapped[3 + k] = exact[3 + order[k]];
+      t.unsnapped[k] = exact[order[k]];
+      t.unsnapped[3 + k] = exact[3 + order[k]];
     }
   } else {
     for (int k = 0; k < 3; ++k) {
-      unsnapped[k] = static_cast<double>(p[k].x);
-      unsnapped[3 + k] = static_cast<double>(p[k].y);
+      t.unsnapped[k] = static_cast<double>(p[k].x);
+      t.unsnapped[3 + k] = static_cast<double>(p[k].y);
     }
   }
-  const std::int64_t min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
-  const std::int64_t min_y = std::min({p[0].y, p[1].y, p[2].y}), max_y = std::max({p[0].y, p[1].y, p[2].y});
-  // Exact edge coverage: the hard texels (those a hard edge may cross) the triangle touches get
-  // its exact share (edge_texels); the coverage paths below draw it as without the option.
-  if (M == mode::depth && edge_ && (hard_faces_ >> face & 1u)) {
-    // Texels the box overlaps (not only those whose centre it holds; grown by the snapping for
-    // the unsnapped triangle), clamped to the face.
-    const std::int64_t c0 = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
-    const std::int64_t c1 = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
-    const std::int64_t r0 = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
-    const std::int64_t r1 = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
-    if (c0 > c1 || r0 > r1) return;
-    if (edge_box_is_hard(face, c0, c1, r0, r1)) {
-      if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
-      fs.prepare(face, texel_step_, first_centre_, rec);
-      const std::int64_t qx[3] = {p[0].x, p[1].x, p[2].x}, qy[3] = {p[0].y, p[1].y, p[2].y};
-      edge_texels(face, qx, qy, unsnapped, fs, draw, rec.plane > 0.0f);
-    }
-  }
-  // Texels whose centre (k + 1/2) lies in the box, clamped to the face.
-  const std::int64_t x_begin = std::max<std::int64_t>(ceil_sub(min_x - sub_half), 0);
-  const std::int64_t x_end = std::min<std::int64_t>(floor_sub(max_x - sub_half), n - 1);
-  const std::int64_t y_begin = std::max<std::int64_t>(ceil_sub(min_y - sub_half), 0);
-  const std::int64_t y_end = std::min<std::int64_t>(floor_sub(max_y - sub_half), rows - 1);
-  if (x_begin > x_end || y_begin > y_end) return;
-  if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
-  // The tie bias of edge k: 0 for owned edges, 1 for the others (a texel centre is covered iff
-  // every edge function minus its bias is >= 0).
-  const auto bias = [](std::int64_t dx, std::int64_t dy) -> std::int64_t {
-    return dy > 0 || (dy == 0 && dx < 0) ? 0 : 1;
-  };
+  t.min_x = std::min({p[0].x, p[1].x, p[2].x});
+  t.max_x = std::max({p[0].x, p[1].x, p[2].x});
+  t.min_y = std::min({p[0].y, p[1].y, p[2].y});
+  t.max_y = std::max({p[0].y, p[1].y, p[2].y});
+  return true;
+}
 
-  fs.prepare(face, texel_step_, first_centre_, rec);
-  const double z00 = fs.z00, dzdy = fs.dzdy;
-  const float dzdx = fs.dzdx;
+// Step 3 (box): the texels whose centre (k + 1/2) lies in t's bounds, clamped to a face of
+// `columns` x `rows` texels.
+inline texel_box centres_in_bounds(const fixed_triangle& t, int columns, int rows) noexcept {
+  return {std::max<std::int64_t>(ceil_sub(t.min_x - sub_half), 0),
+          std::min<std::int64_t>(floor_sub(t.max_x - sub_half), columns - 1),
+          std::max<std::int64_t>(ceil_sub(t.min_y - sub_half), 0),
+          std::min<std::int64_t>(floor_sub(t.max_y - sub_half), rows - 1)};
+}
 
-  const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
-  float* depth = depth_.data() + face_offset;
-  std::uint32_t* ids = ids_.data() + face_offset;
-  std::uint32_t* counts = M == mode::count ? counts_->data() + face_offset : nullptr;
+// The tie bias of edge (dx, dy): 0 for owned edges, 1 for the others (a texel centre is covered
+// iff every edge function minus its bias is >= 0).
+inline std::int64_t tie_bias(std::int64_t dx, std::int64_t dy) noexcept {
+  return dy > 0 || (dy == 0 && dx < 0) ? 0 : 1;
+}
 
-  // Writes the texels [lo, hi] of row y.
-  const auto span = [&](int y, int lo, int hi) {
-    ++stats_.spans;
-    stats_.fragments += static_cast<std::size_t>(hi - lo + 1);
+// The visibility buffers of one face (offset to its first texel) and where the draw's fragments
+// go: depth test into depth and ids, or counts (render_coverage; null in depth mode).
+struct face_target {
+  float* depth;
+  std::uint32_t* ids;
+  std::uint32_t* counts;
+};
+
+// Writes the texels [lo, hi] of row y (the span paths): counts them in count mode, else the
+// depth test of the draw's plane (fs) against `target`, on the fastest path allowed (avx2, simd;
+// all bit-identical). Adds to `stats` (spans, fragments).
+template <bool count_mode>
+struct span_writer {
+  face_target target;
+  int n;                  // texels per row
+  double z00, dzdy;       // the draw's depth plane (face_setup)
+  float dzdx;
+  std::uint32_t draw;     // the texel id written where the draw is nearer
+  bool avx2, simd;
+  raster_statistics& stats;
+
+  void operator()(int y, int lo, int hi) const {
+    ++stats.spans;
+    stats.fragments += static_cast<std::size_t>(hi - lo + 1);
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
-    if (M == mode::count) {
-      for (int x = lo; x <= hi; ++x) ++counts[row + static_cast<std::size_t>(x)];
+    if (count_mode) {
+      for (int x = lo; x <= hi; ++x) ++target.counts[row + static_cast<std::size_t>(x)];
       return;
     }
     const auto zrow = static_cast<float>(z00 + dzdy * y);
-    float* drow = depth + row;
-    std::uint32_t* irow = ids + row;
+    float* drow = target.depth + row;
+    std::uint32_t* irow = target.ids + row;
     int x = lo;
 #if HEMILIGHT_RASTER_AVX2
-    if (avx2_) {
+    if (avx2) {
       span_avx2(drow, irow, lo, hi, zrow, dzdx, draw);
       return;
     }
 #endif
 #if HEMILIGHT_RASTER_SSE2
-    if (simd_ && hi - lo >= 3) {
+    if (simd && hi - lo >= 3) {
       // Four texels at a time; the same operations in the same order as the scalar loop below,
       // so the results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like
       // the scalar select.
@@ -1221,114 +1289,115 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
-  };
-
+  }
+};
 
 #if HEMILIGHT_RASTER_AVX2
-  if (avx2_ && max_x - min_x <= avx2_extent && max_y - min_y <= avx2_extent) {
-    // Triangles up to 120 texels across, AVX2: the box is scanned eight texels per step with
-    // 32-bit edge values (see avx2_extent), the coverage mask going straight into the depth
-    // test. Cheaper than the span walk below even for triangles that fill half their box.
-    // The edge functions below, taken relative to the box's first texel centre (ox, oy): the
-    // same integers, each below the bound derived at avx2_extent, so they fit 32 bits.
-    const std::int64_t ox = x_begin * sub_one + sub_half, oy = y_begin * sub_one + sub_half;
-    std::int32_t base[3], sx[3], sy[3];
-    for (int k = 0; k < 3; ++k) {
-      const fixed_point& a = p[k];
-      const fixed_point& b = p[k == 2 ? 0 : k + 1];
-      const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
-      sx[k] = static_cast<std::int32_t>(-dy * sub_one);
-      sy[k] = static_cast<std::int32_t>(dx * sub_one);
-      // (With edge coverage the bias is at most 128 * 2 * 30,720 < 2^23: the bound above grows
-      // to 1,958,215,681, still < 2^31 - 1.)
-      base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - bias(dx, dy));
-    }
-    small_triangle_avx2_impl<M == mode::count>(base, sx, sy, x_begin, x_end, y_begin, y_end, n, depth, ids, counts,
-                                               z00, dzdy, dzdx, draw);
-    return;
+// Step 4a (small-triangle kernel, AVX2): triangles up to avx2_extent across (the caller checks)
+// are scanned over their box eight texels per step with 32-bit edge values, the coverage mask
+// going straight into the depth test (or the counts). Cheaper than the span walk even for
+// triangles that fill half their box. Reads p, box, the plane fs; writes target.
+template <bool count_mode>
+inline void scan_box_avx2(const fixed_point (&p)[3], const texel_box& box, int n, const face_target& target,
+                          const face_setup& fs, std::uint32_t draw) noexcept {
+  // The edge functions below, taken relative to the box's first texel centre (ox, oy): the
+  // same integers, each below the bound derived at avx2_extent, so they fit 32 bits.
+  const std::int64_t ox = box.x_begin * sub_one + sub_half, oy = box.y_begin * sub_one + sub_half;
+  std::int32_t base[3], sx[3], sy[3];
+  for (int k = 0; k < 3; ++k) {
+    const fixed_point& a = p[k];
+    const fixed_point& b = p[k == 2 ? 0 : k + 1];
+    const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
+    sx[k] = static_cast<std::int32_t>(-dy * sub_one);
+    sy[k] = static_cast<std::int32_t>(dx * sub_one);
+    // (With edge coverage the bias is at most 128 * 2 * 30,720 < 2^23: the bound above grows
+    // to 1,958,215,681, still < 2^31 - 1.)
+    base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - tie_bias(dx, dy));
   }
+  small_triangle_avx2_impl<count_mode>(base, sx, sy, box.x_begin, box.x_end, box.y_begin, box.y_end, n, target.depth,
+                                       target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw);
+}
 #endif
 
-  // Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
-  // (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
-  // d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
-  // texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
+// Edge functions E(P) = d.x (P.y - A.y) - d.y (P.x - A.x) > 0 inside, d = B - A; at texel
+// (x, y): E = ex x + ey y + e0. Ties (E = 0) belong to edges with d.y > 0, or d.y = 0 and
+// d.x < 0: of two triangles sharing an edge exactly one owns it. e0 carries that bias, so a
+// texel is covered iff ex x + ey y + e0 >= 0 for all three edges.
+struct edge_functions {
   std::int64_t ex[3], ey[3], e0[3];
+};
+
+// Step 4 (edge set-up of the 64-bit paths): the edge functions of the counter-clockwise p.
+inline edge_functions edge_functions_of(const fixed_point (&p)[3]) noexcept {
+  edge_functions e;
   for (int k = 0; k < 3; ++k) {
     const fixed_point& a = p[k];
     const fixed_point& b = p[(k + 1) % 3];
     const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
-    ex[k] = -dy * sub_one;
-    ey[k] = dx * sub_one;
-    e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - bias(dx, dy);
+    e.ex[k] = -dy * sub_one;
+    e.ey[k] = dx * sub_one;
+    e.e0[k] = dx * (sub_half - a.y) - dy * (sub_half - a.x) - tie_bias(dx, dy);
   }
+  return e;
+}
 
-#if HEMILIGHT_RASTER_SSE2
-  if (simd_ && max_x - min_x <= simd_extent && max_y - min_y <= simd_extent) {
-    // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
-    // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
-    // additions, and the coverage mask goes straight into the depth test: no span search,
-    // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
-    small_triangle_sse2_impl<M == mode::count>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
-                                               dzdy, dzdx, draw);
-    return;
-  }
-#endif
-  if (x_end - x_begin < 24 && (x_end - x_begin + 1) * (y_end - y_begin + 1) <= 96) {
-    // Small box (most triangles of big scenes): step the edge functions texel by texel
-    // (additions only; a texel is in iff the OR of the three values is not negative) and
-    // write each row's run at once (the triangle is convex: the run is contiguous).
-    std::int64_t row0 = ex[0] * x_begin + ey[0] * y_begin + e0[0];
-    std::int64_t row1 = ex[1] * x_begin + ey[1] * y_begin + e0[1];
-    std::int64_t row2 = ex[2] * x_begin + ey[2] * y_begin + e0[2];
-    for (std::int64_t y = y_begin; y <= y_end; ++y, row0 += ey[0], row1 += ey[1], row2 += ey[2]) {
-      std::int64_t a = row0, b = row1, c = row2;
-      std::int64_t x = x_begin;
-      while (x <= x_end && (a | b | c) < 0) {
-        a += ex[0];
-        b += ex[1];
-        c += ex[2];
-        ++x;
-      }
-      if (x > x_end) continue;
-      const std::int64_t first = x;
-      while (x <= x_end && (a | b | c) >= 0) {
-        a += ex[0];
-        b += ex[1];
-        c += ex[2];
-        ++x;
-      }
-      span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
+// Step 4c (small-triangle kernel, scalar): a small box (most triangles of big scenes) is
+// stepped texel by texel (additions only; a texel is in iff the OR of the three values is not
+// negative), each row's run written at once by span (the triangle is convex: the run is
+// contiguous).
+template <class Span>
+inline void scan_small_box(const edge_functions& e, const texel_box& box, Span& span) {
+  std::int64_t row0 = e.ex[0] * box.x_begin + e.ey[0] * box.y_begin + e.e0[0];
+  std::int64_t row1 = e.ex[1] * box.x_begin + e.ey[1] * box.y_begin + e.e0[1];
+  std::int64_t row2 = e.ex[2] * box.x_begin + e.ey[2] * box.y_begin + e.e0[2];
+  for (std::int64_t y = box.y_begin; y <= box.y_end; ++y, row0 += e.ey[0], row1 += e.ey[1], row2 += e.ey[2]) {
+    std::int64_t a = row0, b = row1, c = row2;
+    std::int64_t x = box.x_begin;
+    while (x <= box.x_end && (a | b | c) < 0) {
+      a += e.ex[0];
+      b += e.ex[1];
+      c += e.ex[2];
+      ++x;
     }
-    return;
+    if (x > box.x_end) continue;
+    const std::int64_t first = x;
+    while (x <= box.x_end && (a | b | c) >= 0) {
+      a += e.ex[0];
+      b += e.ex[1];
+      c += e.ex[2];
+      ++x;
+    }
+    span(static_cast<int>(y), static_cast<int>(first), static_cast<int>(x - 1));
   }
+}
 
-  // Exact incremental spans. Edge k bounds x from the left when ex > 0:
-  // x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
-  // x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped
-  // per row with additions only (a Bresenham-style exact walk, walk_rows). A horizontal edge
-  // (ex = 0) bounds the rows instead: ey y + e0 >= 0.
-  std::int64_t y_first = y_begin, y_last = y_end;
+// Step 5a (span walk: rows): the rows y_first..y_last the walk visits, from the box's rows. A
+// horizontal edge (ex = 0) bounds the rows: ey y + e0 >= 0. A triangle reaching far past the
+// face's sides (clipped triangles reach the guard band) has rows whose span lies wholly outside
+// the face: they are walked for nothing. Its part inside the columns x_begin..x_end (widened by
+// a texel) spans the rows whose centres lie within the y range of that part's vertices (the
+// corners inside the strip and the edges' crossings of its sides); widened by a row, that range
+// is conservative (the crossings are computed in double, to far below a texel), so the rows it
+// drops have no covered texel and the walk stays exact. Convexity: the rows of the part are
+// contiguous. Returns false when no row is left.
+inline bool span_walk_rows(const fixed_triangle& t, const edge_functions& e, const texel_box& box, std::int64_t& y_first,
+                           std::int64_t& y_last) noexcept {
+  y_first = box.y_begin;
+  y_last = box.y_end;
   for (int k = 0; k < 3; ++k) {
-    if (ex[k] != 0) continue;
-    if (ey[k] > 0) {
-      y_first = std::max(y_first, -floor_div(e0[k], ey[k]));  // ceil(-e0 / ey)
-    } else if (ey[k] < 0) {
-      y_last = std::min(y_last, floor_div(e0[k], -ey[k]));
-    } else if (e0[k] < 0) {
-      return;  // a zero-length edge (not reached: such triangles have no area)
+    if (e.ex[k] != 0) continue;
+    if (e.ey[k] > 0) {
+      y_first = std::max(y_first, -floor_div(e.e0[k], e.ey[k]));  // ceil(-e0 / ey)
+    } else if (e.ey[k] < 0) {
+      y_last = std::min(y_last, floor_div(e.e0[k], -e.ey[k]));
+    } else if (e.e0[k] < 0) {
+      return false;  // a zero-length edge (not reached: such triangles have no area)
     }
   }
-  // A triangle reaching far past the face's sides (clipped triangles reach the guard band) has
-  // rows whose span lies wholly outside the face: they are walked for nothing. Its part inside
-  // the columns x_begin..x_end (widened by a texel) spans the rows whose centres lie within the
-  // y range of that part's vertices (the corners inside the strip and the edges' crossings of
-  // its sides); widened by a row, that range is conservative (the crossings are computed in
-  // double, to far below a texel), so the rows it drops have no covered texel and the walk
-  // below stays exact. Convexity: the rows of the part are contiguous.
-  const double strip_lo = static_cast<double>((x_begin - 1) * sub_one + sub_half);
-  const double strip_hi = static_cast<double>((x_end + 1) * sub_one + sub_half);
-  if (static_cast<double>(min_x) < strip_lo || static_cast<double>(max_x) > strip_hi) {
+  const fixed_point* p = t.p;
+  const double strip_lo = static_cast<double>((box.x_begin - 1) * sub_one + sub_half);
+  const double strip_hi = static_cast<double>((box.x_end + 1) * sub_one + sub_half);
+  if (static_cast<double>(t.min_x) < strip_lo || static_cast<double>(t.max_x) > strip_hi) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (int k = 0; k < 3; ++k) {
       const double ax = static_cast<double>(p[k].x), ay = static_cast<double>(p[k].y);
@@ -1344,45 +1413,139 @@ void hemicube_rasterizer::draw_fixed(int face, const std::int64_t (&px)[3], cons
         hi = std::max(hi, y);
       }
     }
-    if (!(lo <= hi)) return;  // the triangle passes beside the face's columns
+    if (!(lo <= hi)) return false;  // the triangle passes beside the face's columns
     // Rows k with centre k + 1/2 in [lo, hi] (fixed point), one more on each side.
     y_first = std::max(y_first, static_cast<std::int64_t>(std::floor((lo - sub_half) / sub_one)));
     y_last = std::min(y_last, static_cast<std::int64_t>(std::ceil((hi - sub_half) / sub_one)));
   }
-  if (y_first > y_last) return;
-  edge_walk left[3], right[3];
-  int nl = 0, nr = 0;
+  return y_first <= y_last;
+}
+
+// Step 5b (span walk: edges): the exact incremental bounds of row y_first. Edge k bounds x from
+// the left when ex > 0: x >= L(y) = ceil(-(ey y + e0) / ex), from the right when ex < 0:
+// x <= R(y) = floor((ey y + e0) / -ex). Both are kept as quotient + remainder and stepped per
+// row with additions only (a Bresenham-style exact walk, walk_rows). Writes nl left and nr
+// right walks.
+inline void set_up_edge_walks(const edge_functions& e, std::int64_t y_first, edge_walk (&left)[3], int& nl,
+                              edge_walk (&right)[3], int& nr) noexcept {
+  nl = 0;
+  nr = 0;
   for (int k = 0; k < 3; ++k) {
-    const std::int64_t r = ey[k] * y_first + e0[k];
-    if (ex[k] > 0) {
-      edge_walk& e = left[nl++];
-      e.m = ex[k];
+    const std::int64_t r = e.ey[k] * y_first + e.e0[k];
+    if (e.ex[k] > 0) {
+      edge_walk& w = left[nl++];
+      w.m = e.ex[k];
       const std::int64_t num = -r;                       // L = ceil(num / m), rem = L m - num
-      e.bound = -floor_div(-num, e.m);
-      e.rem = e.bound * e.m - num;
-      const std::int64_t d = -ey[k];                     // num steps by d per row
-      e.q_step = floor_div(d, e.m);
-      e.r_step = d - e.q_step * e.m;
-    } else if (ex[k] < 0) {
-      edge_walk& e = right[nr++];
-      e.m = -ex[k];
-      e.bound = floor_div(r, e.m);                       // R = floor(r / m), rem = r - R m
-      e.rem = r - e.bound * e.m;
-      e.q_step = floor_div(ey[k], e.m);                  // r steps by ey per row
-      e.r_step = ey[k] - e.q_step * e.m;
+      w.bound = -floor_div(-num, w.m);
+      w.rem = w.bound * w.m - num;
+      const std::int64_t d = -e.ey[k];                   // num steps by d per row
+      w.q_step = floor_div(d, w.m);
+      w.r_step = d - w.q_step * w.m;
+    } else if (e.ex[k] < 0) {
+      edge_walk& w = right[nr++];
+      w.m = -e.ex[k];
+      w.bound = floor_div(r, w.m);                       // R = floor(r / m), rem = r - R m
+      w.rem = r - w.bound * w.m;
+      w.q_step = floor_div(e.ey[k], w.m);                // r steps by ey per row
+      w.r_step = e.ey[k] - w.q_step * w.m;
     }
   }
   assert((nl == 1 && nr == 1) || (nl == 1 && nr == 2) || (nl == 2 && nr == 1));
+}
+
+}  // namespace
+
+// Step 2 (edge coverage hook): the hard texels (those a hard edge may cross) that t's box
+// overlaps get the triangle's exact share (edge_texels), committing the draw if needed; the
+// coverage paths then draw it as without the option. Returns false when the box misses the
+// face (nothing to draw at all). Inlined into draw_fixed (its only caller): out of line, t would
+// have to be stored for every triangle drawn.
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+inline bool raster_detail::rasterizer_impl::draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs,
+                                                      draw_record& rec, std::uint32_t& draw, const frame& basis,
+                                                      const scene::triangle& tri) {
+  const int rows = face == 0 ? n_ : n_ / 2;
+  // Texels the box overlaps (not only those whose centre it holds; grown by the snapping for
+  // the unsnapped triangle), clamped to the face.
+  const std::int64_t c0 = std::max<std::int64_t>(floor_sub(t.min_x - 1), 0);
+  const std::int64_t c1 = std::min<std::int64_t>(ceil_sub(t.max_x + 1) - 1, n_ - 1);
+  const std::int64_t r0 = std::max<std::int64_t>(floor_sub(t.min_y - 1), 0);
+  const std::int64_t r1 = std::min<std::int64_t>(ceil_sub(t.max_y + 1) - 1, rows - 1);
+  if (c0 > c1 || r0 > r1) return false;
+  if (edge_box_is_hard(face, c0, c1, r0, r1)) {
+    if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
+    fs.prepare(face, texel_step_, first_centre_, rec);
+    const std::int64_t qx[3] = {t.p[0].x, t.p[1].x, t.p[2].x}, qy[3] = {t.p[0].y, t.p[1].y, t.p[2].y};
+    edge_texels(face, qx, qy, t.unsnapped, fs, draw, rec.plane > 0.0f);
+  }
+  return true;
+}
+
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
+                                                face_setup& fs, draw_record& rec, std::uint32_t& draw,
+                                                const frame& basis, const scene::triangle& tri, const double* exact) {
+  const int n = n_;
+  const int rows = face == 0 ? n : n / 2;
+  // 1. Set-up: counter-clockwise vertices and bounds.
+  fixed_triangle t;
+  if (!set_up_fixed_triangle(px, py, exact, t)) return;
+  // 2. Exact edge coverage of the hard texels the triangle touches.
+  if (M == mode::depth && edge_ && (hard_faces_ >> face & 1u))
+    if (!draw_hard_texels(face, t, fs, rec, draw, basis, tri)) return;
+  // 3. The box of texel centres; the draw and its depth plane once it covers one.
+  const texel_box box = centres_in_bounds(t, n, rows);
+  if (box.x_begin > box.x_end || box.y_begin > box.y_end) return;
+  if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
+  fs.prepare(face, texel_step_, first_centre_, rec);
+  const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+  const face_target target{depth_.data() + face_offset, ids_.data() + face_offset,
+                           M == mode::count ? counts_->data() + face_offset : nullptr};
+
+  // 4. Small-triangle kernels: the box scanned without spans.
 #if HEMILIGHT_RASTER_AVX2
-  if (M == mode::depth && avx2_) {
-    walk_depth_avx2(nl, nr, left, right, y_first, y_last, x_begin, x_end, depth, ids, n, z00, dzdy, dzdx, draw, stats_);
+  if (avx2_ && t.max_x - t.min_x <= avx2_extent && t.max_y - t.min_y <= avx2_extent) {
+    scan_box_avx2<M == mode::count>(t.p, box, n, target, fs, draw);
     return;
   }
 #endif
-  walk_rows_of(nl, nr, left, right, y_first, y_last, x_begin, x_end, span);
+  const edge_functions e = edge_functions_of(t.p);
+#if HEMILIGHT_RASTER_SSE2
+  if (simd_ && t.max_x - t.min_x <= simd_extent && t.max_y - t.min_y <= simd_extent) {
+    // Small triangle, SSE2: edge functions relative to the box's first texel fit in 32 bits
+    // (extent <= 32 texels: |E| < 2^29), so four texels are tested per step with 32-bit
+    // additions, and the coverage mask goes straight into the depth test: no span search,
+    // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
+    small_triangle_sse2_impl<M == mode::count>(e.ex, e.ey, e.e0, box.x_begin, box.x_end, box.y_begin, box.y_end, n,
+                                               target.depth, target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw);
+    return;
+  }
+#endif
+  span_writer<M == mode::count> span{target, n, fs.z00, fs.dzdy, fs.dzdx, draw, avx2_, simd_, stats_};
+  if (box.x_end - box.x_begin < 24 && (box.x_end - box.x_begin + 1) * (box.y_end - box.y_begin + 1) <= 96) {
+    scan_small_box(e, box, span);
+    return;
+  }
+
+  // 5. The exact span walk: its rows, its edges, then row by row.
+  std::int64_t y_first, y_last;
+  if (!span_walk_rows(t, e, box, y_first, y_last)) return;
+  edge_walk left[3], right[3];
+  int nl, nr;
+  set_up_edge_walks(e, y_first, left, nl, right, nr);
+#if HEMILIGHT_RASTER_AVX2
+  if (M == mode::depth && avx2_) {
+    walk_depth_avx2(nl, nr, left, right, y_first, y_last, box.x_begin, box.x_end, target.depth, target.ids, n, fs.z00,
+                    fs.dzdy, fs.dzdx, draw, stats_);
+    return;
+  }
+#endif
+  walk_rows_of(nl, nr, left, right, y_first, y_last, box.x_begin, box.x_end, span);
 }
 
-void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+void raster_detail::rasterizer_impl::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
                                  const radiance_texture* texture) {
   const char* who = "hemicube_rasterizer::render";
   check_arguments(who, position, basis, resolution);
@@ -1456,7 +1619,7 @@ void hemicube_rasterizer::render(const glm::vec3& position, const frame& basis, 
   }
 }
 
-void hemicube_rasterizer::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+void raster_detail::rasterizer_impl::render_coverage(const glm::vec3& position, const frame& basis, int resolution,
                                           std::vector<std::uint32_t>& counts) {
   check_arguments("hemicube_rasterizer::render_coverage", position, basis, resolution);
   prepare(resolution);

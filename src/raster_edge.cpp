@@ -3,6 +3,8 @@
 #include "hemilight/raster.hpp"
 #include "raster_internal.hpp"
 
+#include "hemilight/cubemap.hpp"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -160,7 +162,7 @@ std::uint32_t bits_of(float f) noexcept {
 
 }  // namespace
 
-void hemicube_rasterizer::edge_find_candidates() {
+void raster_detail::rasterizer_impl::edge_find_candidates() {
   const std::vector<scene::triangle>& tris = scene_->triangles();
   // Step 1: every edge, keyed by its endpoints' bits in a canonical order.
   struct half_edge {
@@ -238,7 +240,7 @@ void hemicube_rasterizer::edge_find_candidates() {
   edge_facing_.assign(edge_planes_.size(), 0);
 }
 
-void hemicube_rasterizer::edge_mark_hard(const glm::vec3& position, const frame& basis) {
+void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, const frame& basis) {
   // Facings of the creases' triangles: the sign of the plane's value at the point, 0 within
   // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
   const double px = position.x, py = position.y, pz = position.z;
@@ -273,7 +275,7 @@ void hemicube_rasterizer::edge_mark_hard(const glm::vec3& position, const frame&
 // and every texel within 1/16 texel of it is marked. The rasterizer's vertices differ from these
 // by its float set-up and 1/512 texel of snapping, far below the margins, so no texel a hard edge
 // crosses is missed; the margins only add a few texels of exact coverage.
-void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette) {
+void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette) {
   const int n = n_;
   const double grow = 1.0 + texel_step_, near = 0.5 * static_cast<double>(near_), eps = 1.0 / 16.0;
   for (int face = 0; face < 5; ++face) {
@@ -339,7 +341,7 @@ void hemicube_rasterizer::edge_mark_segment(const glm::vec3& a, const glm::vec3&
 
 // Whether a hard texel lies in columns c0..c1 of rows r0..r1 of `face` (the rows' hard column
 // ranges, then the texels within them). Cost: O(rows + the texels within the rows' ranges).
-bool hemicube_rasterizer::edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0,
+bool raster_detail::rasterizer_impl::edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0,
                                            std::int64_t r1) const noexcept {
   const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n_) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n_ / 2);
   for (std::int64_t r = r0; r <= r1; ++r) {
@@ -356,7 +358,7 @@ bool hemicube_rasterizer::edge_box_is_hard(int face, std::int64_t c0, std::int64
 // Calls visit(c) for each hard column c in [c0, c1] of face row `row` (hard_bits_), in order,
 // until visit returns false.
 template <class Visit>
-void hemicube_rasterizer::edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const {
+void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const {
   if (c0 > c1) return;
   const std::uint64_t* bits = hard_bits_.data() + row * words_per_row_;
   const std::int64_t w0 = c0 >> 6, w1 = c1 >> 6;
@@ -383,7 +385,7 @@ void hemicube_rasterizer::edge_for_hard(std::size_t row, std::int64_t c0, std::i
 // vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The coverage paths
 // draw the triangle as without the option (centre samples). Cost: O(rows + the hard texels of
 // its rows within its extent).
-void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
+void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
                                       const double (&exact)[6], const face_setup& fs, std::uint32_t draw,
                                       bool back) {
   const int n = n_;
@@ -499,7 +501,7 @@ void hemicube_rasterizer::edge_texels(int face, const std::int64_t (&px)[3], con
 // hard texel with fragments gets its fragments made contiguous, in the order they were added (a
 // counting sort by texel; the texels in first-touch order). fragment_count_ becomes each
 // texel's end.
-void hemicube_rasterizer::edge_group_fragments() {
+void raster_detail::rasterizer_impl::edge_group_fragments() {
   edge_groups_.reserve(fragment_texels_.size());
   std::uint32_t offset = 0;
   for (const std::uint32_t t : fragment_texels_) {
@@ -513,7 +515,7 @@ void hemicube_rasterizer::edge_group_fragments() {
 
 // The radiance a draw (texel id) gives at a texel whose centre direction meets its plane at 1/w
 // = z: the resolve's computation (shade, or the texture at the perspective-correct UV).
-glm::vec3 hemicube_rasterizer::fragment_radiance(std::uint32_t id, std::size_t texel, float z,
+glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, std::size_t texel, float z,
                                                  const radiance_texture* texture) const {
   const std::uint32_t draw = id >> key_bits_;
   if (textured_ && draws_[draw].textured) {
@@ -537,7 +539,7 @@ glm::vec3 hemicube_rasterizer::fragment_radiance(std::uint32_t id, std::size_t t
 // order they were added), each take min(coverage, what is left) until the whole-texel winner
 // (or the first fragment behind it), which takes the rest; with no whole-texel winner the sky
 // takes the rest. Deterministic: the order is total and the sums run in it.
-void hemicube_rasterizer::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
+void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
   const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
   float* red = out.channel(0);
   float* green = out.channel(1);

@@ -1,11 +1,14 @@
-// Internal to the rasterizer (src/raster*.cpp): the fixed-point grid, the faces' clip space and
-// the per-(triangle, face) depth set-up, shared by the coverage paths (raster.cpp) and exact edge
-// coverage (raster_edge.cpp). Not installed.
+// Internal to the rasterizer (src/raster*.cpp): the fixed-point grid, the faces' clip space, the
+// per-(triangle, face) depth set-up, and the rasterizer's state and drawing code
+// (rasterizer_impl, which hemicube_rasterizer holds), shared by the coverage paths (raster.cpp)
+// and exact edge coverage (raster_edge.cpp). Not installed.
 #pragma once
 
 #include "hemilight/raster.hpp"
 
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -44,10 +47,45 @@ inline clip_vertex to_clip(int face, const glm::vec3& p) noexcept {
 inline std::int64_t floor_sub(std::int64_t a) noexcept { return a >> sub_bits; }
 inline std::int64_t ceil_sub(std::int64_t a) noexcept { return -floor_sub(-a); }
 
-}  // namespace raster_detail
+// A point of a face's fixed-point grid (1/2^sub_bits texel; x: columns, y: rows).
+struct fixed_point {
+  std::int64_t x, y;
+};
+
+// A triangle of the fixed-point grid, counter-clockwise (positive area), as draw_fixed sets it up.
+struct fixed_triangle {
+  fixed_point p[3];
+  double unsnapped[6];                      // x0 x1 x2 y0 y1 y2 before snapping, in p's order
+  std::int64_t min_x, max_x, min_y, max_y;  // bounds of p
+};
+
+// The texels of a face whose centre lies in a box: columns x_begin..x_end, rows y_begin..y_end
+// (empty when a begin exceeds its end).
+struct texel_box {
+  std::int64_t x_begin, x_end, y_begin, y_end;
+};
+
+/// A triangle drawn in the current hemicube, in the local frame. The clipping and big-triangle
+/// paths use its geometry; a textured render keeps one per draw for the UV pass.
+struct draw_record {
+  glm::vec3 normal;      ///< (v1 - v0) x (v2 - v0), local frame
+  float plane;           ///< normal . v0 (local; the point is the origin); < 0 for a front face
+  glm::vec3 v0;          ///< first vertex, local frame
+  std::uint32_t index;   ///< scene triangle (scene_desc numbering)
+  glm::vec3 grad_b1;     ///< barycentric b1 = grad_b1 . (q - v0)  (only with a texture)
+  glm::vec3 grad_b2;     ///< barycentric b2 = grad_b2 . (q - v0)
+  bool textured;         ///< UVs + texture: radiance comes from the texture
+};
+/// What the resolve pass copies to the texels of a draw: the sky, a back face, or the front of
+/// a triangle with one of the scene's emissions.
+struct shade {
+  float r, g, b;
+  std::uint32_t flags;
+};
+
 
 // The depth plane of one (triangle, face) pair, computed when the pair first covers a texel.
-struct hemicube_rasterizer::face_setup {
+struct face_setup {
   bool ready = false;
   double z00 = 0.0, dzdy = 0.0;
   float dzdx = 0.0f;
@@ -68,5 +106,136 @@ struct hemicube_rasterizer::face_setup {
     ready = true;
   }
 };
+
+struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
+
+// The state and drawing code of a hemicube_rasterizer (raster.hpp): the public class holds one
+// of these and forwards to it. The hot code is member functions of this class, so nothing in
+// the drawing loops goes through the public object. Cache-line aligned (heap-allocated on its
+// own): the counters one thread writes share no line with another rasterizer's members.
+class alignas(64) rasterizer_impl {
+ public:
+  static constexpr std::uint32_t no_triangle = hemicube_rasterizer::no_triangle;
+
+  // The public functions of hemicube_rasterizer (raster.hpp has their contracts).
+  void bind(std::shared_ptr<const scene> s, const raster_options& options);
+  void unbind() noexcept;
+  void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
+              const radiance_texture* texture);
+  void render_coverage(const glm::vec3& position, const frame& basis, int resolution,
+                       std::vector<std::uint32_t>& counts);
+  std::uint32_t seen_triangle(std::size_t texel) const noexcept;
+  float near_distance() const noexcept { return near_; }
+  const raster_statistics& statistics() const noexcept { return stats_; }
+  const std::shared_ptr<const scene>& scene_ptr() const noexcept { return scene_; }
+
+ private:
+  enum class mode { depth, count };
+  void check_arguments(const char* who, const glm::vec3& position, const frame& basis, int resolution) const;
+  void prepare(int resolution);
+  unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
+                                            const frame& basis, bool hard) const;
+  template <mode M>
+  void draw_all(const glm::vec3& position, const frame& basis);
+  template <mode M>
+  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis);
+  template <mode M>
+  void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
+                   const scene::triangle& tri);
+  std::uint32_t commit_record(float plane, const scene::triangle& tri, const draw_record* rec, const frame& basis);
+  template <mode M>
+  void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
+                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
+                  const double* exact = nullptr);
+  bool draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs, draw_record& rec, std::uint32_t& draw,
+                        const frame& basis, const scene::triangle& tri);
+  template <mode M>
+  void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
+                      const frame& basis);
+  template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
+  void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
+                        const simd_frame& sf, const frame& basis);
+
+  // Exact edge coverage (raster_options::edge_coverage; raster_edge.cpp).
+  struct edge_fragment {
+    std::uint32_t texel;  // hemicube texel index
+    float z;              // the triangle's 1/w at the texel centre (the depth test's value)
+    float coverage;       // the covered fraction of the texel's weight, [0, 1]
+    std::uint32_t id;     // the draw's texel id (as in ids_)
+  };
+  void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
+                   const face_setup& fs, std::uint32_t draw, bool back);
+  // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
+  // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
+  struct edge_candidate {
+    std::uint32_t triangle;   // scene_->triangles() position
+    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
+    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
+    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
+  };
+  void edge_find_candidates();
+  void edge_mark_hard(const glm::vec3& position, const frame& basis);
+  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
+  bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
+  std::vector<edge_candidate> edge_candidates_;
+  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
+  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
+  // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
+  // a hard edge may cross texel c (words_per_row_ words a row).
+  std::vector<std::uint64_t> hard_bits_;
+  std::vector<std::uint64_t> silhouette_bits_;  // the same for silhouette edges only
+  std::size_t words_per_row_ = 0;
+  template <class Visit>
+  void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
+  std::vector<float> whole_z_;                // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
+  std::vector<std::uint32_t> whole_id_;       // and its texel id
+  std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
+  std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
+  unsigned hard_faces_ = 0;                   // faces with a hard texel
+  void edge_group_fragments();
+  void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
+  glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
+  bool edge_ = false;
+  std::vector<edge_fragment> fragments_;
+  std::vector<std::uint32_t> fragment_count_;   // per texel: its fragments (0 = none)
+  std::vector<edge_fragment> grouped_;          // fragments_ by texel (edge_groups_ ranges)
+  std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
+  struct edge_group {
+    std::uint32_t texel;
+    std::uint32_t first, count;  // its fragments in grouped_
+  };
+  std::vector<edge_group> edge_groups_;
+
+  std::shared_ptr<const scene> scene_;
+  float near_ = 0.0f;
+  bool simd_ = true;
+  bool avx2_ = false;  // simd_ and the CPU has AVX2
+  bool avx512_ = false;  // avx2_, the option, and the CPU has AVX-512 F, VL, BW and DQ
+  bool depth_clear_ = false;  // depth_ is all zero (the last render's resolve cleared it)
+  std::shared_ptr<const cubemap> sky_;
+  int n_ = 0;
+  double texel_step_ = 0.0, first_centre_ = 0.0;  // 2 / N and 1 / N - 1 (face units)
+  std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
+  std::vector<std::uint32_t> ids_;     // draw of the nearest fragment per texel (0 = none; see key_bits_)
+  std::vector<std::uint32_t>* counts_ = nullptr;
+  std::vector<glm::vec3> directions_;  // unit texel-centre directions, local frame
+  std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
+  // Draws: a triangle's first covered texel of a render gives it a draw number, which the texels
+  // it wins hold in ids_ (0 = nothing hit).
+  std::vector<std::uint32_t> draw_keys_;       // per draw: its entry in shades_
+  std::vector<std::uint32_t> draw_triangles_;  // per draw: the scene triangle (seen_triangle)
+  std::vector<draw_record> draws_;             // per draw, textured renders only: the UV pass's data
+  bool textured_ = false;                      // this render samples a texture (draws_ is kept)
+  // [0] the sky, [1] a back face, [2 + e] the front of a triangle with scene emission e: built
+  // once, so a draw needs no radiance of its own and equal radiances share one key.
+  std::vector<shade> shades_;
+  // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
+  // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
+  std::uint32_t key_bits_ = 0;
+  std::vector<std::uint32_t> stack_;
+  raster_statistics stats_;
+};
+
+}  // namespace raster_detail
 
 }  // namespace hemilight

@@ -10,8 +10,8 @@
 // and tested against the five faces together; each triangle that survives then goes through
 // the face stage below, face by face, in leaf order within each face (the scalar path's order
 // for every texel).
-template <hemicube_rasterizer::mode M>
-HEMILIGHT_LEAF_TARGET void hemicube_rasterizer::HEMILIGHT_LEAF_NAME(const scene::triangle* all, std::uint32_t first,
+template <rasterizer_impl::mode M>
+HEMILIGHT_LEAF_TARGET void raster_detail::rasterizer_impl::HEMILIGHT_LEAF_NAME(const scene::triangle* all, std::uint32_t first,
                                                                std::uint32_t count,
                                                                unsigned face_mask, const simd_frame& sf,
                                                                const frame& basis) {

@@ -5,6 +5,7 @@
 // terms), an occluder's umbra and the shadow mask, a point-lit furnace against the geometric
 // series, determinism and bad lights.
 #include "hemilight/bake.hpp"
+#include "hemilight/cubemap.hpp"
 #include "hemilight/reference_scenes.hpp"
 
 #include "raycast_reference.hpp"

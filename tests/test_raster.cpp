@@ -481,8 +481,8 @@ TEST_CASE("raster: every texel gets the emission of the triangle it sees, with f
     const auto s = scene::create(m.desc());
     CHECK(s->emissions().size() == (kinds ? 5u : m.triangle_count()));
     raster_options scalar, sse2;
-    scalar.simd = false;
-    sse2.avx2 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
     hemicube_rasterizer paths[] = {hemicube_rasterizer(s), hemicube_rasterizer(s, sse2), hemicube_rasterizer(s, scalar)};
     const glm::vec3 centre = 0.5f * (s->bounds_lo() + s->bounds_hi());
     const float height = 0.2f * s->size();
@@ -693,6 +693,53 @@ TEST_CASE("raster: bind() to another scene renders bitwise as a new rasterizer; 
   CHECK(reused.radiance == fresh_room.radiance);
 }
 
+TEST_CASE("raster: a copy renders bitwise as its original; a moved-from rasterizer fails until bound", "[raster]") {
+  const auto room = scene::create(hexagon_room(2).desc());
+  const glm::vec3 p{0.3f, 1.2f, -0.4f};
+  std::mt19937 rng(9);
+  const frame f = random_frame(rng);
+  // The reference: a fresh rasterizer (bitwise equality: the same code on the same inputs).
+  hemicube_buffer fresh, copied, moved, revived;
+  hemicube_rasterizer(room).render(p, f, 32, fresh);
+  hemicube_rasterizer original(room);
+  original.render(p, f, 16, copied);  // scratch sized for another N, copied with the state
+  hemicube_rasterizer copy(original);
+  copy.render(p, f, 32, copied);
+  CHECK(copied.radiance == fresh.radiance);
+  CHECK(copied.distance == fresh.distance);
+  CHECK(copied.flags == fresh.flags);
+  hemicube_rasterizer reference(room);
+  hemicube_buffer again;
+  reference.render(p, f, 32, again);
+  std::size_t same_triangle = 0;
+  for (std::size_t i = 0; i < hemicube_texel_count(32); ++i)
+    same_triangle += copy.seen_triangle(i) == reference.seen_triangle(i) ? 1u : 0u;
+  CHECK(same_triangle == hemicube_texel_count(32));
+  hemicube_rasterizer target(std::move(original));
+  target.render(p, f, 32, moved);
+  CHECK(moved.radiance == fresh.radiance);
+  CHECK(moved.flags == fresh.flags);
+  // The moved-from one holds nothing: no scene, and render() fails with a clear error.
+  CHECK(original.scene_ptr() == nullptr);  // NOLINT(bugprone-use-after-move): the documented state
+  CHECK(original.near_distance() == 0.0f);
+  CHECK_THROWS_WITH(original.render(p, f, 32, revived), Catch::Contains("moved from"));
+  std::vector<std::uint32_t> counts;
+  CHECK_THROWS_WITH(original.render_coverage(p, f, 32, counts), Catch::Contains("moved from"));
+  // bind() gives it a scene again; it then renders as a new rasterizer.
+  original.bind(room);
+  original.render(p, f, 32, revived);
+  CHECK(revived.radiance == fresh.radiance);
+  CHECK(revived.distance == fresh.distance);
+  // Assignments: copy and move.
+  hemicube_rasterizer assigned(scene::create(cornell_box().desc()));
+  assigned = copy;
+  assigned.render(p, f, 32, revived);
+  CHECK(revived.radiance == fresh.radiance);
+  assigned = std::move(copy);
+  assigned.render(p, f, 32, revived);
+  CHECK(revived.radiance == fresh.radiance);
+}
+
 TEST_CASE("hemicube cross: every texel has its own pixel and the EXR files round-trip", "[raster]") {
   for (int n : {2, 8}) {
     std::set<std::pair<int, int>> used;
@@ -736,9 +783,9 @@ TEST_CASE("raster: the SIMD paths (AVX-512 and AVX2 where the CPU has them, SSE2
   for (const scene_mesh& m : scenes) {
     const auto s = scene::create(m.desc());
     raster_options scalar, sse2, avx2;
-    scalar.simd = false;
-    sse2.avx2 = false;     // the SSE2 kernels even on an AVX2 machine
-    avx2.avx512 = false;   // the AVX2 build of the set-up even on an AVX-512 machine
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;     // the SSE2 kernels even on an AVX2 machine
+    avx2.diagnostics.avx512 = false;   // the AVX2 build of the set-up even on an AVX-512 machine
     hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
     hemicube_buffer a, b, c, e;
     std::vector<std::uint32_t> ca, cb, cc, ce;
@@ -841,9 +888,9 @@ TEST_CASE("raster: edges through texel centres (exact ties) give the same covera
       }
     const auto s = scene::create(m.desc());
     raster_options scalar, sse2, avx2;
-    scalar.simd = false;
-    sse2.avx2 = false;
-    avx2.avx512 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
+    avx2.diagnostics.avx512 = false;
     hemicube_rasterizer best(s), sse2_only(s, sse2), reference(s, scalar), avx2_only(s, avx2);
     const frame f{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     std::vector<std::uint32_t> ca, cb, cc, ce;
@@ -1142,9 +1189,9 @@ TEST_CASE("raster: exact edge coverage keeps the texel centres' flags and triang
     const auto s = scene::create(m.desc());
     raster_options point, edge, scalar, sse2, avx2;
     edge.edge_coverage = scalar.edge_coverage = sse2.edge_coverage = avx2.edge_coverage = true;
-    scalar.simd = false;
-    sse2.avx2 = false;
-    avx2.avx512 = false;
+    scalar.diagnostics.simd = false;
+    sse2.diagnostics.avx2 = false;
+    avx2.diagnostics.avx512 = false;
     hemicube_rasterizer rp(s, point), re(s, edge), rs(s, scalar), r2(s, sse2), ra(s, avx2);
     hemicube_buffer bp, be, bs, b2, ba, again;
     for (int k = 0; k < 5; ++k) {

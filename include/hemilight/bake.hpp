@@ -67,6 +67,7 @@
 #pragma once
 
 #include "hemilight/cache.hpp"
+#include "hemilight/cubemap.hpp"
 #include "hemilight/image_io.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"

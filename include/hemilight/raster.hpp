@@ -62,14 +62,13 @@
 //     texels at a time; the resolve writes runs of texels that see the same shade (found through
 //     a per-render shade key, so the two triangles of a quad make one run) as broadcast stores.
 //     Where the CPU has AVX-512 (F, VL, BW, DQ) the set-up runs as an AVX-512 build of the same
-//     code (32 registers; raster_options::avx512).
+//     code (32 registers; raster_options::diagnostics.avx512).
 //   - SSE2 (every x86-64): the same for triangles up to 32 texels across, four texels at a time.
-// raster_options::simd = false selects the scalar reference path; raster_options::avx2 = false
-// keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
+// raster_options::diagnostics.simd = false selects the scalar reference path;
+// raster_options::diagnostics.avx2 = false keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
 // same exact float comparisons, four per instruction.) Other targets use the scalar path.
 #pragma once
 
-#include "hemilight/cubemap.hpp"
 #include "hemilight/geometry.hpp"
 #include "hemilight/hemicube.hpp"
 #include "hemilight/image_io.hpp"
@@ -80,6 +79,10 @@
 #include <vector>
 
 namespace hemilight {
+
+// The environment sky of raster_options (hemilight/cubemap.hpp, a module above this one: include
+// it to build or sample one).
+struct cubemap;
 
 /// A read-only view of an RGB(A) float radiance texture over the scene's lightmap UVs. Sampled
 /// bilinearly with clamp-to-edge; texel (x, y) (x = column, y = row of `pixels`) has its centre at
@@ -113,16 +116,6 @@ struct raster_options {
   /// Near-plane distance along each face's forward axis (scene units). 0 = the default,
   /// default_near_distance(scene). Must be finite and >= 0.
   float near_distance = 0.0f;
-  /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it; see the top of this
-  /// header). false selects the scalar reference path; all give bit-identical buffers (tested).
-  bool simd = true;
-  /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked at
-  /// run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine. Bit-identical.
-  bool avx2 = true;
-  /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
-  /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
-  /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build. Bit-identical.
-  bool avx512 = true;
   /// Optional environment sky: texels that hit nothing get sky->sample(world direction of the
   /// texel centre) (seamless bilinear, top level; cubemap.hpp) instead of the scene's constant
   /// sky radiance. The cube map's directions are the scene's world axes (OpenGL face table).
@@ -145,6 +138,24 @@ struct raster_options {
   /// box (material changes all around), 15x on a terrain seen from its own surface
   /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
+
+  /// Diagnostic switches, for comparisons and tests only (not for tuning): every setting gives
+  /// bit-identical buffers (tested), only the speed differs. The defaults pick the fastest kernels
+  /// the CPU has; an engine leaves them alone.
+  struct diagnostic_switches {
+    /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it; see the top of
+    /// this header). false selects the scalar reference path.
+    bool simd = true;
+    /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked
+    /// at run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine.
+    bool avx2 = true;
+    /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
+    /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
+    /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build.
+    bool avx512 = true;
+  };
+  /// Diagnostic switches (see diagnostic_switches): for comparisons only.
+  diagnostic_switches diagnostics = {};
 };
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
@@ -166,6 +177,10 @@ struct raster_statistics {
   std::size_t edge_hard_texels = 0;    ///< edge coverage: texels such an edge may cross (exact there)
 };
 
+namespace raster_detail {
+class rasterizer_impl;  // src/raster_internal.hpp
+}  // namespace raster_detail
+
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
@@ -174,9 +189,9 @@ struct raster_statistics {
 /// per scene edge that may be hard and per crease triangle, 12 more bytes per texel and 32 per
 /// partial (triangle, texel) fragment (~1,000 per hemicube of the Cornell box at N = 64, under
 /// 100 in tessellated rooms).
-/// Cache-line aligned: rasterizers of different threads kept side by side (a std::vector of them)
-/// must not share a line, or the counters one writes slow down the members the other reads.
-class alignas(64) hemicube_rasterizer {
+/// The state lives in a cache-line aligned block of its own (rasterizers of different threads
+/// kept side by side, e.g. a std::vector of them, share no line of it).
+class hemicube_rasterizer {
  public:
   /// Value of seen_triangle() for a texel that sees nothing.
   static constexpr std::uint32_t no_triangle = 0xffffffffu;
@@ -223,138 +238,31 @@ class alignas(64) hemicube_rasterizer {
   /// After render(): the scene triangle (scene_desc numbering) seen through a texel, or
   /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). A debugging and
   /// testing aid; the buffer itself does not carry triangle numbers.
-  /// Precondition: texel < 3 N^2 of the last render (asserted).
+  /// Precondition: texel < 3 N^2 of the last render, and not moved from since (asserted).
   std::uint32_t seen_triangle(std::size_t texel) const noexcept;
 
-  /// The near distance in use (the option, or the scene's default).
-  float near_distance() const noexcept { return near_; }
-  const raster_statistics& statistics() const noexcept { return stats_; }
-  const std::shared_ptr<const scene>& scene_ptr() const noexcept { return scene_; }
+  /// The near distance in use (the option, or the scene's default). Cost: O(1).
+  float near_distance() const noexcept;
+  /// Counters of the last render (raster_statistics). Cost: O(1).
+  const raster_statistics& statistics() const noexcept;
+  /// The scene bound (null after unbind() or a move). Cost: O(1).
+  const std::shared_ptr<const scene>& scene_ptr() const noexcept;
 
-  /// A triangle drawn in the current hemicube, in the local frame (internal, exposed for the
-  /// implementation's helpers). The clipping and big-triangle paths use its geometry; a textured
-  /// render keeps one per draw for the UV pass.
-  struct draw_record {
-    glm::vec3 normal;      ///< (v1 - v0) x (v2 - v0), local frame
-    float plane;           ///< normal . v0 (local; the point is the origin); < 0 for a front face
-    glm::vec3 v0;          ///< first vertex, local frame
-    std::uint32_t index;   ///< scene triangle (scene_desc numbering)
-    glm::vec3 grad_b1;     ///< barycentric b1 = grad_b1 . (q - v0)  (only with a texture)
-    glm::vec3 grad_b2;     ///< barycentric b2 = grad_b2 . (q - v0)
-    bool textured;         ///< UVs + texture: radiance comes from the texture
-  };
-  /// What the resolve pass copies to the texels of a draw (internal): the sky, a back face, or
-  /// the front of a triangle with one of the scene's emissions.
-  struct shade {
-    float r, g, b;
-    std::uint32_t flags;
-  };
+  /// Copies and moves: a copy renders bitwise as the original; it allocates and copies the
+  /// tables and scratch memory (see Memory above; std::bad_alloc if that fails), so copy a
+  /// rasterizer once per thread, not per render. A move is O(1). A moved-from rasterizer holds
+  /// nothing: render() and render_coverage() throw error(invalid_argument) until bind() gives it
+  /// a scene again; near_distance() is 0, statistics() all zero, scene_ptr() null.
+  hemicube_rasterizer(const hemicube_rasterizer& other);
+  hemicube_rasterizer(hemicube_rasterizer&& other) noexcept;
+  hemicube_rasterizer& operator=(const hemicube_rasterizer& other);
+  hemicube_rasterizer& operator=(hemicube_rasterizer&& other) noexcept;
+  ~hemicube_rasterizer();
 
  private:
-  enum class mode { depth, count };
-  void check_arguments(const char* who, const glm::vec3& position, const frame& basis, int resolution) const;
-  void prepare(int resolution);
-  unsigned drop_faces_between_texel_centres(const bvh_node& node, unsigned mask, const glm::vec3& position,
-                                            const frame& basis, bool hard) const;
-  template <mode M>
-  void draw_all(const glm::vec3& position, const frame& basis);
-  template <mode M>
-  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis);
-  template <mode M>
-  void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
-                   const scene::triangle& tri);
-  std::uint32_t commit_record(float plane, const scene::triangle& tri, const draw_record* rec, const frame& basis);
-  struct face_setup;  // per (triangle, face) pair: the depth plane (raster.cpp)
-  template <mode M>
-  void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
-                  draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
-                  const double* exact = nullptr);
-  struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
-  template <mode M>
-  void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
-                      const frame& basis);
-  template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
-  void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
-                        const simd_frame& sf, const frame& basis);
-
-  // Exact edge coverage (raster_options::edge_coverage; raster_edge.cpp).
-  struct edge_fragment {
-    std::uint32_t texel;  // hemicube texel index
-    float z;              // the triangle's 1/w at the texel centre (the depth test's value)
-    float coverage;       // the covered fraction of the texel's weight, [0, 1]
-    std::uint32_t id;     // the draw's texel id (as in ids_)
-  };
-  void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
-                   const face_setup& fs, std::uint32_t draw, bool back);
-  // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
-  // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
-  struct edge_candidate {
-    std::uint32_t triangle;   // scene_->triangles() position
-    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
-    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
-    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
-  };
-  void edge_find_candidates();
-  void edge_mark_hard(const glm::vec3& position, const frame& basis);
-  void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
-  bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
-  std::vector<edge_candidate> edge_candidates_;
-  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
-  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
-  // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
-  // a hard edge may cross texel c (words_per_row_ words a row).
-  std::vector<std::uint64_t> hard_bits_;
-  std::vector<std::uint64_t> silhouette_bits_;  // the same for silhouette edges only
-  std::size_t words_per_row_ = 0;
-  template <class Visit>
-  void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
-  std::vector<float> whole_z_;                // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
-  std::vector<std::uint32_t> whole_id_;       // and its texel id
-  std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
-  std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
-  unsigned hard_faces_ = 0;                   // faces with a hard texel
-  void edge_group_fragments();
-  void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
-  glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
-  bool edge_ = false;
-  std::vector<edge_fragment> fragments_;
-  std::vector<std::uint32_t> fragment_count_;   // per texel: its fragments (0 = none)
-  std::vector<edge_fragment> grouped_;          // fragments_ by texel (edge_groups_ ranges)
-  std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
-  struct edge_group {
-    std::uint32_t texel;
-    std::uint32_t first, count;  // its fragments in grouped_
-  };
-  std::vector<edge_group> edge_groups_;
-
-  std::shared_ptr<const scene> scene_;
-  float near_ = 0.0f;
-  bool simd_ = true;
-  bool avx2_ = false;  // simd_ and the CPU has AVX2
-  bool avx512_ = false;  // avx2_, the option, and the CPU has AVX-512 F, VL, BW and DQ
-  bool depth_clear_ = false;  // depth_ is all zero (the last render's resolve cleared it)
-  std::shared_ptr<const cubemap> sky_;
-  int n_ = 0;
-  double texel_step_ = 0.0, first_centre_ = 0.0;  // 2 / N and 1 / N - 1 (face units)
-  std::vector<float> depth_;           // 1/w of the nearest fragment per texel (0 = none)
-  std::vector<std::uint32_t> ids_;     // draw of the nearest fragment per texel (0 = none; see key_bits_)
-  std::vector<std::uint32_t>* counts_ = nullptr;
-  std::vector<glm::vec3> directions_;  // unit texel-centre directions, local frame
-  std::vector<float> lengths_;         // |a + u c + v r| of each texel centre
-  // Draws: a triangle's first covered texel of a render gives it a draw number, which the texels
-  // it wins hold in ids_ (0 = nothing hit).
-  std::vector<std::uint32_t> draw_keys_;       // per draw: its entry in shades_
-  std::vector<std::uint32_t> draw_triangles_;  // per draw: the scene triangle (seen_triangle)
-  std::vector<draw_record> draws_;             // per draw, textured renders only: the UV pass's data
-  bool textured_ = false;                      // this render samples a texture (draws_ is kept)
-  // [0] the sky, [1] a back face, [2 + e] the front of a triangle with scene emission e: built
-  // once, so a draw needs no radiance of its own and equal radiances share one key.
-  std::vector<shade> shades_;
-  // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
-  // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
-  std::uint32_t key_bits_ = 0;
-  std::vector<std::uint32_t> stack_;
-  raster_statistics stats_;
+  // The state and the drawing code (src/raster_internal.hpp, not installed). Allocated
+  // cache-line aligned: rasterizers of different threads never share a line of it.
+  std::unique_ptr<raster_detail::rasterizer_impl> impl_;
 };
 
 }  // namespace hemilight
