@@ -208,9 +208,9 @@ constexpr std::int64_t simd_extent = 32 * sub_one;
 // extents <= E = 120 texels (30,720 in fixed point), every edge value it forms (texel centres in
 // the triangle's box, or up to 8 texels past it in x), dx (Py - Ay) - dy (Px - Ax) + bias, is at
 // most E^2 + E (E + 2^11) + 1 = 1,950,351,361 < 2^31 - 1: exact in 32-bit lanes, and so are the
-// two products and the signed area of the set-up. (Formerly 64 texels: three in five of
-// the room's triangles over 64 texels across are under 120, and the box scan of their part on the
-// face is cheaper than the exact span walk.)
+// two products and the signed area of the set-up. 120 rather than 64: three in five of the
+// room's triangles over 64 texels across are under 120, and the box scan of their part on the
+// face is cheaper than the exact span walk.
 constexpr std::int64_t avx2_extent = 120 * sub_one;
 
 // See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
@@ -1310,8 +1310,6 @@ inline void scan_box_avx2(const fixed_point (&p)[3], const texel_box& box, int n
     const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
     sx[k] = static_cast<std::int32_t>(-dy * sub_one);
     sy[k] = static_cast<std::int32_t>(dx * sub_one);
-    // (With edge coverage the bias is at most 128 * 2 * 30,720 < 2^23: the bound above grows
-    // to 1,958,215,681, still < 2^31 - 1.)
     base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - tie_bias(dx, dy));
   }
   small_triangle_avx2_impl<count_mode>(base, sx, sy, box.x_begin, box.x_end, box.y_begin, box.y_end, n, target.depth,
