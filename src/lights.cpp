@@ -444,6 +444,117 @@ light_sample direct_light(const scene& s, const light_set& lights, std::size_t i
 }
 
 namespace {
+
+// direct_light_unchecked's visibility of a rect light over its clipped outline (soft shadows),
+// and where the closed form's direction holds, that direction in out.direction.
+visibility_result rect_visibility(const scene& s, const light_set::prepared& L, const light_geometry& g,
+                                  const glm::vec3& p, const glm::vec3& n, const glm::vec3& o, float off,
+                                  std::uint64_t seed, const direct_options& options, light_sample& out,
+                                  bool& closed_direction) {
+  const bool shadows = L.l.casts_shadows;
+  visibility_result v;
+  const glm::vec3 c = L.l.position, t = L.l.tangent * L.l.width, b = L.bitangent * L.l.height, nl = L.l.direction;
+  v = estimate(s, o, options, seed, rect_outline, [&](const glm::vec2& u, probe& pb) {
+    const glm::vec3 q = c + (u.x - 0.5f) * t + (u.y - 0.5f) * b;
+    const glm::vec3 to = q - o;
+    const float d2 = glm::dot(to, to);
+    if (!(d2 > 0.0f)) return;
+    pb.d = to / std::sqrt(d2);
+    const float cos_r = glm::dot(n, pb.d), cos_l = -glm::dot(nl, pb.d);
+    if (!(cos_r > 0.0f) || !(cos_l > 0.0f)) return;
+    pb.rw = cos_l / d2;
+    pb.w = cos_r * pb.rw;
+    pb.visible = true;
+    if (shadows) {  // reaches(s, o, q, off), traced by the estimator
+      const float len = glm::length(to);
+      if (len > off) {
+        pb.trace = true;
+        pb.ray = to;
+        pb.t_max = 1.0f - off / len;
+      }
+    }
+  });
+  closed_direction = v.visibility == 1.0f;
+  if (!v.any_traced) {  // a sliver above the horizon: one ray to the clipped polygon's centroid
+    const glm::vec3 q = p + glm::vec3(g.rect.centroid);
+    const bool visible = !shadows || reaches(s, o, q, off);
+    v.visibility = visible ? 1.0f : 0.0f;
+    closed_direction = visible;
+  }
+  if (closed_direction) out.direction = glm::vec3(glm::normalize(g.rect.phi));
+  return v;
+}
+
+// The same for a cone: the sun's disc, or a sphere light seen from p.
+visibility_result cone_visibility(const scene& s, const light_set::prepared& L, const light_geometry& g,
+                                  const glm::vec3& n, const glm::vec3& o, float off, std::uint64_t seed,
+                                  const direct_options& options, light_sample& out, bool& closed_direction) {
+  const bool shadows = L.l.casts_shadows;
+  visibility_result v;
+  // Cones: the sun's disc, or the sphere seen from p.
+  const bool sun = L.l.type == light_type::directional;
+  const float h_max = sun ? L.one_minus_cos_radius
+                          : static_cast<float>(double(g.sin2a) / (1.0 + std::sqrt(std::max(0.0, 1.0 - double(g.sin2a)))));
+  const float cos_axis = glm::dot(n, g.axis);
+  const bool above = double(cos_axis) > 0.0 && double(cos_axis) * double(cos_axis) >= double(g.sin2a);
+  if (g.inside) {
+    // p inside a sphere light: no ray can leave the light; it is taken as visible.
+    v.visibility = 1.0f;
+    v.any_traced = true;
+    out.direction = g.axis;
+    closed_direction = true;
+  } else {
+    const frame f = make_frame(g.axis);
+    const float r = L.l.radius;
+    v = estimate(s, o, options, seed, cone_outline, [&](const glm::vec2& u, probe& pb) {
+      pb.d = cone_direction(f, h_max, u);
+      const float cos_r = glm::dot(n, pb.d);
+      if (!(cos_r > 0.0f)) return;
+      pb.w = cos_r;
+      pb.rw = 1.0f;
+      pb.visible = true;
+      if (!shadows) return;
+      if (sun) {
+        pb.trace = true;
+        pb.ray = pb.d;
+        pb.t_max = std::numeric_limits<float>::infinity();
+      } else {
+        const float t = sphere_distance(o, pb.d, L.l.position, r) - off;
+        if (t > 0.0f) {
+          pb.trace = true;
+          pb.ray = pb.d;
+          pb.t_max = t;
+        }
+      }
+    });
+    if (!v.any_traced) {  // a sliver above the horizon: one ray to the cone's point nearest the normal
+      const glm::vec3 across = g.axis - cos_axis * n;
+      const float len = glm::length(across);
+      glm::vec3 d = g.axis;
+      if (len > 0.0f) {
+        const float theta = std::acos(std::clamp(cos_axis, -1.0f, 1.0f));
+        const float a = std::asin(std::sqrt(std::min(1.0f, g.sin2a)));
+        const float gamma = std::max(0.0f, theta - 0.999f * a);
+        d = std::cos(gamma) * n + std::sin(gamma) * (across / len);
+      }
+      bool visible = true;
+      if (shadows) {
+        if (sun) {
+          visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
+        } else {
+          const float t = sphere_distance(o, d, L.l.position, r) - off;
+          visible = !(t > 0.0f) || !occluded(s, o, d, t);
+        }
+      }
+      v.visibility = visible ? 1.0f : 0.0f;
+      v.direction = visible ? d : glm::vec3(0.0f);
+    }
+    closed_direction = above && v.visibility == 1.0f;
+    if (closed_direction) out.direction = g.axis;
+  }
+  return v;
+}
+
 // direct_light with the options already checked (direct_irradiance checks them once per point,
 // not once per light).
 light_sample direct_light_unchecked(const scene& s, const light_set& lights, std::size_t i, const glm::vec3& p,
@@ -475,99 +586,10 @@ light_sample direct_light_unchecked(const scene& s, const light_set& lights, std
   const std::uint64_t seed = point_seed(p, n, i);
   visibility_result v;
   bool closed_direction = false;  // the closed form's direction is right (fully visible, fully above)
-  if (L.l.type == light_type::rect) {
-    const glm::vec3 c = L.l.position, t = L.l.tangent * L.l.width, b = L.bitangent * L.l.height, nl = L.l.direction;
-    v = estimate(s, o, options, seed, rect_outline, [&](const glm::vec2& u, probe& pb) {
-      const glm::vec3 q = c + (u.x - 0.5f) * t + (u.y - 0.5f) * b;
-      const glm::vec3 to = q - o;
-      const float d2 = glm::dot(to, to);
-      if (!(d2 > 0.0f)) return;
-      pb.d = to / std::sqrt(d2);
-      const float cos_r = glm::dot(n, pb.d), cos_l = -glm::dot(nl, pb.d);
-      if (!(cos_r > 0.0f) || !(cos_l > 0.0f)) return;
-      pb.rw = cos_l / d2;
-      pb.w = cos_r * pb.rw;
-      pb.visible = true;
-      if (shadows) {  // reaches(s, o, q, off), traced by the estimator
-        const float len = glm::length(to);
-        if (len > off) {
-          pb.trace = true;
-          pb.ray = to;
-          pb.t_max = 1.0f - off / len;
-        }
-      }
-    });
-    closed_direction = v.visibility == 1.0f;
-    if (!v.any_traced) {  // a sliver above the horizon: one ray to the clipped polygon's centroid
-      const glm::vec3 q = p + glm::vec3(g.rect.centroid);
-      const bool visible = !shadows || reaches(s, o, q, off);
-      v.visibility = visible ? 1.0f : 0.0f;
-      closed_direction = visible;
-    }
-    if (closed_direction) out.direction = glm::vec3(glm::normalize(g.rect.phi));
-  } else {
-    // Cones: the sun's disc, or the sphere seen from p.
-    const bool sun = L.l.type == light_type::directional;
-    const float h_max = sun ? L.one_minus_cos_radius
-                            : static_cast<float>(double(g.sin2a) / (1.0 + std::sqrt(std::max(0.0, 1.0 - double(g.sin2a)))));
-    const float cos_axis = glm::dot(n, g.axis);
-    const bool above = double(cos_axis) > 0.0 && double(cos_axis) * double(cos_axis) >= double(g.sin2a);
-    if (g.inside) {
-      // p inside a sphere light: no ray can leave the light; it is taken as visible.
-      v.visibility = 1.0f;
-      v.any_traced = true;
-      out.direction = g.axis;
-      closed_direction = true;
-    } else {
-      const frame f = make_frame(g.axis);
-      const float r = L.l.radius;
-      v = estimate(s, o, options, seed, cone_outline, [&](const glm::vec2& u, probe& pb) {
-        pb.d = cone_direction(f, h_max, u);
-        const float cos_r = glm::dot(n, pb.d);
-        if (!(cos_r > 0.0f)) return;
-        pb.w = cos_r;
-        pb.rw = 1.0f;
-        pb.visible = true;
-        if (!shadows) return;
-        if (sun) {
-          pb.trace = true;
-          pb.ray = pb.d;
-          pb.t_max = std::numeric_limits<float>::infinity();
-        } else {
-          const float t = sphere_distance(o, pb.d, L.l.position, r) - off;
-          if (t > 0.0f) {
-            pb.trace = true;
-            pb.ray = pb.d;
-            pb.t_max = t;
-          }
-        }
-      });
-      if (!v.any_traced) {  // a sliver above the horizon: one ray to the cone's point nearest the normal
-        const glm::vec3 across = g.axis - cos_axis * n;
-        const float len = glm::length(across);
-        glm::vec3 d = g.axis;
-        if (len > 0.0f) {
-          const float theta = std::acos(std::clamp(cos_axis, -1.0f, 1.0f));
-          const float a = std::asin(std::sqrt(std::min(1.0f, g.sin2a)));
-          const float gamma = std::max(0.0f, theta - 0.999f * a);
-          d = std::cos(gamma) * n + std::sin(gamma) * (across / len);
-        }
-        bool visible = true;
-        if (shadows) {
-          if (sun) {
-            visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
-          } else {
-            const float t = sphere_distance(o, d, L.l.position, r) - off;
-            visible = !(t > 0.0f) || !occluded(s, o, d, t);
-          }
-        }
-        v.visibility = visible ? 1.0f : 0.0f;
-        v.direction = visible ? d : glm::vec3(0.0f);
-      }
-      closed_direction = above && v.visibility == 1.0f;
-      if (closed_direction) out.direction = g.axis;
-    }
-  }
+  if (L.l.type == light_type::rect)
+    v = rect_visibility(s, L, g, p, n, o, off, seed, options, out, closed_direction);
+  else
+    v = cone_visibility(s, L, g, n, o, off, seed, options, out, closed_direction);
   out.visibility = v.visibility;
   out.irradiance = g.e * v.visibility;
   if (!closed_direction) {
