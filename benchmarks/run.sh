@@ -10,7 +10,7 @@
 #                                     ward_continuous, first order (docs/cache.md; 15-30 min; not run by default)
 #   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
 #                                     both weights (docs/cache.md; ~25 min; not run by default)
-#   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~5 min; also
+#   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
@@ -120,7 +120,7 @@ for n in "${names[@]}"; do
   fi
   if [ "$n" = edge_downstream ]; then
     # What exact edge coverage buys downstream (docs/raster.md): cost, the cache at a matched hemicube
-    # budget, the N at which a hemicube per point reaches 1%. ~5 min on 2 cores. A subset:
+    # budget, the N at which a hemicube per point reaches 1%. ~2.5 min on 2 cores. A subset:
     # EDGE_DOWNSTREAM_FLAGS="--parts n --scenes cornell" (flags at the top of sweep_edge_downstream.cpp).
     echo "== sweep_edge_downstream"
     # shellcheck disable=SC2086  # the flags are words on purpose
@@ -131,7 +131,7 @@ for n in "${names[@]}"; do
   if [ "$n" = edge ]; then
     # Exact edge coverage against point sampling: accuracy and paired-round cost (docs/raster.md).
     echo "== sweep_edge"
-    "$build/benchmarks/sweep_edge" docs/bench/edge_accuracy.csv docs/bench/edge_cost.csv 5
+    "$build/benchmarks/sweep_edge" docs/bench/edge_accuracy.csv docs/bench/edge_cost.csv 7
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge.py docs/bench
     continue
   fi
