@@ -154,6 +154,12 @@ inline int lowest_bit(std::uint64_t word) noexcept {
 #endif
 }
 
+// The first of `face`'s rows in the per-row hard-texel tables (face 0's N rows, then each side
+// face's N / 2).
+inline std::size_t face_row_base(int n, int face) noexcept {
+  return face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n / 2);
+}
+
 std::uint32_t bits_of(float f) noexcept {
   std::uint32_t b;
   std::memcpy(&b, &f, sizeof b);
@@ -301,7 +307,7 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
     const double x1 = (q1.x / q1.z + 1.0) * half, y1 = (q1.y / q1.z + v_offset) * half;
     const int rows = face == 0 ? n : n / 2;
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
-    const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(rows);
+    const std::size_t row_base = face_row_base(n, face);
     const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
     const int r_first = std::max(0, static_cast<int>(std::floor(ylo - eps)));
     const int r_last = std::min(rows - 1, static_cast<int>(std::floor(yhi + eps)));
@@ -343,7 +349,7 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
 // ranges, then the texels within them). Cost: O(rows + the texels within the rows' ranges).
 bool raster_detail::rasterizer_impl::edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0,
                                            std::int64_t r1) const noexcept {
-  const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n_) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n_ / 2);
+  const std::size_t row_base = face_row_base(n_, face);
   for (std::int64_t r = r0; r <= r1; ++r) {
     const std::size_t row = row_base + static_cast<std::size_t>(r);
     if (hard_rows_[2 * row] > c1 || hard_rows_[2 * row + 1] < c0) continue;
@@ -391,7 +397,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   const int n = n_;
   const int rows = face == 0 ? n : n / 2;
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
-  const std::size_t row_base = face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(rows);
+  const std::size_t row_base = face_row_base(n, face);
   std::int64_t dx[3], dy[3];
   for (int k = 0; k < 3; ++k) {
     const int b = k == 2 ? 0 : k + 1;
