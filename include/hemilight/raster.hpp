@@ -178,7 +178,7 @@ struct raster_statistics {
 };
 
 namespace raster_detail {
-class rasterizer_impl;  // src/raster_internal.hpp
+class rasterizer_impl;  // src/raster/internal.hpp
 }  // namespace raster_detail
 
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
@@ -260,7 +260,7 @@ class hemicube_rasterizer {
   ~hemicube_rasterizer();
 
  private:
-  // The state and the drawing code (src/raster_internal.hpp, not installed). Allocated
+  // The state and the drawing code (src/raster/internal.hpp, not installed). Allocated
   // cache-line aligned: rasterizers of different threads never share a line of it.
   std::unique_ptr<raster_detail::rasterizer_impl> impl_;
 };

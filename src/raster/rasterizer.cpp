@@ -1,5 +1,9 @@
+// The hemicube rasterizer (raster.hpp): binding, traversal and culling, clipping and snapping,
+// the coverage paths of one triangle (draw_fixed) and the resolve. The SIMD kernel sets it
+// dispatches to are in kernels_sse2.hpp, kernels_avx2.hpp and leaf_avx.inl (one translation unit,
+// so the kernels inline where their target allows); exact edge coverage is in edge.cpp.
 #include "hemilight/raster.hpp"
-#include "raster_internal.hpp"
+#include "internal.hpp"
 
 #include "hemilight/cubemap.hpp"
 
@@ -11,23 +15,10 @@
 #include <cstring>
 #include <string>
 
-#if defined(__SSE2__) || defined(_M_X64)
-#include <emmintrin.h>
-#define HEMILIGHT_RASTER_SSE2 1
-#else
-#define HEMILIGHT_RASTER_SSE2 0
-#endif
-// AVX2 kernels (eight texels per step), compiled for AVX2 with a target attribute and picked at
-// run time, so the library itself still runs on any x86-64. GCC and Clang only. The eight-lane
-// set-up is also compiled for AVX-512 (raster_leaf.inl), picked where the CPU has it.
-#if HEMILIGHT_RASTER_SSE2 && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define HEMILIGHT_RASTER_AVX2 1
-#define HEMILIGHT_TARGET_AVX2 __attribute__((target("avx2")))
-#define HEMILIGHT_TARGET_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
-#else
-#define HEMILIGHT_RASTER_AVX2 0
-#endif
+#include "isa.hpp"
+#include "kernel_common.hpp"
+#include "kernels_sse2.hpp"
+#include "kernels_avx2.hpp"
 
 namespace hemilight {
 
@@ -85,15 +76,7 @@ constexpr unsigned face_planes[5] = {
 
 inline unsigned outcode(const glm::vec3& p) noexcept {
 #if HEMILIGHT_RASTER_SSE2
-  // The same twelve differences as below, four per register (x + (-y) is x - y exactly; the sign
-  // of a zero cannot change a "< 0" test), so both versions give the same bits.
-  const __m128 zero = _mm_setzero_ps();
-  const __m128 a = _mm_add_ps(_mm_setr_ps(p.x, p.x, -p.x, -p.x), _mm_setr_ps(-p.y, p.y, -p.y, p.y));
-  const __m128 b = _mm_sub_ps(_mm_setr_ps(p.x, -p.x, p.y, -p.y), _mm_set1_ps(p.z));
-  const __m128 c = _mm_add_ps(_mm_set1_ps(p.z), _mm_setr_ps(-p.x, p.x, -p.y, p.y));
-  return static_cast<unsigned>(p.z < 0) | static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(a, zero))) << 1 |
-         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(b, zero))) << 5 |
-         static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(c, zero))) << 9;
+  return outcode_sse2(p);  // the same bits
 #else
   unsigned c = 0;
   if (p.z < 0) c |= below;
@@ -136,429 +119,7 @@ inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, cons
 }
 
 
-// floor(a / m) for m > 0 and |a|, m < 2^52: a double estimate (off by at most one, both are
-// exact doubles) made exact with integer checks; cheaper than a 64-bit division.
-inline std::int64_t floor_div(std::int64_t a, std::int64_t m) noexcept {
-  auto q = static_cast<std::int64_t>(static_cast<double>(a) / static_cast<double>(m));
-  while (q * m > a) --q;
-  while ((q + 1) * m <= a) ++q;
-  return q;
-}
 
-// Nearest integer, halves away from zero (deterministic, no libm call). |x| < 2^30 here.
-inline std::int64_t round_to_int(double x) noexcept {
-  return static_cast<std::int64_t>(x >= 0.0 ? x + 0.5 : x - 0.5);
-}
-
-// One edge of the exact span walk: the bound on x (left: x >= bound, right: x <= bound) of the
-// current row as quotient and remainder, and their steps per row (see draw_fixed).
-struct edge_walk {
-  std::int64_t bound, rem, m, q_step, r_step;
-};
-
-// Rows y0..y1 of the exact span walk with NL left and NR right edges; span(y, lo, hi) writes a
-// row. The carries are branch-free (sign masks): they are taken in a data-dependent pattern.
-template <std::size_t NL, std::size_t NR, class Span>
-inline void walk_rows(const edge_walk* left_in, const edge_walk* right_in, std::int64_t y0, std::int64_t y1,
-                      std::int64_t x_begin, std::int64_t x_end, Span& span) {
-  edge_walk left[NL], right[NR];
-  std::copy(left_in, left_in + NL, left);
-  std::copy(right_in, right_in + NR, right);
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    std::int64_t lo = x_begin, hi = x_end;
-    for (std::size_t i = 0; i < NL; ++i) {
-      edge_walk& e = left[i];
-      lo = std::max(lo, e.bound);
-      e.rem -= e.r_step;
-      const std::int64_t carry = e.rem >> 63;  // -1 if rem < 0, else 0
-      e.bound += e.q_step - carry;
-      e.rem += carry & e.m;
-    }
-    for (std::size_t i = 0; i < NR; ++i) {
-      edge_walk& e = right[i];
-      hi = std::min(hi, e.bound);
-      e.rem += e.r_step - e.m;
-      const std::int64_t keep = e.rem >> 63;  // -1 if the old rem + r_step < m (no carry)
-      e.bound += e.q_step + 1 + keep;
-      e.rem += keep & e.m;
-    }
-    if (lo <= hi) span(static_cast<int>(y), static_cast<int>(lo), static_cast<int>(hi));
-  }
-}
-
-// walk_rows for the edge counts a triangle with area has: one left and one right bound (with a
-// horizontal edge), or one and two, or two and one. Fixed counts keep the walk in registers.
-template <class Span>
-inline void walk_rows_of(int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
-                         std::int64_t x_begin, std::int64_t x_end, Span& span) {
-  if (nl == 1 && nr == 1)
-    walk_rows<1, 1>(left, right, y0, y1, x_begin, x_end, span);
-  else if (nl == 1 && nr == 2)
-    walk_rows<1, 2>(left, right, y0, y1, x_begin, x_end, span);
-  else if (nl == 2 && nr == 1)
-    walk_rows<2, 1>(left, right, y0, y1, x_begin, x_end, span);
-  else
-    assert(false && "a triangle with area has a left and a right edge");
-}
-
-#if HEMILIGHT_RASTER_SSE2
-// Largest triangle extent (in 1/256 texel) for the 32-bit SSE2 small-triangle path.
-constexpr std::int64_t simd_extent = 32 * sub_one;
-// The same for the AVX2 kernel, which also takes the big triangles of small hemicubes: with both
-// extents <= E = 120 texels (30,720 in fixed point), every edge value it forms (texel centres in
-// the triangle's box, or up to 8 texels past it in x), dx (Py - Ay) - dy (Px - Ax) + bias, is at
-// most E^2 + E (E + 2^11) + 1 = 1,950,351,361 < 2^31 - 1: exact in 32-bit lanes, and so are the
-// two products and the signed area of the set-up. 120 rather than 64: three in five of the
-// room's triangles over 64 texels across are under 120, and the box scan of their part on the
-// face is cheaper than the exact span walk.
-constexpr std::int64_t avx2_extent = 120 * sub_one;
-
-// See the call site. ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
-// E = ex x + ey y + e0; covered iff all three are >= 0.
-template <bool count_mode>
-void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3], const std::int64_t (&e0)[3],
-                              std::int64_t x_begin, std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
-                              float* depth, std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
-                              float dzdx, std::uint32_t draw) noexcept {
-  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
-  __m128i step[3], row[3];
-  for (int k = 0; k < 3; ++k) {
-    // Values at (x_begin + lane, y_begin): exact in int64, small enough for int32 here.
-    const std::int64_t base = ex[k] * x_begin + ey[k] * y_begin + e0[k];
-    row[k] = _mm_setr_epi32(static_cast<std::int32_t>(base), static_cast<std::int32_t>(base + ex[k]),
-                            static_cast<std::int32_t>(base + 2 * ex[k]), static_cast<std::int32_t>(base + 3 * ex[k]));
-    step[k] = _mm_set1_epi32(static_cast<std::int32_t>(4 * ex[k]));
-  }
-  const __m128i dy0 = _mm_set1_epi32(static_cast<std::int32_t>(ey[0])), dy1 = _mm_set1_epi32(static_cast<std::int32_t>(ey[1])),
-                dy2 = _mm_set1_epi32(static_cast<std::int32_t>(ey[2]));
-  const __m128 dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
-  const __m128i id = _mm_set1_epi32(static_cast<std::int32_t>(draw));
-  const int xb = static_cast<int>(x_begin), xe = static_cast<int>(x_end);
-  for (std::int64_t y = y_begin; y <= y_end; ++y) {
-    const std::size_t r = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
-    const __m128 zr = _mm_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
-    __m128i a = row[0], b = row[1], c = row[2];
-    for (int x = xb; x <= xe; x += 4) {
-      // Covered lanes: the OR of the three values has a clear sign bit.
-      const __m128i in = _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(a, b), c), _mm_set1_epi32(-1));
-      a = _mm_add_epi32(a, step[0]);
-      b = _mm_add_epi32(b, step[1]);
-      c = _mm_add_epi32(c, step[2]);
-      if (_mm_movemask_epi8(in) == 0) continue;
-      if (x + 3 >= n) {
-        // Last group of the row would pass the row's end: scalar, lane by lane.
-        alignas(16) std::int32_t m[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(m), in);
-        for (int k = 0; k < 4 && x + k < n; ++k) {
-          if (!m[k]) continue;
-          const std::size_t i = r + static_cast<std::size_t>(x + k);
-          if (count_mode) {
-            ++counts[i];
-            continue;
-          }
-          float z = _mm_cvtss_f32(zr) + dzdx * static_cast<float>(x + k);
-          z = z > FLT_MIN ? z : FLT_MIN;
-          if (z > depth[i]) {
-            depth[i] = z;
-            ids[i] = draw;
-          }
-        }
-        continue;
-      }
-      const std::size_t i = r + static_cast<std::size_t>(x);
-      if (count_mode) {
-        __m128i* cp = reinterpret_cast<__m128i*>(counts + i);
-        _mm_storeu_si128(cp, _mm_sub_epi32(_mm_loadu_si128(cp), in));  // in = -1 where covered
-        continue;
-      }
-      const __m128 xf = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x), lane));
-      const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
-      const __m128 old = _mm_loadu_ps(depth + i);
-      const __m128 closer = _mm_and_ps(_mm_cmpgt_ps(z, old), _mm_castsi128_ps(in));
-      _mm_storeu_ps(depth + i, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
-      __m128i* ip = reinterpret_cast<__m128i*>(ids + i);
-      const __m128i mask = _mm_castps_si128(closer);
-      _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
-    }
-    row[0] = _mm_add_epi32(row[0], dy0);
-    row[1] = _mm_add_epi32(row[1], dy1);
-    row[2] = _mm_add_epi32(row[2], dy2);
-  }
-}
-#endif
-
-// A texel's id -> its entry in shades: the low `bits` bits of the id when the rasterizer packs
-// the key there (rasterizer_impl::key_bits_), else keys[id] (keys: per draw).
-struct key_map {
-  const std::uint32_t* keys;
-  std::uint32_t bits;
-  std::uint32_t operator()(std::uint32_t id) const noexcept { return bits ? id & ((1u << bits) - 1u) : keys[id]; }
-};
-
-// The resolves' per-texel copy (groups of texels with different shades, and the scalar path):
-// the shade (keys[k] indexes shades) copied to the radiance planes and flags.
-inline void copy_shades(const std::uint32_t* keys, std::size_t count, const shade* shades,
-                        float* red, float* green, float* blue, std::uint8_t* flags) noexcept {
-  for (std::size_t k = 0; k < count; ++k) {
-    const shade& sh = shades[keys[k]];
-    red[k] = sh.r;
-    green[k] = sh.g;
-    blue[k] = sh.b;
-    flags[k] = static_cast<std::uint8_t>(sh.flags);
-  }
-}
-
-#if HEMILIGHT_RASTER_AVX2
-// The AVX2 kernels compute exactly what the scalar reference does (the same float operations in
-// the same order; target("avx2") does not enable FMA contraction), so buffers stay bit-identical.
-// They may read and write back up to 7 texels past the last one they own (the rows are contiguous
-// and the visibility buffers are padded by 8): masked lanes store the values they loaded.
-
-// Depth test of the eight texels at depth / ids: where `mask` is set and z is nearer (a larger
-// 1/w), z and `id` win. The common tail of the AVX2 kernels.
-HEMILIGHT_TARGET_AVX2 inline void depth_test8(float* depth, std::uint32_t* ids, __m256 z, __m256 mask,
-                                              __m256 id) noexcept {
-  const __m256 old = _mm256_loadu_ps(depth);
-  const __m256 closer = _mm256_and_ps(_mm256_cmp_ps(z, old, _CMP_GT_OQ), mask);
-  _mm256_storeu_ps(depth, _mm256_blendv_ps(old, z, closer));
-  float* ip = reinterpret_cast<float*>(ids);
-  _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), id, closer));
-}
-
-// Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
-// The depth test of span_avx2 with its constants given (zr: the row's depth, dz: its step per
-// texel, zmin = FLT_MIN, id: the record in every lane), shared with the span walk's functor.
-HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(float* drow, std::uint32_t* irow,
-                                                                               int lo, int hi, __m256 zr, __m256 dz,
-                                                                               __m256 zmin, __m256 id) noexcept {
-  const __m256i end = _mm256_set1_epi32(hi + 1), eight = _mm256_set1_epi32(8);
-  __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
-    const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-    depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
-  }
-}
-
-HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
-                                     std::uint32_t draw) noexcept {
-  span_body_avx2(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN),
-                 _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw))));
-}
-
-// The exact span walk's rows in depth mode (draw_fixed): walk_rows with span_avx2's depth test
-// inlined and its constants set up once per triangle instead of once per row. The same float
-// operations on the same values as span_avx2 and the scalar span, so the same bits.
-struct depth_spans_avx2 {
-  float* depth;
-  std::uint32_t* ids;
-  std::size_t n;
-  double z00, dzdy;
-  __m256 dz, zmin, id;
-  std::size_t spans = 0, fragments = 0;
-
-  HEMILIGHT_TARGET_AVX2 depth_spans_avx2(float* depth_, std::uint32_t* ids_, int n_, double z00_, double dzdy_,
-                                         float dzdx, std::uint32_t draw) noexcept
-      : depth(depth_), ids(ids_), n(static_cast<std::size_t>(n_)), z00(z00_), dzdy(dzdy_),
-        dz(_mm256_set1_ps(dzdx)), zmin(_mm256_set1_ps(FLT_MIN)),
-        id(_mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)))) {}
-
-  HEMILIGHT_TARGET_AVX2 void operator()(int y, int lo, int hi) noexcept {
-    ++spans;
-    fragments += static_cast<std::size_t>(hi - lo + 1);
-    const std::size_t row = static_cast<std::size_t>(y) * n;
-    span_body_avx2(depth + row, ids + row, lo, hi, _mm256_set1_ps(static_cast<float>(z00 + dzdy * y)), dz, zmin, id);
-  }
-};
-
-// The span walk of draw_fixed (see there), depth mode, AVX2. flatten: walk_rows and the span
-// functor are inlined here (an always_inline functor could not be: walk_rows is not AVX2 code).
-HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(
-    int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
-    std::int64_t x_begin, std::int64_t x_end, float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
-    float dzdx, std::uint32_t draw, raster_statistics& stats) noexcept {
-  depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
-  walk_rows_of(nl, nr, left, right, y0, y1, x_begin, x_end, span);
-  stats.spans += span.spans;
-  stats.fragments += span.fragments;
-}
-
-// The small-triangle path of small_triangle_sse2_impl, eight texels per step.
-// base, sx, sy: the 32-bit edge values at the box's first texel (x_begin, y_begin) and their
-// steps per texel in x and y (the caller checks they fit, see avx2_extent).
-template <bool count_mode>
-HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_avx2_body(
-    const std::int32_t* base, const std::int32_t* sx, const std::int32_t* sy, std::size_t stride, std::int64_t x_begin,
-    std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n, float* depth, std::uint32_t* ids,
-    std::uint32_t* counts, double z00, double dzdy, float dzdx, std::uint32_t draw) noexcept {
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  __m256i step[3], row[3], dy[3];
-  for (std::size_t k = 0; k < 3; ++k) {
-    // Values at (x_begin + lane, y_begin); edge k's values are at [k * stride].
-    const std::int32_t b = base[k * stride], ex = sx[k * stride];
-    row[k] = _mm256_add_epi32(_mm256_set1_epi32(b), _mm256_mullo_epi32(_mm256_set1_epi32(ex), lane));
-    step[k] = _mm256_set1_epi32(8 * ex);
-    dy[k] = _mm256_set1_epi32(sy[k * stride]);
-  }
-  const __m256 dz = _mm256_set1_ps(dzdx), zmin = _mm256_set1_ps(FLT_MIN);
-  const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
-  const int xb = static_cast<int>(x_begin), xe = static_cast<int>(x_end);
-  const __m256i end = _mm256_set1_epi32(xe + 1);
-  if (!count_mode && xe - xb < 8) {
-    // One group per row (most triangles of big scenes): the lanes' x, their depth step and the
-    // box mask are the same on every row. The same operations as below, so the same bits.
-    const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(xb), lane);
-    const __m256i box = _mm256_cmpgt_epi32(end, xi);
-    const __m256 zx = _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi));
-    __m256i a = row[0], b = row[1], c = row[2];
-    for (std::int64_t y = y_begin; y <= y_end; ++y) {
-      const __m256i in = _mm256_andnot_si256(_mm256_or_si256(_mm256_or_si256(a, b), c), box);
-      a = _mm256_add_epi32(a, dy[0]);
-      b = _mm256_add_epi32(b, dy[1]);
-      c = _mm256_add_epi32(c, dy[2]);
-      // No test for an empty row: the depth test then stores back what it loaded, and a branch
-      // here mispredicted often enough (slivers, box corners) to cost more than the stores: without
-      // it and the one below, the room renders ~13% faster (interleaved timings; more instructions).
-      const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
-      const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
-      depth_test8(depth + i, ids + i, _mm256_max_ps(_mm256_add_ps(zr, zx), zmin), mask, id);
-    }
-    return;
-  }
-  for (std::int64_t y = y_begin; y <= y_end; ++y) {
-    const std::size_t r = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
-    const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
-    __m256i a = row[0], b = row[1], c = row[2];
-    for (int x = xb; x <= xe; x += 8) {
-      const __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
-      // Covered lanes (the OR of the three edge values has a clear sign bit) inside the box.
-      const __m256i in = _mm256_andnot_si256(_mm256_or_si256(_mm256_or_si256(a, b), c), _mm256_cmpgt_epi32(end, xi));
-      a = _mm256_add_epi32(a, step[0]);
-      b = _mm256_add_epi32(b, step[1]);
-      c = _mm256_add_epi32(c, step[2]);
-      // No test for an empty group either (see the one-group loop above).
-      const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
-      const std::size_t i = r + static_cast<std::size_t>(x);
-      if (count_mode) {
-        __m256i* cp = reinterpret_cast<__m256i*>(counts + i);
-        _mm256_storeu_si256(cp, _mm256_sub_epi32(_mm256_loadu_si256(cp), _mm256_castps_si256(mask)));
-        continue;
-      }
-      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-      depth_test8(depth + i, ids + i, z, mask, id);
-    }
-    row[0] = _mm256_add_epi32(row[0], dy[0]);
-    row[1] = _mm256_add_epi32(row[1], dy[1]);
-    row[2] = _mm256_add_epi32(row[2], dy[2]);
-  }
-}
-
-// small_triangle_avx2_body as a function (for draw_fixed, outside the AVX2 set-up).
-template <bool count_mode>
-HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, const std::int32_t* sx,
-                                                    const std::int32_t* sy, std::int64_t x_begin, std::int64_t x_end,
-                                                    std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
-                                                    std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
-                                                    float dzdx, std::uint32_t draw) noexcept {
-  small_triangle_avx2_body<count_mode>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
-                                       dzdy, dzdx, draw);
-}
-
-// The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
-// texels are left to the caller. Runs are found by shade key (the draw's entry in shades), so the
-// two triangles of a quad, or all black surfaces, make one run. packed: the key is the id's low
-// `bits` bits (no lookup); otherwise keys[id].
-template <bool packed>
-HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restrict depth,
-                                               const float* __restrict lengths, std::uint32_t* __restrict ids,
-                                               const shade* __restrict shades,
-                                               const std::uint32_t* __restrict keys, std::uint32_t bits,
-                                               float* __restrict distance,
-                                               float* __restrict red, float* __restrict green,
-                                               float* __restrict blue, std::uint8_t* __restrict flags) noexcept {
-  const __m256 zero = _mm256_setzero_ps();
-  // The current run: its shade key, and its record when all its texels so far had one record
-  // (a cheap first test); -1 = none (record numbers are < 2^31).
-  __m256i run_id = _mm256_set1_epi32(-1), run_key = _mm256_set1_epi32(-1);
-  const __m256i key_mask = _mm256_set1_epi32(static_cast<int>((1u << bits) - 1u));
-  __m256 run_r = zero, run_g = zero, run_b = zero;
-  std::uint64_t run_flags = 0;
-  for (std::size_t i = 0; i + 8 <= count; i += 8) {
-    const __m256 d = _mm256_loadu_ps(depth + i);
-    _mm256_storeu_ps(depth + i, zero);  // cleared for the next render
-    _mm256_storeu_ps(distance + i, _mm256_div_ps(_mm256_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
-    const __m256i id = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ids + i)),
-                                        _mm256_castps_si256(_mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ids + i), id);
-    __m256i key, this_run = run_id;
-    bool same_run;
-    if (packed) {
-      key = _mm256_and_si256(id, key_mask);
-      same_run = _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1;
-    } else if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(id, run_id)) == -1) {
-      same_run = true;
-    } else {
-      // Eight texels of one record (most groups: big triangles, black walls) look up its key
-      // with one load; only groups of several records gather (slow on some CPUs). Either way the
-      // run remembers the record, so the next group of the same record skips the lookup.
-      const __m256i id0 = _mm256_broadcastd_epi32(_mm256_castsi256_si128(id));
-      const bool one_record = _mm256_movemask_epi8(_mm256_cmpeq_epi32(id, id0)) == -1;
-      key = one_record ? _mm256_set1_epi32(static_cast<int>(keys[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(id))]))
-                       : _mm256_i32gather_epi32(reinterpret_cast<const int*>(keys), id, 4);
-      this_run = one_record ? id0 : _mm256_set1_epi32(-1);
-      same_run = _mm256_movemask_epi8(_mm256_cmpeq_epi32(key, run_key)) == -1;
-      run_id = this_run;  // same shade (maybe other records): the run goes on
-    }
-    if (!same_run) {
-      const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(key));
-      const __m256i is_first = _mm256_cmpeq_epi32(key, first);
-      if (_mm256_movemask_epi8(is_first) != -1) {  // (never for a group of one record)
-        run_id = run_key = _mm256_set1_epi32(-1);
-        // Two shades (a group across the boundary of two regions, the usual mixed group): the
-        // first lane's and the last lane's, blended.
-        const __m256i last = _mm256_permutevar8x32_epi32(key, _mm256_set1_epi32(7));
-        if (_mm256_movemask_epi8(_mm256_or_si256(is_first, _mm256_cmpeq_epi32(key, last))) == -1) {
-          const shade& s0 = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-          const shade& s1 = shades[static_cast<std::uint32_t>(_mm256_extract_epi32(key, 7))];
-          const __m256 m = _mm256_castsi256_ps(is_first);
-          _mm256_storeu_ps(red + i, _mm256_blendv_ps(_mm256_set1_ps(s1.r), _mm256_set1_ps(s0.r), m));
-          _mm256_storeu_ps(green + i, _mm256_blendv_ps(_mm256_set1_ps(s1.g), _mm256_set1_ps(s0.g), m));
-          _mm256_storeu_ps(blue + i, _mm256_blendv_ps(_mm256_set1_ps(s1.b), _mm256_set1_ps(s0.b), m));
-          // Byte k of `pick` is 0xff where lane k has the first shade: byte 0 of each lane's mask.
-          const __m256i bytes = _mm256_shuffle_epi8(
-              is_first, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1,
-                                         -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
-          const std::uint64_t pick =
-              static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_castsi256_si128(bytes))) |
-              static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm256_extracti128_si256(bytes, 1))))
-                  << 32;
-          const std::uint64_t f0 = (s0.flags & 0xffu) * 0x0101010101010101ull, f1 = (s1.flags & 0xffu) * 0x0101010101010101ull;
-          const std::uint64_t f = (f0 & pick) | (f1 & ~pick);
-          std::memcpy(flags + i, &f, 8);
-          continue;
-        }
-        // More shades: texel by texel.
-        alignas(32) std::uint32_t lane[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lane), key);
-        copy_shades(lane, 8, shades, red + i, green + i, blue + i, flags + i);
-        continue;
-      }
-      // A new run of shade key `first`.
-      run_key = first;
-      run_id = this_run;
-      const shade& sh = shades[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(key))];
-      run_r = _mm256_set1_ps(sh.r);
-      run_g = _mm256_set1_ps(sh.g);
-      run_b = _mm256_set1_ps(sh.b);
-      run_flags = (sh.flags & 0xffu) * 0x0101010101010101ull;
-    }
-    _mm256_storeu_ps(red + i, run_r);
-    _mm256_storeu_ps(green + i, run_g);
-    _mm256_storeu_ps(blue + i, run_b);
-    std::memcpy(flags + i, &run_flags, 8);
-  }
-}
-#endif
 
 // The resolve loops, with restrict pointers so that the byte stores of the flags do not force
 // reloads (char stores may alias anything). Texels never written have depth 0 (their id is
@@ -570,50 +131,7 @@ void resolve_texels(std::size_t count, float* __restrict depth, const float* __r
                     float* __restrict blue, std::uint8_t* __restrict flags, bool simd) noexcept {
   std::size_t i = 0;
 #if HEMILIGHT_RASTER_SSE2
-  if (simd) {
-    // Four texels at a time: distance, id of unwritten texels -> 0, radiance, flags. Texels come
-    // in runs that see the same record (a triangle, or the sky): when four neighbours share one,
-    // its channels go out as three broadcast stores, kept while the record does not change, and
-    // its flags as one word; mixed groups are written texel by texel.
-    const __m128 zero = _mm_setzero_ps();
-    __m128i run_id = _mm_set1_epi32(-1);  // no record yet (record numbers are < 2^31)
-    __m128 run_r = zero, run_g = zero, run_b = zero;
-    std::uint32_t run_flags = 0;
-    for (; i + 4 <= count; i += 4) {
-      const __m128 d = _mm_loadu_ps(depth + i);
-      _mm_storeu_ps(depth + i, zero);  // cleared for the next render
-      _mm_storeu_ps(distance + i, _mm_div_ps(_mm_loadu_ps(lengths + i), d));  // +inf for 1/w = 0
-      const __m128i id = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)),
-                                       _mm_castps_si128(_mm_cmpgt_ps(d, zero)));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(ids + i), id);
-      bool uniform = true;
-      if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, run_id)) != 0xffff) {
-        const __m128i first = _mm_shuffle_epi32(id, 0);
-        if (_mm_movemask_epi8(_mm_cmpeq_epi32(id, first)) == 0xffff) {
-          run_id = first;
-          const shade& sh = shades[key_of(static_cast<std::uint32_t>(_mm_cvtsi128_si32(id)))];
-          run_r = _mm_set1_ps(sh.r);
-          run_g = _mm_set1_ps(sh.g);
-          run_b = _mm_set1_ps(sh.b);
-          run_flags = (sh.flags & 0xffu) * 0x01010101u;
-        } else {
-          run_id = _mm_set1_epi32(-1);
-          uniform = false;
-        }
-      }
-      if (uniform) {
-        _mm_storeu_ps(red + i, run_r);
-        _mm_storeu_ps(green + i, run_g);
-        _mm_storeu_ps(blue + i, run_b);
-        std::memcpy(flags + i, &run_flags, 4);
-        continue;
-      }
-      std::uint32_t lane[4];
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(lane), id);
-      for (std::uint32_t& k : lane) k = key_of(k);
-      copy_shades(lane, 4, shades, red + i, green + i, blue + i, flags + i);
-    }
-  }
+  if (simd) i = resolve_texels_sse2(count, depth, lengths, ids, shades, key_of, distance, red, green, blue, flags);
 #endif
   // Scalar reference (and tail): the same values.
   for (; i < count; ++i) {
@@ -941,41 +459,6 @@ unsigned raster_detail::rasterizer_impl::drop_faces_between_texel_centres(const 
 }
 
 
-#if HEMILIGHT_RASTER_AVX2
-// The position and the frame's axes, broadcast once per render for draw_leaf_avx2, and the
-// scene's per-coordinate vertex arrays.
-struct raster_detail::simd_frame {
-  __m256 p[3];              // each component of the position in all eight lanes
-  __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
-  const float* coordinates[3][3];  // scene::vertex_coordinates(vertex, axis)
-
-  HEMILIGHT_TARGET_AVX2 void set(const glm::vec3& position, const frame& basis, const scene& s) noexcept {
-    for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < 3; ++k) coordinates[i][k] = s.vertex_coordinates(i, k);
-    for (int k = 0; k < 3; ++k) {
-      p[k] = _mm256_set1_ps(position[k]);
-      t[k] = _mm256_set1_ps(basis.t[k]);
-      b[k] = _mm256_set1_ps(basis.b[k]);
-      n[k] = _mm256_set1_ps(basis.n[k]);
-    }
-  }
-};
-
-namespace {
-// frame::to_local's dot(w, axis) = (w.x axis.x + w.y axis.y) + w.z axis.z, eight lanes.
-HEMILIGHT_TARGET_AVX2 inline __m256 dot8(const __m256 (&w)[3], const __m256 (&axis)[3]) noexcept {
-  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w[0], axis[0]), _mm256_mul_ps(w[1], axis[1])),
-                       _mm256_mul_ps(w[2], axis[2]));
-}
-HEMILIGHT_TARGET_AVX2 inline __m256 negative8(__m256 m) noexcept {
-  return _mm256_cmp_ps(m, _mm256_setzero_ps(), _CMP_LT_OQ);
-}
-HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
-  return _mm256_cmp_ps(m, _mm256_setzero_ps(), _CMP_GT_OQ);
-}
-}  // namespace
-
-#endif
 
 template <rasterizer_impl::mode M>
 void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const frame& basis) {
@@ -1058,14 +541,14 @@ void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, u
 #define HEMILIGHT_LEAF_NAME draw_leaf_avx2
 #define HEMILIGHT_LEAF_TARGET HEMILIGHT_TARGET_AVX2
 #define HEMILIGHT_LEAF_WIDE 0
-#include "raster_leaf.inl"
+#include "leaf_avx.inl"
 #undef HEMILIGHT_LEAF_NAME
 #undef HEMILIGHT_LEAF_TARGET
 #undef HEMILIGHT_LEAF_WIDE
 #define HEMILIGHT_LEAF_NAME draw_leaf_avx512
 #define HEMILIGHT_LEAF_TARGET HEMILIGHT_TARGET_AVX512
 #define HEMILIGHT_LEAF_WIDE 1
-#include "raster_leaf.inl"
+#include "leaf_avx.inl"
 #undef HEMILIGHT_LEAF_NAME
 #undef HEMILIGHT_LEAF_TARGET
 #undef HEMILIGHT_LEAF_WIDE
@@ -1116,10 +599,7 @@ void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&loc
     const clip_vertex& c = poly[i];
     const float gw = guard_band * c.w;
 #if HEMILIGHT_RASTER_SSE2
-    // gw + (-u) is gw - u exactly: the same bits as the scalar expressions.
-    const __m128 d = _mm_add_ps(_mm_set1_ps(gw), _mm_setr_ps(-c.u, c.u, -c.v, c.v));
-    const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) |
-                          static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps()))) << 1;
+    const unsigned code = clip_codes_sse2(c, gw, near);  // the same bits
 #else
     const unsigned code = static_cast<unsigned>(c.w - near < 0.0f) | static_cast<unsigned>(gw - c.u < 0.0f) << 1 |
                           static_cast<unsigned>(gw + c.u < 0.0f) << 2 | static_cast<unsigned>(gw - c.v < 0.0f) << 3 |
@@ -1259,23 +739,7 @@ struct span_writer {
     }
 #endif
 #if HEMILIGHT_RASTER_SSE2
-    if (simd && hi - lo >= 3) {
-      // Four texels at a time; the same operations in the same order as the scalar loop below,
-      // so the results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like
-      // the scalar select.
-      const __m128 zr = _mm_set1_ps(zrow), dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
-      const __m128i id = _mm_set1_epi32(static_cast<int>(draw)), lane = _mm_setr_epi32(0, 1, 2, 3);
-      for (; x + 3 <= hi; x += 4) {
-        const __m128 xf = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(x), lane));
-        const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
-        const __m128 old = _mm_loadu_ps(drow + x);
-        const __m128 closer = _mm_cmpgt_ps(z, old);
-        _mm_storeu_ps(drow + x, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
-        __m128i* ip = reinterpret_cast<__m128i*>(irow + x);
-        const __m128i mask = _mm_castps_si128(closer);
-        _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
-      }
-    }
+    if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw);
 #endif
     // The scalar reference path (and the tail of the SIMD one).
     for (; x <= hi; ++x) {

@@ -1,7 +1,7 @@
 // Internal to the rasterizer (src/raster*.cpp): the fixed-point grid, the faces' clip space, the
 // per-(triangle, face) depth set-up, and the rasterizer's state and drawing code
-// (rasterizer_impl, which hemicube_rasterizer holds), shared by the coverage paths (raster.cpp)
-// and exact edge coverage (raster_edge.cpp). Not installed.
+// (rasterizer_impl, which hemicube_rasterizer holds), shared by the coverage paths (rasterizer.cpp)
+// and exact edge coverage (edge.cpp). Not installed.
 #pragma once
 
 #include "hemilight/raster.hpp"
@@ -107,7 +107,7 @@ struct face_setup {
   }
 };
 
-struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (raster.cpp)
+struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (kernels_avx2.hpp)
 
 // The state and drawing code of a hemicube_rasterizer (raster.hpp): the public class holds one
 // of these and forwards to it. The hot code is member functions of this class, so nothing in
@@ -152,11 +152,11 @@ class alignas(64) rasterizer_impl {
   template <mode M>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis);
-  template <mode M>  // the same, compiled for AVX-512 (raster_leaf.inl)
+  template <mode M>  // the same, compiled for AVX-512 (leaf_avx.inl)
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
-  // Exact edge coverage (raster_options::edge_coverage; raster_edge.cpp).
+  // Exact edge coverage (raster_options::edge_coverage; edge.cpp).
   struct edge_fragment {
     std::uint32_t texel;  // hemicube texel index
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
@@ -166,7 +166,7 @@ class alignas(64) rasterizer_impl {
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
   // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
-  // silhouettes); only texels they may cross need exact coverage (raster_edge.cpp, "Hard edges").
+  // silhouettes); only texels they may cross need exact coverage (edge.cpp, "Hard edges").
   struct edge_candidate {
     std::uint32_t triangle;   // scene_->triangles() position
     std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)

@@ -1,7 +1,7 @@
 // Exact edge coverage (raster_options::edge_coverage; docs/raster.md, "Exact edge coverage"): the
 // partial texels of each drawn triangle, their front-to-back resolve and blend.
 #include "hemilight/raster.hpp"
-#include "raster_internal.hpp"
+#include "internal.hpp"
 
 #include "hemilight/cubemap.hpp"
 

@@ -1,7 +1,7 @@
 // The eight-lane set-up of the AVX2 path (draw_leaf_avx2 and draw_leaf_avx512), included twice
-// by raster.cpp: once compiled for AVX2 and once for AVX-512 (VL, BW, DQ: the same 256-bit code
+// by rasterizer.cpp: once compiled for AVX2 and once for AVX-512 (VL, BW, DQ: the same 256-bit code
 // with 32 registers and EVEX encodings). HEMILIGHT_LEAF_NAME and HEMILIGHT_LEAF_TARGET name the
-// member and its target attribute. raster.cpp is compiled with -ffp-contract=off, so the
+// member and its target attribute. rasterizer.cpp is compiled with -ffp-contract=off, so the
 // AVX-512 build (whose target includes FMA) forms no fused multiply-adds: both builds compute
 // the same bits as the scalar path (tested).
 // draw_triangle for the AVX2 path, up to eight triangles at a time (a BVH leaf): the same results,
