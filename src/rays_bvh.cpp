@@ -16,6 +16,7 @@
 // Compiled with -ffp-contract=off (CMakeLists.txt): the edge functions of two triangles that share
 // an edge must be exact negations of each other, which a fused multiply-add would break.
 #include "rays_internal.hpp"
+#include "scene_internal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -56,7 +57,7 @@ bool make_setup(const scene& s, const glm::vec3& origin, const glm::vec3& d, flo
     r.ow[i] = origin[i];
     const float di = std::fabs(d[i]) < min_abs_direction ? std::copysign(min_abs_direction, d[i]) : d[i];
     r.inv[i] = 1.0f / di;
-    for (int v = 0; v < 3; ++v) r.c[v][i] = s.vertex_coordinates(v, k[i]);
+    for (int v = 0; v < 3; ++v) r.c[v][i] = detail::scene_access::vertex_coordinates(s, v, k[i]);
   }
   r.sx = d[kx] / d[kz];
   r.sy = d[ky] / d[kz];

@@ -184,7 +184,7 @@ void scene::index_emissions() {
 
 void scene::build_bvh() {
   nodes_.clear();
-  coordinates_.assign(9 * 8, 0.0f);  // vertex_coordinates() of an empty scene: the padding only
+  coordinates_.assign(9 * 8, 0.0f);  // scene_access::vertex_coordinates of an empty scene: the padding only
   if (triangles_.empty()) return;
   const std::size_t count = triangles_.size();
   std::vector<glm::vec3> centroid(count), tlo(count), thi(count);
@@ -250,7 +250,7 @@ void scene::build_bvh() {
   std::vector<triangle> sorted(count);
   for (std::size_t i = 0; i < count; ++i) sorted[i] = triangles_[order[i]];
   triangles_.swap(sorted);
-  // The same coordinates, one array each (vertex_coordinates()), zero-padded by 8.
+  // The same coordinates, one array each (detail::scene_access::vertex_coordinates), zero-padded by 8.
   const std::size_t stride = count + 8;
   coordinates_.assign(9 * stride, 0.0f);
   for (std::size_t i = 0; i < count; ++i) {

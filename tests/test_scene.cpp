@@ -3,6 +3,7 @@
 // closed forms written here, and edge-incidence counting done in the test.
 #include "hemilight/reference_scenes.hpp"
 #include "hemilight/scene.hpp"
+#include "scene_internal.hpp"  // the SIMD vertex arrays (src/)
 
 #include <catch2/catch.hpp>
 
@@ -281,13 +282,13 @@ TEST_CASE("scene: emissions() holds each distinct emission once, bit for bit, an
   CHECK(s->emission_index(0) != s->emission_index(4));
 }
 
-TEST_CASE("scene: vertex_coordinates() repeats triangles() per coordinate, padded by eight zeros", "[scene]") {
+TEST_CASE("scene: the SIMD vertex arrays (scene_access::vertex_coordinates) repeat triangles() per coordinate, padded by eight zeros", "[scene]") {
   for (const scene_mesh& m : {heightfield(500), cornell_box(), scene_mesh{}}) {
     const auto s = scene::create(m.desc());
     const auto& tris = s->triangles();
     for (int v = 0; v < 3; ++v)
       for (int a = 0; a < 3; ++a) {
-        const float* c = s->vertex_coordinates(v, a);
+        const float* c = detail::scene_access::vertex_coordinates(*s, v, a);
         for (std::size_t t = 0; t < tris.size(); ++t) {
           const glm::vec3& p = v == 0 ? tris[t].v0 : (v == 1 ? tris[t].v1 : tris[t].v2);
           REQUIRE(std::memcmp(&c[t], &p[a], sizeof(float)) == 0);

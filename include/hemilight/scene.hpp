@@ -32,6 +32,7 @@ namespace hemilight {
 namespace detail {
 struct ray_accel;   // rays.hpp's Embree scene, built on the first ray query (src/rays_internal.hpp)
 struct ray_access;
+struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene_internal.hpp)
 }  // namespace detail
 
 /// Per-triangle material: what the hemicube sees of a triangle and what a bounce needs.
@@ -162,13 +163,6 @@ class scene {
   /// Drawable triangles in BVH order, and the BVH (node 0 is the root; empty if no triangle).
   const std::vector<triangle>& triangles() const noexcept { return triangles_; }
   const std::vector<bvh_node>& bvh() const noexcept { return nodes_; }
-  /// The vertex coordinates of triangles() again, one array per coordinate: vertex_coordinates(v, a)[t]
-  /// is coordinate a (0 = x, 1 = y, 2 = z) of vertex v (0, 1, 2) of triangles()[t], bit for bit.
-  /// Each array has 8 entries of padding after the last triangle, so SIMD code loads eight
-  /// consecutive triangles without gathers. Precondition: v, a in [0, 2].
-  const float* vertex_coordinates(int v, int a) const noexcept {
-    return coordinates_.data() + static_cast<std::size_t>(3 * v + a) * (triangles_.size() + 8);
-  }
 
   /// Largest number of triangles in a BVH leaf. Coarse on purpose: the rasterizer's AVX2 set-up
   /// tests eight triangles of a leaf for less than a node visit costs (docs/raster.md). The BVH
@@ -190,7 +184,8 @@ class scene {
   glm::vec3 lo_{0.0f}, hi_{0.0f};
   float size_ = 0.0f;
   std::vector<triangle> triangles_;
-  std::vector<float> coordinates_;  // vertex_coordinates(): 9 arrays of triangles_.size() + 8
+  std::vector<float> coordinates_;  // detail::scene_access::vertex_coordinates: 9 arrays of triangles_.size() + 8
+  friend struct detail::scene_access;
   std::vector<bvh_node> nodes_;
   // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
   friend struct detail::ray_access;

@@ -6,6 +6,7 @@
 
 #include "isa.hpp"
 #include "kernel_common.hpp"
+#include "../scene_internal.hpp"
 
 #include <cfloat>
 #include <cstddef>
@@ -286,11 +287,11 @@ HEMILIGHT_TARGET_AVX2 void resolve_texels_avx2(std::size_t count, float* __restr
 struct raster_detail::simd_frame {
   __m256 p[3];              // each component of the position in all eight lanes
   __m256 t[3], b[3], n[3];  // each component of t, b, n in all eight lanes
-  const float* coordinates[3][3];  // scene::vertex_coordinates(vertex, axis)
+  const float* coordinates[3][3];  // detail::scene_access::vertex_coordinates(s, vertex, axis)
 
   HEMILIGHT_TARGET_AVX2 void set(const glm::vec3& position, const frame& basis, const scene& s) noexcept {
     for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < 3; ++k) coordinates[i][k] = s.vertex_coordinates(i, k);
+      for (int k = 0; k < 3; ++k) coordinates[i][k] = detail::scene_access::vertex_coordinates(s, i, k);
     for (int k = 0; k < 3; ++k) {
       p[k] = _mm256_set1_ps(position[k]);
       t[k] = _mm256_set1_ps(basis.t[k]);

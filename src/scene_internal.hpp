@@ -1,0 +1,25 @@
+// Internal to hemilight (not installed): the scene's per-coordinate vertex arrays, which only the
+// SIMD paths read (the rasterizer's eight-lane set-up, the ray queries' fallback traversal). The
+// tests include this header to check the arrays against scene::triangles().
+#pragma once
+
+#include "hemilight/scene.hpp"
+
+#include <cstddef>
+
+namespace hemilight {
+namespace detail {
+
+struct scene_access {
+  /// The vertex coordinates of s.triangles() again, one array per coordinate:
+  /// vertex_coordinates(s, v, a)[t] is coordinate a (0 = x, 1 = y, 2 = z) of vertex v (0, 1, 2) of
+  /// s.triangles()[t], bit for bit. Each array has 8 entries of zero padding after the last
+  /// triangle, so SIMD code loads eight consecutive triangles without gathers.
+  /// Precondition: v, a in [0, 2]. Cost: O(1).
+  static const float* vertex_coordinates(const scene& s, int v, int a) noexcept {
+    return s.coordinates_.data() + static_cast<std::size_t>(3 * v + a) * (s.triangles_.size() + 8);
+  }
+};
+
+}  // namespace detail
+}  // namespace hemilight
