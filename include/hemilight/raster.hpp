@@ -80,8 +80,8 @@
 
 namespace hemilight {
 
-// The environment sky of raster_options (hemilight/cubemap.hpp, a module above this one: include
-// it to build or sample one).
+// The environment sky of raster_options (hemilight/cubemap.hpp: include it to build or sample
+// one). Only declared here: the rasterizer's callers need not compile the cube-map module.
 struct cubemap;
 
 /// A read-only view of an RGB(A) float radiance texture over the scene's lightmap UVs. Sampled
