@@ -21,13 +21,19 @@ using namespace raster_detail;
 
 namespace {
 
-// square_part_inside (below) for one clipping edge f0 + gx x + gy y >= 0: the polygon's shoelace terms, edge by edge: the inside part of each side of
-// the square (an interval of it: a half-plane cuts a segment once), then the cut itself, from
-// where the boundary leaves the half-plane to where it comes back. Selects, no branches.
-double square_part_inside_one(double f0, double gx, double gy, double wx, double wy) noexcept {
+// square_part_inside (below) for one clipping edge f0 + gx x + gy y >= 0, with rgx = 1 / gx and
+// rgy = 1 / gy (made once per triangle edge; infinite for a zero step, never selected then: a
+// side can only be crossed where its step is nonzero): the polygon's shoelace terms, edge by
+// edge: the inside part of each side of the square (an interval of it: a half-plane cuts a
+// segment once), then the cut itself, from where the boundary leaves the half-plane to where it
+// comes back. The crossing of a side runs t = value / (value - next value) along it, and
+// value - next value is -gx, -gy, gx, gy on the bottom, right, top and left sides: multiplies by
+// the reciprocals, no division. Selects, no branches.
+double square_part_inside_one(double f0, double gx, double gy, double rgx, double rgy, double wx, double wy) noexcept {
   const double cx[4] = {-0.5, 0.5, 0.5, -0.5}, cy[4] = {-0.5, -0.5, 0.5, 0.5};  // corners about the centre
   double value[4];
   for (int i = 0; i < 4; ++i) value[i] = f0 + gx * (cx[i] + 0.5) + gy * (cy[i] + 0.5);
+  const double step[4] = {-rgx, -rgy, rgx, rgy};  // 1 / (value[i] - value[i + 1]) per side
   double twice = 0.0, mx = 0.0, my = 0.0;
   double out_x = 0.0, out_y = 0.0, in_x = 0.0, in_y = 0.0;  // where the boundary leaves and re-enters
   const auto term = [&](double ax, double ay, double bx, double by) {
@@ -39,8 +45,8 @@ double square_part_inside_one(double f0, double gx, double gy, double wx, double
   for (int i = 0; i < 4; ++i) {
     const int j = (i + 1) & 3;
     const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
-    const double d = value[i] - value[j];
-    const double t = in_i != in_j ? value[i] / d : 0.0;
+    // (Clamped: the product may round past the side's end, or overflow for a tiny step.)
+    const double t = in_i != in_j ? std::min(std::max(value[i] * step[i], 0.0), 1.0) : 0.0;
     const double hx = cx[i] + t * (cx[j] - cx[i]), hy = cy[i] + t * (cy[j] - cy[i]);  // the crossing
     const double ax = in_i ? cx[i] : hx, ay = in_i ? cy[i] : hy;
     const double bx = in_j ? cx[j] : hx, by = in_j ? cy[j] : hy;
@@ -51,7 +57,7 @@ double square_part_inside_one(double f0, double gx, double gy, double wx, double
     in_y = !in_i && in_j ? hy : in_y;
   }
   term(out_x, out_y, in_x, in_y);  // (zero when the square is all in or all out)
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
 // The part of the unit square [0, 1]^2 (a texel, in texel units) inside the half-planes
@@ -60,14 +66,11 @@ double square_part_inside_one(double f0, double gx, double gy, double wx, double
 // about the square's centre (the shoelace formula and its moment form), weighted by the density
 // 1 + wx (x - 1/2) + wy (y - 1/2). Double precision: within ~1e-15 of the exact value for the
 // snapped triangle. The square's own moments vanish, so the values of two triangles sharing an
-// edge sum to those of their union.
+// edge sum to those of their union. (One cutting edge, most partial texels, goes to
+// square_part_inside_one instead: the same polygon without divisions.)
 double square_part_inside(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3], unsigned clip,
                           double wx, double wy) noexcept {
   if (clip == 0) return 1.0;  // the whole square (its moments vanish): what the loops below give
-  if ((clip & (clip - 1)) == 0) {  // one edge (most partial texels): the same polygon, branch-free
-    const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
-    return square_part_inside_one(f0[k], gx[k], gy[k], wx, wy);
-  }
   double ax_[8] = {0.0, 1.0, 1.0, 0.0}, ay_[8] = {0.0, 0.0, 1.0, 1.0};
   double bx_[8], by_[8];
   double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;  // the polygon, and the next one (swapped)
@@ -106,7 +109,7 @@ double square_part_inside(const double (&f0)[3], const double (&gx)[3], const do
     mx += (ax + bx) * cross;
     my += (ay + by) * cross;
   }
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
 }  // namespace
@@ -246,7 +249,35 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
   edge_facing_.assign(edge_planes_.size(), 0);
 }
 
+// The slopes of each texel's weight density (edge_density_), once per resolution (and the
+// per-texel front_cover_, front_z_ sized). The
+// integrator weights a texel by the projected solid angle over it, of density (1 + u^2 + v^2)^-2
+// on the top face (z = 1) and v (1 + u^2 + v^2)^-2 on the side faces (v = height); relative to
+// the centre's and per texel unit, its derivatives there are wx = -4 u / q step and
+// wy = -4 v / q step (top) or (1 / v - 4 v / q) step (sides), q = 1 + u^2 + v^2, step = 2 / N.
+void raster_detail::rasterizer_impl::edge_make_density() {
+  const int n = n_;
+  edge_density_.resize(2 * hemicube_texel_count(n));
+  front_cover_.resize(hemicube_texel_count(n));
+  front_z_.resize(hemicube_texel_count(n));
+  for (int face = 0; face < 5; ++face) {
+    const int rows = face == 0 ? n : n / 2;
+    const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < n; ++c) {
+        const double u = first_centre_ + texel_step_ * static_cast<double>(c);
+        const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
+        const double q = 1.0 + u * u + v * v;
+        const std::size_t texel = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
+        edge_density_[2 * texel] = static_cast<float>(-4.0 * u / q * texel_step_);
+        edge_density_[2 * texel + 1] = static_cast<float>((face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_);
+      }
+  }
+  edge_density_n_ = n;
+}
+
 void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, const frame& basis) {
+  if (edge_density_n_ != n_) edge_make_density();
   // Facings of the creases' triangles: the sign of the plane's value at the point, 0 within
   // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
   const double px = position.x, py = position.y, pz = position.z;
@@ -407,10 +438,31 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   const std::int64_t min_y = std::min({py[0], py[1], py[2]}), max_y = std::max({py[0], py[1], py[2]});
   const std::int64_t min_x = std::min({px[0], px[1], px[2]}), max_x = std::max({px[0], px[1], px[2]});
   // Texels the box overlaps, grown by the snapping (half a unit) for the unsnapped triangle.
-  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
-  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
-  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
-  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
+  // Cut to the texels the unsnapped triangle's box overlaps by a positive length (the others
+  // share no area with it; a texel the snapped triangle covers whole is among them, the two
+  // triangles' vertices being within half a unit of each other).
+  const double ux_lo = std::min({exact[0], exact[1], exact[2]}), ux_hi = std::max({exact[0], exact[1], exact[2]});
+  const double uy_lo = std::min({exact[3], exact[4], exact[5]}), uy_hi = std::max({exact[3], exact[4], exact[5]});
+  const double inv_one = 1.0 / static_cast<double>(sub_one);  // (exact: a power of two)
+  const auto uc_lo = static_cast<std::int64_t>(std::floor(ux_lo * inv_one)), uc_hi = static_cast<std::int64_t>(std::ceil(ux_hi * inv_one)) - 1;
+  const auto ur_lo = static_cast<std::int64_t>(std::floor(uy_lo * inv_one)), ur_hi = static_cast<std::int64_t>(std::ceil(uy_hi * inv_one)) - 1;
+  const std::int64_t col_lo = std::max<std::int64_t>({floor_sub(min_x - 1), uc_lo, 0});
+  const std::int64_t col_hi = std::min<std::int64_t>({ceil_sub(max_x + 1) - 1, uc_hi, n - 1});
+  const std::int64_t row_lo = std::max<std::int64_t>({floor_sub(min_y - 1), ur_lo, 0});
+  const std::int64_t row_hi = std::min<std::int64_t>({ceil_sub(max_y + 1) - 1, ur_hi, rows - 1});
+  if (col_lo > col_hi || row_lo > row_hi) return;
+  // A triangle within one texel (the terrain's far triangles): its covered weight is its area
+  // times the density at its centroid, exact for a density linear over the texel, with no
+  // clipping (what clipping the square by its three edges gives, to rounding; an unsnapped
+  // triangle that snapping turned clockwise has no inside, as there, and gets nothing).
+  const bool tiny = uc_lo == uc_hi && ur_lo == ur_hi;
+  double tiny_area = 0.0, tiny_x = 0.0, tiny_y = 0.0;  // texel units; centroid about the texel's centre
+  if (tiny) {
+    const double ax = exact[1] - exact[0], ay = exact[4] - exact[3], bx = exact[2] - exact[0], by = exact[5] - exact[3];
+    tiny_area = 0.5 * (ax * by - bx * ay) * (inv_one * inv_one);
+    tiny_x = (exact[0] + exact[1] + exact[2]) * (inv_one / 3.0) - static_cast<double>(uc_lo) - 0.5;
+    tiny_y = (exact[3] + exact[4] + exact[5]) * (inv_one / 3.0) - static_cast<double>(ur_lo) - 0.5;
+  }
 
   // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
   // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
@@ -424,22 +476,31 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
     gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
   }
+  double rgx[3] = {0.0, 0.0, 0.0}, rgy[3] = {0.0, 0.0, 0.0};  // 1 / gx, 1 / gy: made when an edge first cuts a texel alone
+  unsigned have_reciprocals = 0;
+  // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
+  // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's edges
+  // are within ~2 units of the snapped ones over its box, so it has no area there. With the
+  // edge function e_k at the texel's lower left corner, the texel is whole when e_k >=
+  // whole_at[k] for every edge and far when e_k < far_below[k] for some edge; e_k steps by
+  // step_x[k] per column (exact integers: terms below 2^61, see guard_band).
+  std::int64_t step_x[3], whole_at[3], far_below[3];
+  for (int k = 0; k < 3; ++k) {
+    const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
+    step_x[k] = sx;
+    whole_at[k] = -(std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0));
+    far_below[k] = -4 * (std::abs(dx[k]) + std::abs(dy[k])) - (std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0));
+  }
+  // Per row: the edge functions at its column 0 (snapped, then unsnapped) and the depth row.
+  std::int64_t e_row[3];
+  double f_row[3];
+  float zrow = 0.0f;
   const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
     ++stats_.edge_texels_tested;
-    const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
-    // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
-    // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's
-    // edges are within ~2 units of the snapped ones over its box, so it has no area there.
-    bool whole = true, far = false;
-    for (int k = 0; k < 3; ++k) {
-      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
-      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
-      whole = whole && e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0) >= 0;
-      far = far || e + std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0) < -4 * (std::abs(dx[k]) + std::abs(dy[k]));
-    }
-    if (far) return;
+    const std::int64_t e0 = e_row[0] + c * step_x[0], e1 = e_row[1] + c * step_x[1], e2 = e_row[2] + c * step_x[2];
+    if ((e0 < far_below[0]) | (e1 < far_below[1]) | (e2 < far_below[2])) return;
+    const bool whole = (e0 >= whole_at[0]) & (e1 >= whole_at[1]) & (e2 >= whole_at[2]);
     // The triangle's depth at the texel centre, as the coverage paths compute it.
-    const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     float z = zrow + fs.dzdx * static_cast<float>(c);
     z = z > FLT_MIN ? z : FLT_MIN;
     if (whole) {
@@ -457,35 +518,60 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     // leaves it through the far sheet), which the blend, taking fragments as side by side,
     // would count again in place of what lies behind.
     if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
+    // Behind every fragment the texel has, whose coverages sum to one or more: the blend, front
+    // to back, has given the whole texel away before it reaches this one (each takes min(its
+    // coverage, what is left); the margin covers the float sums of up to ~1000 fragments), so
+    // it would take no share, and the render is the same bits without it.
+    if (fragment_count_[texel] != 0 && z < front_z_[texel] && front_cover_[texel] >= 1.0f + 1e-4f) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
     // triangles sharing an edge clip it from the same unsnapped endpoints, so between them they
     // miss no part of a texel.
-    double f0[3];
-    unsigned clip = 0;  // the unsnapped edges that cut the texel
-    for (int k = 0; k < 3; ++k) {
-      f0[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) - edy[k] * (static_cast<double>(x0) - exact[k]);
-      if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
-      if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
-    }
+    //
     // The integrator weights a texel by the projected solid angle over it; within the texel its
     // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
-    // centre's, in texel units): the covered fraction of the texel's weight, to second order.
-    // Top face (z = 1): density (1 + u^2 + v^2)^-2; side faces (v = height): v (1 + u^2 + v^2)^-2.
-    const double u = first_centre_ + texel_step_ * static_cast<double>(c);
-    const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
-    const double q = 1.0 + u * u + v * v;
-    const double wx = -4.0 * u / q * texel_step_;
-    const double wy = (face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_;
-    const double area = square_part_inside(f0, gx, gy, clip, wx, wy);
+    // centre's, in texel units; edge_density_): the covered fraction of the texel's weight, to
+    // second order.
+    const float* slope = edge_density_.data() + 2 * texel;
+    const double wx = slope[0], wy = slope[1];
+    double area;
+    if (tiny) {
+      area = tiny_area * (1.0 + wx * tiny_x + wy * tiny_y);
+    } else {
+      double f0[3];
+      unsigned clip = 0;  // the unsnapped edges that cut the texel
+      for (int k = 0; k < 3; ++k) {
+        f0[k] = f_row[k] + static_cast<double>(c) * gx[k];
+        if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
+        if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
+      }
+      if (clip != 0 && (clip & (clip - 1)) == 0) {  // one cutting edge (most partial texels)
+        const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
+        if (!(have_reciprocals >> k & 1u)) {
+          rgx[k] = 1.0 / gx[k];
+          rgy[k] = 1.0 / gy[k];
+          have_reciprocals |= 1u << k;
+        }
+        area = square_part_inside_one(f0[k], gx[k], gy[k], rgx[k], rgy[k], wx, wy);
+      } else {
+        area = square_part_inside(f0, gx, gy, clip, wx, wy);
+      }
+    }
     if (!(area > 0.0)) return;
     edge_fragment fr;
     fr.texel = static_cast<std::uint32_t>(texel);
     fr.z = z;
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
-    if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
+    if (fragment_count_[texel]++ == 0) {
+      fragment_texels_.push_back(fr.texel);
+      front_cover_[texel] = fr.coverage;
+      front_z_[texel] = z;
+    } else {
+      front_cover_[texel] += fr.coverage;
+      front_z_[texel] = std::min(front_z_[texel], z);
+    }
     fragments_.push_back(fr);
     ++stats_.edge_fragments;
   };
@@ -496,6 +582,12 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (hard_lo > col_hi || hard_hi < col_lo) continue;
     const std::int64_t c0 = std::max<std::int64_t>(col_lo, hard_lo), c1 = std::min<std::int64_t>(col_hi, hard_hi);
     const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
+    const std::int64_t y0 = r * sub_one;
+    for (int k = 0; k < 3; ++k) {
+      e_row[k] = dx[k] * (y0 - py[k]) + dy[k] * px[k];
+      f_row[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) + edy[k] * exact[k];
+    }
+    zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     edge_for_hard(row_base + static_cast<std::size_t>(r), c0, c1, [&](std::int64_t c) {
       classify(c, r, row + static_cast<std::size_t>(c));
       return true;
