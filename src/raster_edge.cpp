@@ -21,7 +21,8 @@ using namespace raster_detail;
 
 namespace {
 
-// square_part_inside (below) for one clipping edge f0 + gx x + gy y >= 0, with rgx = 1 / gx and
+// The covered part of a texel (as texel_part_inside, below) for one clipping edge
+// f0 + gx x + gy y >= 0, with rgx = 1 / gx and
 // rgy = 1 / gy (made once per triangle edge; infinite for a zero step, never selected then: a
 // side can only be crossed where its step is nonzero): the polygon's shoelace terms, edge by
 // edge: the inside part of each side of the square (an interval of it: a half-plane cuts a
@@ -60,55 +61,79 @@ double square_part_inside_one(double f0, double gx, double gy, double rgx, doubl
   return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
-// The part of the unit square [0, 1]^2 (a texel, in texel units) inside the half-planes
-// f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of the edges in `clip` (bit k): Sutherland-Hodgman
-// on the square's polygon (at most 4 + 3 vertices), then the polygon's area and first moments
-// about the square's centre (the shoelace formula and its moment form), weighted by the density
-// 1 + wx (x - 1/2) + wy (y - 1/2). Double precision: within ~1e-15 of the exact value for the
-// snapped triangle. The square's own moments vanish, so the values of two triangles sharing an
-// edge sum to those of their union. (One cutting edge, most partial texels, goes to
-// square_part_inside_one instead: the same polygon without divisions.)
-double square_part_inside(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3], unsigned clip,
-                          double wx, double wy) noexcept {
-  if (clip == 0) return 1.0;  // the whole square (its moments vanish): what the loops below give
-  double ax_[8] = {0.0, 1.0, 1.0, 0.0}, ay_[8] = {0.0, 0.0, 1.0, 1.0};
-  double bx_[8], by_[8];
-  double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;  // the polygon, and the next one (swapped)
-  int count = 4;
-  for (int k = 0; k < 3 && count >= 3; ++k) {
-    if (!(clip >> k & 1u)) continue;
-    double value[8];
-    for (int i = 0; i < count; ++i) value[i] = f0[k] + gx[k] * px[i] + gy[k] * py[i];
-    int out = 0;
-    for (int i = 0; i < count; ++i) {
-      const int j = i + 1 == count ? 0 : i + 1;
-      const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
-      if (in_i) {
-        qx[out] = px[i];
-        qy[out] = py[i];
-        ++out;
-      }
-      if (in_i != in_j) {
-        const double t = value[i] / (value[i] - value[j]);
-        qx[out] = px[i] + t * (px[j] - px[i]);
-        qy[out] = py[i] + t * (py[j] - py[i]);
-        ++out;
-      }
-    }
-    count = out;
-    std::swap(px, qx);
-    std::swap(py, qy);
-  }
-  if (count < 3) return 0.0;
+// One edge of a triangle, for texel_part_inside (texel units, the face's origin): from vertex
+// (ax, ay) by (dx, dy), with its edge function's steps across a texel (gx, gy: f = f0 + gx x +
+// gy y at (x, y) from the texel's lower left corner, inside where f >= 0) and the reciprocals
+// of all four (made once per edge, when it first cuts a texel; unused where a step is zero).
+struct clip_edge {
+  double ax, ay, dx, dy, gx, gy;
+  double rdx, rdy, rgx, rgy;
+};
+
+// The covered part of a texel by Green's theorem: the area and first moments of the region
+// (the texel square, within the half-planes of the triangle's edges in `clip`, those that cut
+// it; the others hold the whole square) are sums over its boundary, counter-clockwise, of the
+// shoelace terms of its segments. That boundary is the cutting edges' segments within the
+// square (Liang-Barsky: the edge's parameter against the square's four sides) and the square's
+// sides within the half-planes (each side's parameter against each edge function, linear along
+// it). Every crossing is a product with a reciprocal made per edge: no division, no polygon
+// built, few branches, and the branches on the sign of a step are the same for every texel of
+// a triangle. (cx, cy): the texel's centre; f0: the edge functions at its lower left corner; the
+// moments are about the centre and weighted by the density 1 + wx x + wy y (x, y about the
+// centre). The part inside is exact to rounding (~1e-15) for a counter-clockwise triangle;
+// the caller gives a triangle that is not counter-clockwise nothing.
+double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigned clip, double cx, double cy,
+                         double wx, double wy) noexcept {
   double twice = 0.0, mx = 0.0, my = 0.0;  // 2 area, 6 first moments (about the centre)
-  for (int i = 0; i < count; ++i) {
-    const int j = i + 1 == count ? 0 : i + 1;
-    const double ax = px[i] - 0.5, ay = py[i] - 0.5, bx = px[j] - 0.5, by = py[j] - 0.5;
-    const double cross = ax * by - bx * ay;
+  const auto term = [&](double px, double py, double qx, double qy) {
+    const double cross = px * qy - qx * py;
     twice += cross;
-    mx += (ax + bx) * cross;
-    my += (ay + by) * cross;
+    mx += (px + qx) * cross;
+    my += (py + qy) * cross;
+  };
+  // 1. The cutting edges within the square [-1/2, 1/2]^2 (about the centre).
+  for (int k = 0; k < 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    const clip_edge& g = e[k];
+    const double ax = g.ax - cx, ay = g.ay - cy;
+    double t0 = 0.0, t1 = 1.0;
+    if (g.dx != 0.0) {
+      const double ta = (-0.5 - ax) * g.rdx, tb = (0.5 - ax) * g.rdx;
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    } else if (!(std::fabs(ax) <= 0.5)) {
+      continue;
+    }
+    if (g.dy != 0.0) {
+      const double ta = (-0.5 - ay) * g.rdy, tb = (0.5 - ay) * g.rdy;
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    } else if (!(std::fabs(ay) <= 0.5)) {
+      continue;
+    }
+    if (t0 < t1) term(ax + t0 * g.dx, ay + t0 * g.dy, ax + t1 * g.dx, ay + t1 * g.dy);
   }
+  // 2. The square's sides (bottom, right, top, left) within the cutting half-planes. Side i
+  // runs from corner (sx, sy) by (ux, uy), over s in [s0, s1]; along it f_k starts at its
+  // value at the corner, with slope m: inside where s >= -v / m (m > 0), s <= -v / m (m < 0),
+  // everywhere or nowhere (m = 0). Selects (a zero slope's product is never selected).
+  static constexpr double sx[4] = {-0.5, 0.5, 0.5, -0.5}, sy[4] = {-0.5, -0.5, 0.5, 0.5};
+  static constexpr double ux[4] = {1.0, 0.0, -1.0, 0.0}, uy[4] = {0.0, 1.0, 0.0, -1.0};
+  double s0[4] = {0.0, 0.0, 0.0, 0.0}, s1[4] = {1.0, 1.0, 1.0, 1.0};
+  for (int k = 0; k < 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    const clip_edge& g = e[k];
+    const double v[4] = {f0[k], f0[k] + g.gx, f0[k] + g.gx + g.gy, f0[k] + g.gy};  // f_k at the corners
+    const double m[4] = {g.gx, g.gy, -g.gx, -g.gy};
+    const double rm[4] = {g.rgx, g.rgy, -g.rgx, -g.rgy};
+    for (int i = 0; i < 4; ++i) {
+      const double cut = -v[i] * rm[i];
+      s0[i] = m[i] > 0.0 ? std::max(s0[i], cut) : s0[i];
+      s1[i] = m[i] < 0.0 ? std::min(s1[i], cut) : (m[i] == 0.0 && v[i] < 0.0 ? -1.0 : s1[i]);
+    }
+  }
+  for (int i = 0; i < 4; ++i)
+    if (s0[i] < s1[i]) term(sx[i] + s0[i] * ux[i], sy[i] + s0[i] * uy[i], sx[i] + s1[i] * ux[i], sy[i] + s1[i] * uy[i]);
   return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
@@ -340,14 +365,15 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
     const std::size_t row_base = face_row_base(n, face);
     const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
+    const double inv_dy = yhi - ylo > 1e-12 ? 1.0 / (y1 - y0) : 0.0;  // (the margins dwarf its rounding)
     const int r_first = std::max(0, static_cast<int>(std::floor(ylo - eps)));
     const int r_last = std::min(rows - 1, static_cast<int>(std::floor(yhi + eps)));
     for (int r = r_first; r <= r_last; ++r) {
       // The segment's x range within the strip [r - eps, r + 1 + eps].
       double xlo = std::min(x0, x1), xhi = std::max(x0, x1);
       if (yhi - ylo > 1e-12) {
-        const double s0 = std::max(0.0, std::min(1.0, (static_cast<double>(r) - eps - y0) / (y1 - y0)));
-        const double s1 = std::max(0.0, std::min(1.0, (static_cast<double>(r) + 1.0 + eps - y0) / (y1 - y0)));
+        const double s0 = std::max(0.0, std::min(1.0, (static_cast<double>(r) - eps - y0) * inv_dy));
+        const double s1 = std::max(0.0, std::min(1.0, (static_cast<double>(r) + 1.0 + eps - y0) * inv_dy));
         const double xa = x0 + s0 * (x1 - x0), xb = x0 + s1 * (x1 - x0);
         xlo = std::min(xa, xb);
         xhi = std::max(xa, xb);
@@ -476,8 +502,20 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
     gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
   }
-  double rgx[3] = {0.0, 0.0, 0.0}, rgy[3] = {0.0, 0.0, 0.0};  // 1 / gx, 1 / gy: made when an edge first cuts a texel alone
+  // The edges for texel_part_inside (texel units); their reciprocals when they first cut a texel.
+  clip_edge ce[3];
+  for (int k = 0; k < 3; ++k) {
+    ce[k].ax = exact[k] * inv_one;
+    ce[k].ay = exact[3 + k] * inv_one;
+    ce[k].dx = edx[k] * inv_one;
+    ce[k].dy = edy[k] * inv_one;
+    ce[k].gx = gx[k];
+    ce[k].gy = gy[k];
+  }
   unsigned have_reciprocals = 0;
+  // Only a counter-clockwise unsnapped triangle has an inside (snapping, by at most half a unit,
+  // can turn a sliver around): another gets no partial texels.
+  const bool positive = edx[0] * edy[2] - edx[2] * edy[0] < 0.0;
   // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
   // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's edges
   // are within ~2 units of the snapped ones over its box, so it has no area there. With the
@@ -510,6 +548,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       }
       return;
     }
+    if (!positive) return;
     // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
     // blend stops at the whole-texel winner, which can only come nearer).
     if (!(z > whole_z_[texel])) return;
@@ -546,16 +585,23 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
         if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
         if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
       }
-      if (clip != 0 && (clip & (clip - 1)) == 0) {  // one cutting edge (most partial texels)
+      if ((clip & ~have_reciprocals) != 0) {
+        for (int k = 0; k < 3; ++k)
+          if ((clip & ~have_reciprocals) >> k & 1u) {
+            ce[k].rdx = 1.0 / ce[k].dx;
+            ce[k].rdy = 1.0 / ce[k].dy;
+            ce[k].rgx = 1.0 / ce[k].gx;
+            ce[k].rgy = 1.0 / ce[k].gy;
+          }
+        have_reciprocals |= clip;
+      }
+      if (clip == 0)
+        area = 1.0;
+      else if ((clip & (clip - 1)) == 0) {  // one cutting edge (most partial texels): the corners' form
         const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
-        if (!(have_reciprocals >> k & 1u)) {
-          rgx[k] = 1.0 / gx[k];
-          rgy[k] = 1.0 / gy[k];
-          have_reciprocals |= 1u << k;
-        }
-        area = square_part_inside_one(f0[k], gx[k], gy[k], rgx[k], rgy[k], wx, wy);
+        area = square_part_inside_one(f0[k], ce[k].gx, ce[k].gy, ce[k].rgx, ce[k].rgy, wx, wy);
       } else {
-        area = square_part_inside(f0, gx, gy, clip, wx, wy);
+        area = texel_part_inside(ce, f0, clip, static_cast<double>(c) + 0.5, static_cast<double>(r) + 0.5, wx, wy);
       }
     }
     if (!(area > 0.0)) return;
