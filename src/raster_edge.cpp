@@ -426,9 +426,8 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
   const std::uint64_t* bits = hard_bits_.data() + row * words_per_row_;
   const std::int64_t w0 = c0 >> 6, w1 = c1 >> 6;
   for (std::int64_t w = w0; w <= w1; ++w) {
-    std::uint64_t word = bits[w];
-    if (w == w0) word &= ~std::uint64_t(0) << (c0 & 63);
-    if (w == w1 && (c1 & 63) != 63) word &= (std::uint64_t(1) << ((c1 & 63) + 1)) - 1;
+    const int lo = w == w0 ? static_cast<int>(c0 & 63) : 0, hi = w == w1 ? static_cast<int>(c1 & 63) : 63;
+    std::uint64_t word = bits[w] & (~std::uint64_t(0) << lo) & (~std::uint64_t(0) >> (63 - hi));
     while (word) {
       if (!visit(w * 64 + lowest_bit(word))) return;
       word &= word - 1;
@@ -529,8 +528,11 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     whole_at[k] = -(std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0));
     far_below[k] = -4 * (std::abs(dx[k]) + std::abs(dy[k])) - (std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0));
   }
-  // Per row: the edge functions at its column 0 (snapped, then unsnapped) and the depth row.
-  std::int64_t e_row[3];
+  // Per row: the edge functions at its column 0 (snapped: made at the first row with hard
+  // texels, then stepped row by row, exactly; unsnapped: made at the row's first partial texel)
+  // and the depth row.
+  std::int64_t e_row[3] = {0, 0, 0};
+  std::int64_t e_row_at = -1, f_row_at = -1;  // the rows they hold
   double f_row[3];
   float zrow = 0.0f;
   const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
@@ -578,6 +580,11 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (tiny) {
       area = tiny_area * (1.0 + wx * tiny_x + wy * tiny_y);
     } else {
+      if (f_row_at != r) {
+        const double y0 = static_cast<double>(r * sub_one);
+        for (int k = 0; k < 3; ++k) f_row[k] = edx[k] * (y0 - exact[3 + k]) + edy[k] * exact[k];
+        f_row_at = r;
+      }
       double f0[3];
       unsigned clip = 0;  // the unsnapped edges that cut the texel
       for (int k = 0; k < 3; ++k) {
@@ -628,16 +635,18 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (hard_lo > col_hi || hard_hi < col_lo) continue;
     const std::int64_t c0 = std::max<std::int64_t>(col_lo, hard_lo), c1 = std::min<std::int64_t>(col_hi, hard_hi);
     const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
-    const std::int64_t y0 = r * sub_one;
-    for (int k = 0; k < 3; ++k) {
-      e_row[k] = dx[k] * (y0 - py[k]) + dy[k] * px[k];
-      f_row[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) + edy[k] * exact[k];
+    if (r != e_row_at) {
+      const std::int64_t y0 = r * sub_one;
+      for (int k = 0; k < 3; ++k) e_row[k] = dx[k] * (y0 - py[k]) + dy[k] * px[k];
     }
+    e_row_at = r + 1;  // the next row's values follow by a step
+    f_row_at = -1;
     zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     edge_for_hard(row_base + static_cast<std::size_t>(r), c0, c1, [&](std::int64_t c) {
       classify(c, r, row + static_cast<std::size_t>(c));
       return true;
     });
+    for (int k = 0; k < 3; ++k) e_row[k] += dx[k] * sub_one;
   }
 }
 
