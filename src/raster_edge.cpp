@@ -476,45 +476,48 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   const std::int64_t row_lo = std::max<std::int64_t>({floor_sub(min_y - 1), ur_lo, 0});
   const std::int64_t row_hi = std::min<std::int64_t>({ceil_sub(max_y + 1) - 1, ur_hi, rows - 1});
   if (col_lo > col_hi || row_lo > row_hi) return;
-  // A triangle within one texel (the terrain's far triangles): its covered weight is its area
-  // times the density at its centroid, exact for a density linear over the texel, with no
-  // clipping (what clipping the square by its three edges gives, to rounding; an unsnapped
-  // triangle that snapping turned clockwise has no inside, as there, and gets nothing).
+  // The unsnapped triangle's values, made at its first partial texel (many calls have none: all
+  // their hard texels are far, whole, behind or in a silhouette's back sheet).
+  //  - The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex
+  //    k = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel;
+  //  - the edges for texel_part_inside (texel units; their reciprocals when they first cut a
+  //    texel: have_reciprocals);
+  //  - positive: only a counter-clockwise unsnapped triangle has an inside (snapping, by at most
+  //    half a unit, can turn a sliver around): another gets no partial texels;
+  //  - tiny: a triangle within one texel (the terrain's far triangles): its covered weight is its
+  //    area times the density at its centroid, exact for a density linear over the texel, with
+  //    no clipping (what clipping the square by its three edges gives, to rounding).
+  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
+  clip_edge ce[3];
+  unsigned have_reciprocals = 0;
+  bool unsnapped_ready = false, positive = false;
   const bool tiny = uc_lo == uc_hi && ur_lo == ur_hi;
   double tiny_area = 0.0, tiny_x = 0.0, tiny_y = 0.0;  // texel units; centroid about the texel's centre
-  if (tiny) {
-    const double ax = exact[1] - exact[0], ay = exact[4] - exact[3], bx = exact[2] - exact[0], by = exact[5] - exact[3];
-    tiny_area = 0.5 * (ax * by - bx * ay) * (inv_one * inv_one);
-    tiny_x = (exact[0] + exact[1] + exact[2]) * (inv_one / 3.0) - static_cast<double>(uc_lo) - 0.5;
-    tiny_y = (exact[3] + exact[4] + exact[5]) * (inv_one / 3.0) - static_cast<double>(ur_lo) - 0.5;
-  }
-
-  // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
-  // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
-  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
-  for (int k = 0; k < 3; ++k) {
-    const int b = k == 2 ? 0 : k + 1;
-    edx[k] = exact[b] - exact[k];
-    edy[k] = exact[3 + b] - exact[3 + k];
-    gx[k] = -edy[k] * static_cast<double>(sub_one);
-    gy[k] = edx[k] * static_cast<double>(sub_one);
-    gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
-    gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
-  }
-  // The edges for texel_part_inside (texel units); their reciprocals when they first cut a texel.
-  clip_edge ce[3];
-  for (int k = 0; k < 3; ++k) {
-    ce[k].ax = exact[k] * inv_one;
-    ce[k].ay = exact[3 + k] * inv_one;
-    ce[k].dx = edx[k] * inv_one;
-    ce[k].dy = edy[k] * inv_one;
-    ce[k].gx = gx[k];
-    ce[k].gy = gy[k];
-  }
-  unsigned have_reciprocals = 0;
-  // Only a counter-clockwise unsnapped triangle has an inside (snapping, by at most half a unit,
-  // can turn a sliver around): another gets no partial texels.
-  const bool positive = edx[0] * edy[2] - edx[2] * edy[0] < 0.0;
+  const auto make_unsnapped = [&] {
+    for (int k = 0; k < 3; ++k) {
+      const int b = k == 2 ? 0 : k + 1;
+      edx[k] = exact[b] - exact[k];
+      edy[k] = exact[3 + b] - exact[3 + k];
+      gx[k] = -edy[k] * static_cast<double>(sub_one);
+      gy[k] = edx[k] * static_cast<double>(sub_one);
+      gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
+      gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
+      ce[k].ax = exact[k] * inv_one;
+      ce[k].ay = exact[3 + k] * inv_one;
+      ce[k].dx = edx[k] * inv_one;
+      ce[k].dy = edy[k] * inv_one;
+      ce[k].gx = gx[k];
+      ce[k].gy = gy[k];
+    }
+    positive = edx[0] * edy[2] - edx[2] * edy[0] < 0.0;
+    if (tiny) {
+      const double ax = exact[1] - exact[0], ay = exact[4] - exact[3], bx = exact[2] - exact[0], by = exact[5] - exact[3];
+      tiny_area = 0.5 * (ax * by - bx * ay) * (inv_one * inv_one);
+      tiny_x = (exact[0] + exact[1] + exact[2]) * (inv_one / 3.0) - static_cast<double>(uc_lo) - 0.5;
+      tiny_y = (exact[3] + exact[4] + exact[5]) * (inv_one / 3.0) - static_cast<double>(ur_lo) - 0.5;
+    }
+    unsnapped_ready = true;
+  };
   // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
   // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's edges
   // are within ~2 units of the snapped ones over its box, so it has no area there. With the
@@ -550,6 +553,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       }
       return;
     }
+    if (!unsnapped_ready) make_unsnapped();
     if (!positive) return;
     // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
     // blend stops at the whole-texel winner, which can only come nearer).
@@ -694,6 +698,12 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
 // takes the rest. Deterministic: the order is total and the sums run in it.
 void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
   const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
+  // A draw's radiance: its shade (inline; most renders have no texture), else fragment_radiance.
+  const auto radiance = [&](std::uint32_t id, std::size_t texel, float z) {
+    if (textured_) return fragment_radiance(id, texel, z, texture);
+    const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];
+    return glm::vec3(sh.r, sh.g, sh.b);
+  };
   float* red = out.channel(0);
   float* green = out.channel(1);
   float* blue = out.channel(2);
@@ -722,7 +732,7 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
       const float share = std::min(fr.coverage, left);
       if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
-      sum += share * fragment_radiance(fr.id, g.texel, fr.z, texture);
+      sum += share * radiance(fr.id, g.texel, fr.z);
       left -= share;
       if (!(left > 0.0f)) break;
     }
@@ -732,11 +742,14 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
     // at an occluding edge must carry the occluder's distance, or half the edge's radiance step
     // would move with the surface behind; and one whose centre sees nothing must not be at +inf
     // (a wall between two texels at +inf contributes nothing).
-    if (nearest > 0.0f && lengths_[g.texel] / nearest < out.distance[g.texel]) out.distance[g.texel] = lengths_[g.texel] / nearest;
+    if (nearest > 0.0f) {
+      const float distance = lengths_[g.texel] / nearest;
+      if (distance < out.distance[g.texel]) out.distance[g.texel] = distance;
+    }
     if (left > 0.0f) {
       glm::vec3 rest;
       if (full_z > 0.0f)
-        rest = fragment_radiance(full_id, g.texel, full_z, texture);
+        rest = radiance(full_id, g.texel, full_z);
       else if (sky_)
         rest = glm::vec3(sky_->sample(basis.to_world(directions_[g.texel])));
       else
