@@ -188,6 +188,17 @@ inline std::size_t face_row_base(int n, int face) noexcept {
   return face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n / 2);
 }
 
+// floor(x) and ceil(x) as integers, for |x| < 2^62 (not NaN): a conversion and a compare (the
+// library's floor is a call or a long sequence without SSE4.1).
+inline std::int64_t floor_int(double x) noexcept {
+  const auto i = static_cast<std::int64_t>(x);  // truncates toward zero
+  return i - (x < static_cast<double>(i) ? 1 : 0);
+}
+inline std::int64_t ceil_int(double x) noexcept {
+  const auto i = static_cast<std::int64_t>(x);
+  return i + (x > static_cast<double>(i) ? 1 : 0);
+}
+
 std::uint32_t bits_of(float f) noexcept {
   std::uint32_t b;
   std::memcpy(&b, &f, sizeof b);
@@ -366,8 +377,8 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
     const std::size_t row_base = face_row_base(n, face);
     const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
     const double inv_dy = yhi - ylo > 1e-12 ? 1.0 / (y1 - y0) : 0.0;  // (the margins dwarf its rounding)
-    const int r_first = std::max(0, static_cast<int>(std::floor(ylo - eps)));
-    const int r_last = std::min(rows - 1, static_cast<int>(std::floor(yhi + eps)));
+    const int r_first = std::max(0, static_cast<int>(floor_int(ylo - eps)));
+    const int r_last = std::min(rows - 1, static_cast<int>(floor_int(yhi + eps)));
     for (int r = r_first; r <= r_last; ++r) {
       // The segment's x range within the strip [r - eps, r + 1 + eps].
       double xlo = std::min(x0, x1), xhi = std::max(x0, x1);
@@ -378,8 +389,8 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
         xlo = std::min(xa, xb);
         xhi = std::max(xa, xb);
       }
-      const int c_first = std::max(0, static_cast<int>(std::floor(xlo - eps)));
-      const int c_last = std::min(n - 1, static_cast<int>(std::floor(xhi + eps)));
+      const int c_first = std::max(0, static_cast<int>(floor_int(xlo - eps)));
+      const int c_last = std::min(n - 1, static_cast<int>(floor_int(xhi + eps)));
       if (c_first > c_last) continue;
       std::int32_t& lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
       std::int32_t& hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
@@ -469,8 +480,8 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   const double ux_lo = std::min({exact[0], exact[1], exact[2]}), ux_hi = std::max({exact[0], exact[1], exact[2]});
   const double uy_lo = std::min({exact[3], exact[4], exact[5]}), uy_hi = std::max({exact[3], exact[4], exact[5]});
   const double inv_one = 1.0 / static_cast<double>(sub_one);  // (exact: a power of two)
-  const auto uc_lo = static_cast<std::int64_t>(std::floor(ux_lo * inv_one)), uc_hi = static_cast<std::int64_t>(std::ceil(ux_hi * inv_one)) - 1;
-  const auto ur_lo = static_cast<std::int64_t>(std::floor(uy_lo * inv_one)), ur_hi = static_cast<std::int64_t>(std::ceil(uy_hi * inv_one)) - 1;
+  const std::int64_t uc_lo = floor_int(ux_lo * inv_one), uc_hi = ceil_int(ux_hi * inv_one) - 1;
+  const std::int64_t ur_lo = floor_int(uy_lo * inv_one), ur_hi = ceil_int(uy_hi * inv_one) - 1;
   const std::int64_t col_lo = std::max<std::int64_t>({floor_sub(min_x - 1), uc_lo, 0});
   const std::int64_t col_hi = std::min<std::int64_t>({ceil_sub(max_x + 1) - 1, uc_hi, n - 1});
   const std::int64_t row_lo = std::max<std::int64_t>({floor_sub(min_y - 1), ur_lo, 0});
