@@ -549,8 +549,11 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   std::int64_t e_row_at = -1, f_row_at = -1;  // the rows they hold
   double f_row[3];
   float zrow = 0.0f;
+  // The statistics, counted here and added at the end (an increment of the member per texel
+  // would chain every iteration through memory).
+  std::size_t tested = 0, kept = 0;
   const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
-    ++stats_.edge_texels_tested;
+    ++tested;
     const std::int64_t e0 = e_row[0] + c * step_x[0], e1 = e_row[1] + c * step_x[1], e2 = e_row[2] + c * step_x[2];
     if ((e0 < far_below[0]) | (e1 < far_below[1]) | (e2 < far_below[2])) return;
     const bool whole = (e0 >= whole_at[0]) & (e1 >= whole_at[1]) & (e2 >= whole_at[2]);
@@ -641,7 +644,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       front_z_[texel] = std::min(front_z_[texel], z);
     }
     fragments_.push_back(fr);
-    ++stats_.edge_fragments;
+    ++kept;
   };
 
   for (std::int64_t r = row_lo; r <= row_hi; ++r) {
@@ -663,6 +666,8 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     });
     for (int k = 0; k < 3; ++k) e_row[k] += dx[k] * sub_one;
   }
+  stats_.edge_texels_tested += tested;
+  stats_.edge_fragments += kept;
 }
 
 // After the resolve (which gave every texel its centre sample, as without the option): each
