@@ -450,14 +450,16 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
 // clockwise) touches on `face`. A texel it covers whole makes it the texel's whole-texel
 // candidate (whole_z_, whole_id_: the nearest, ties to the earlier draw); one it covers in part
 // gets a fragment with the exact covered fraction of its weight, unless a triangle drawn earlier
-// covers the whole texel in front of it. Row by row: the rows' hard column ranges, cut to the
-// triangle's x extent within the row's strip (its vertices in the strip and its edges' crossings
-// of the strip's lines), bound the texels to classify; they are classified exactly with the
-// integer edge functions at their corners (outside: an edge leaves every corner at <= 0, i.e. no
-// area in common; whole: every corner of every edge >= 0; else partial). `exact`: the unsnapped
-// vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The coverage paths
-// draw the triangle as without the option (centre samples). Cost: O(rows + the hard texels of
-// its rows within its extent).
+// covers the whole texel in front of it or fragments in front of it already fill the texel.
+// Row by row over the box (the snapped box grown by the snapping, cut to the unsnapped
+// triangle's): the rows' hard texels within it (hard_rows_, hard_bits_) are classified exactly
+// with the integer edge functions at their corners (far: an edge leaves every corner more than
+// 1/64 texel outside; whole: every corner of every edge >= 0; else partial). The rows' texels
+// are not cut to the triangle's extent within each row: computing its crossings per row costs
+// about what testing the row's few hard texels does (docs/design/raster.md). `exact`: the
+// unsnapped vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The
+// coverage paths draw the triangle as without the option (centre samples). Cost: O(rows of the
+// box + its hard texels), a partial texel ~100-200 instructions.
 void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
                                       const double (&exact)[6], const face_setup& fs, std::uint32_t draw,
                                       bool back) {
