@@ -581,9 +581,11 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
     // Behind every fragment the texel has, whose coverages sum to one or more: the blend, front
     // to back, has given the whole texel away before it reaches this one (each takes min(its
-    // coverage, what is left); the margin covers the float sums of up to ~1000 fragments), so
-    // it would take no share, and the render is the same bits without it.
-    if (fragment_count_[texel] != 0 && z < front_z_[texel] && front_cover_[texel] >= 1.0f + 1e-4f) return;
+    // coverage, what is left), or stopped earlier at the whole-texel candidate), so it would
+    // take no share, and the render is the same bits without it. (The margin covers the float
+    // sums' rounding, 6e-8 a fragment, up to the 256 fragments the test allows.)
+    const std::uint32_t count = fragment_count_[texel];
+    if (count != 0 && count <= 256 && z < front_z_[texel] && front_cover_[texel] >= 1.0f + 1e-4f) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
