@@ -1076,6 +1076,68 @@ TEST_CASE("raster: with exact edge coverage, triangles sharing edges sum to one 
   CHECK(worst <= 4e-6);
 }
 
+TEST_CASE("raster: exact edge coverage of triangles smaller than a texel sums to one and gives Lambert's formula", "[raster]") {
+  // A rectangle at z = 1 cut into cells of 0.23 texels at N = 64 (two triangles each; the cells'
+  // albedos alternate, so every edge is hard and every texel under the rectangle is covered in
+  // parts): most triangles lie within one texel (their covered weight is their area times the
+  // density at the centroid, with no clipping), the others are cut by one, two or three texel
+  // lines (the clipping paths). Under a sky of 2 and an emission of 1, a texel inside the
+  // rectangle is 1 only if its parts sum to one (4e-6 as in the closed-mesh test: float
+  // coverages and sums, dozens of parts a texel); under a black sky, E is Lambert's formula for
+  // the rectangle (1e-4 as for the issue's rectangle: the density's linearisation within
+  // partial texels, measured 1e-5).
+  const int n = 64;
+  const double texel = 2.0 / n, cell = 0.23 * texel;
+  const double x0 = -0.31, y0 = 0.07;
+  const int cols = 90, rows = 70;  // about 21 x 16 texels
+  scene_mesh m;
+  const material a{glm::vec3(1.0f), glm::vec3(0.5f), true}, b{glm::vec3(1.0f), glm::vec3(0.25f), true};
+  const auto at = [&](int i, int j) { return glm::vec3(float(x0 + i * cell), float(y0 + j * cell), 1.0f); };
+  // Triangles within one texel, by their vertices' texel coordinates on the top face (counted
+  // here from the geometry, so the test knows that path is exercised).
+  const auto texel_of = [&](const glm::vec3& v) { return std::make_pair(int(std::floor((v.x + 1.0) / texel)), int(std::floor((v.y + 1.0) / texel))); };
+  int within_one = 0;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < cols; ++i) {
+      const glm::vec3 p00 = at(i, j), p10 = at(i + 1, j), p11 = at(i + 1, j + 1), p01 = at(i, j + 1);
+      const material& mat = (i + j) % 2 ? a : b;
+      m.add_triangle(p00, p10, p11, mat);
+      m.add_triangle(p00, p11, p01, mat);
+      within_one += texel_of(p00) == texel_of(p10) && texel_of(p10) == texel_of(p11) ? 1 : 0;
+      within_one += texel_of(p00) == texel_of(p11) && texel_of(p11) == texel_of(p01) ? 1 : 0;
+    }
+  CHECK(within_one > cols * rows);  // more than half of the 2 x 90 x 70 triangles
+  raster_options o;
+  o.edge_coverage = true;
+  const frame up{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  hemicube_buffer buf;
+  {
+    scene_mesh lit = m;
+    lit.sky_radiance = glm::vec3(2.0f);
+    hemicube_rasterizer r(scene::create(lit.desc()), o);
+    r.render({0, 0, 0}, up, n, buf);
+    CHECK(r.statistics().edge_fragments > 10000);
+    double worst = 0;
+    int inside = 0;
+    for (int ty = 0; ty < n; ++ty)
+      for (int tx = 0; tx < n; ++tx) {
+        // Texels whose square lies inside the rectangle (a cell's margin: float vertices).
+        const double u0 = -1.0 + tx * texel, v0 = -1.0 + ty * texel;
+        if (u0 < x0 + cell || u0 + texel > x0 + cols * cell - cell || v0 < y0 + cell || v0 + texel > y0 + rows * cell - cell) continue;
+        ++inside;
+        worst = std::max(worst, std::fabs(double(buf.radiance_at(static_cast<std::size_t>(ty * n + tx)).x) - 1.0));
+      }
+    INFO("texels inside the rectangle: " << inside);
+    CHECK(inside > 200);
+    CHECK(worst <= 4e-6);
+  }
+  hemicube_rasterizer r(scene::create(m.desc()), o);
+  r.render({0, 0, 0}, up, n, buf);
+  const double x1 = double(float(x0 + cols * cell)), y1 = double(float(y0 + rows * cell));
+  const double want = lambert_polygon({{double(float(x0)), double(float(y0)), 1.0}, {x1, double(float(y0)), 1.0}, {x1, y1, 1.0}, {double(float(x0)), y1, 1.0}});
+  CHECK(std::fabs(integrate(buf).irradiance.x - want) <= 1e-4 * want);
+}
+
 TEST_CASE("raster: exact edge coverage leaves a closed room of one material as point sampling gives it, bit for bit", "[raster]") {
   // Seen from inside a closed, consistently wound mesh of one material, no edge is hard (no
   // boundary, no silhouette, no change of material): exact coverage has nothing to correct,

@@ -21,13 +21,20 @@ using namespace raster_detail;
 
 namespace {
 
-// square_part_inside (below) for one clipping edge f0 + gx x + gy y >= 0: the polygon's shoelace terms, edge by edge: the inside part of each side of
-// the square (an interval of it: a half-plane cuts a segment once), then the cut itself, from
-// where the boundary leaves the half-plane to where it comes back. Selects, no branches.
-double square_part_inside_one(double f0, double gx, double gy, double wx, double wy) noexcept {
+// The covered part of a texel (as texel_part_inside, below) for one clipping edge
+// f0 + gx x + gy y >= 0, with rgx = 1 / gx and
+// rgy = 1 / gy (made once per triangle edge; infinite for a zero step, never selected then: a
+// side can only be crossed where its step is nonzero): the polygon's shoelace terms, edge by
+// edge: the inside part of each side of the square (an interval of it: a half-plane cuts a
+// segment once), then the cut itself, from where the boundary leaves the half-plane to where it
+// comes back. The crossing of a side runs t = value / (value - next value) along it, and
+// value - next value is -gx, -gy, gx, gy on the bottom, right, top and left sides: multiplies by
+// the reciprocals, no division. Selects, no branches.
+double square_part_inside_one(double f0, double gx, double gy, double rgx, double rgy, double wx, double wy) noexcept {
   const double cx[4] = {-0.5, 0.5, 0.5, -0.5}, cy[4] = {-0.5, -0.5, 0.5, 0.5};  // corners about the centre
   double value[4];
   for (int i = 0; i < 4; ++i) value[i] = f0 + gx * (cx[i] + 0.5) + gy * (cy[i] + 0.5);
+  const double step[4] = {-rgx, -rgy, rgx, rgy};  // 1 / (value[i] - value[i + 1]) per side
   double twice = 0.0, mx = 0.0, my = 0.0;
   double out_x = 0.0, out_y = 0.0, in_x = 0.0, in_y = 0.0;  // where the boundary leaves and re-enters
   const auto term = [&](double ax, double ay, double bx, double by) {
@@ -39,8 +46,8 @@ double square_part_inside_one(double f0, double gx, double gy, double wx, double
   for (int i = 0; i < 4; ++i) {
     const int j = (i + 1) & 3;
     const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
-    const double d = value[i] - value[j];
-    const double t = in_i != in_j ? value[i] / d : 0.0;
+    // (Clamped: the product may round past the side's end, or overflow for a tiny step.)
+    const double t = in_i != in_j ? std::min(std::max(value[i] * step[i], 0.0), 1.0) : 0.0;
     const double hx = cx[i] + t * (cx[j] - cx[i]), hy = cy[i] + t * (cy[j] - cy[i]);  // the crossing
     const double ax = in_i ? cx[i] : hx, ay = in_i ? cy[i] : hy;
     const double bx = in_j ? cx[j] : hx, by = in_j ? cy[j] : hy;
@@ -51,62 +58,83 @@ double square_part_inside_one(double f0, double gx, double gy, double wx, double
     in_y = !in_i && in_j ? hy : in_y;
   }
   term(out_x, out_y, in_x, in_y);  // (zero when the square is all in or all out)
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
-// The part of the unit square [0, 1]^2 (a texel, in texel units) inside the half-planes
-// f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of the edges in `clip` (bit k): Sutherland-Hodgman
-// on the square's polygon (at most 4 + 3 vertices), then the polygon's area and first moments
-// about the square's centre (the shoelace formula and its moment form), weighted by the density
-// 1 + wx (x - 1/2) + wy (y - 1/2). Double precision: within ~1e-15 of the exact value for the
-// snapped triangle. The square's own moments vanish, so the values of two triangles sharing an
-// edge sum to those of their union.
-double square_part_inside(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3], unsigned clip,
-                          double wx, double wy) noexcept {
-  if (clip == 0) return 1.0;  // the whole square (its moments vanish): what the loops below give
-  if ((clip & (clip - 1)) == 0) {  // one edge (most partial texels): the same polygon, branch-free
-    const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
-    return square_part_inside_one(f0[k], gx[k], gy[k], wx, wy);
-  }
-  double ax_[8] = {0.0, 1.0, 1.0, 0.0}, ay_[8] = {0.0, 0.0, 1.0, 1.0};
-  double bx_[8], by_[8];
-  double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;  // the polygon, and the next one (swapped)
-  int count = 4;
-  for (int k = 0; k < 3 && count >= 3; ++k) {
-    if (!(clip >> k & 1u)) continue;
-    double value[8];
-    for (int i = 0; i < count; ++i) value[i] = f0[k] + gx[k] * px[i] + gy[k] * py[i];
-    int out = 0;
-    for (int i = 0; i < count; ++i) {
-      const int j = i + 1 == count ? 0 : i + 1;
-      const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
-      if (in_i) {
-        qx[out] = px[i];
-        qy[out] = py[i];
-        ++out;
-      }
-      if (in_i != in_j) {
-        const double t = value[i] / (value[i] - value[j]);
-        qx[out] = px[i] + t * (px[j] - px[i]);
-        qy[out] = py[i] + t * (py[j] - py[i]);
-        ++out;
-      }
-    }
-    count = out;
-    std::swap(px, qx);
-    std::swap(py, qy);
-  }
-  if (count < 3) return 0.0;
+// One edge of a triangle, for texel_part_inside (texel units, the face's origin): from vertex
+// (ax, ay) by (dx, dy), with its edge function's steps across a texel (gx, gy: f = f0 + gx x +
+// gy y at (x, y) from the texel's lower left corner, inside where f >= 0) and the reciprocals
+// of all four (made once per edge, when it first cuts a texel; unused where a step is zero).
+struct clip_edge {
+  double ax, ay, dx, dy, gx, gy;
+  double rdx, rdy, rgx, rgy;
+};
+
+// The covered part of a texel by Green's theorem: the area and first moments of the region
+// (the texel square, within the half-planes of the triangle's edges in `clip`, those that cut
+// it; the others hold the whole square) are sums over its boundary, counter-clockwise, of the
+// shoelace terms of its segments. That boundary is the cutting edges' segments within the
+// square (Liang-Barsky: the edge's parameter against the square's four sides) and the square's
+// sides within the half-planes (each side's parameter against each edge function, linear along
+// it). Every crossing is a product with a reciprocal made per edge: no division, no polygon
+// built, few branches, and the branches on the sign of a step are the same for every texel of
+// a triangle. (cx, cy): the texel's centre; f0: the edge functions at its lower left corner; the
+// moments are about the centre and weighted by the density 1 + wx x + wy y (x, y about the
+// centre). The part inside is exact to rounding (~1e-15) for a counter-clockwise triangle;
+// the caller gives a triangle that is not counter-clockwise nothing.
+double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigned clip, double cx, double cy,
+                         double wx, double wy) noexcept {
   double twice = 0.0, mx = 0.0, my = 0.0;  // 2 area, 6 first moments (about the centre)
-  for (int i = 0; i < count; ++i) {
-    const int j = i + 1 == count ? 0 : i + 1;
-    const double ax = px[i] - 0.5, ay = py[i] - 0.5, bx = px[j] - 0.5, by = py[j] - 0.5;
-    const double cross = ax * by - bx * ay;
+  const auto term = [&](double px, double py, double qx, double qy) {
+    const double cross = px * qy - qx * py;
     twice += cross;
-    mx += (ax + bx) * cross;
-    my += (ay + by) * cross;
+    mx += (px + qx) * cross;
+    my += (py + qy) * cross;
+  };
+  // 1. The cutting edges within the square [-1/2, 1/2]^2 (about the centre).
+  for (int k = 0; k < 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    const clip_edge& g = e[k];
+    const double ax = g.ax - cx, ay = g.ay - cy;
+    double t0 = 0.0, t1 = 1.0;
+    if (g.dx != 0.0) {
+      const double ta = (-0.5 - ax) * g.rdx, tb = (0.5 - ax) * g.rdx;
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    } else if (!(std::fabs(ax) <= 0.5)) {
+      continue;
+    }
+    if (g.dy != 0.0) {
+      const double ta = (-0.5 - ay) * g.rdy, tb = (0.5 - ay) * g.rdy;
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    } else if (!(std::fabs(ay) <= 0.5)) {
+      continue;
+    }
+    if (t0 < t1) term(ax + t0 * g.dx, ay + t0 * g.dy, ax + t1 * g.dx, ay + t1 * g.dy);
   }
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+  // 2. The square's sides (bottom, right, top, left) within the cutting half-planes. Side i
+  // runs from corner (sx, sy) by (ux, uy), over s in [s0, s1]; along it f_k starts at its
+  // value at the corner, with slope m: inside where s >= -v / m (m > 0), s <= -v / m (m < 0),
+  // everywhere or nowhere (m = 0). Selects (a zero slope's product is never selected).
+  static constexpr double sx[4] = {-0.5, 0.5, 0.5, -0.5}, sy[4] = {-0.5, -0.5, 0.5, 0.5};
+  static constexpr double ux[4] = {1.0, 0.0, -1.0, 0.0}, uy[4] = {0.0, 1.0, 0.0, -1.0};
+  double s0[4] = {0.0, 0.0, 0.0, 0.0}, s1[4] = {1.0, 1.0, 1.0, 1.0};
+  for (int k = 0; k < 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    const clip_edge& g = e[k];
+    const double v[4] = {f0[k], f0[k] + g.gx, f0[k] + g.gx + g.gy, f0[k] + g.gy};  // f_k at the corners
+    const double m[4] = {g.gx, g.gy, -g.gx, -g.gy};
+    const double rm[4] = {g.rgx, g.rgy, -g.rgx, -g.rgy};
+    for (int i = 0; i < 4; ++i) {
+      const double cut = -v[i] * rm[i];
+      s0[i] = m[i] > 0.0 ? std::max(s0[i], cut) : s0[i];
+      s1[i] = m[i] < 0.0 ? std::min(s1[i], cut) : (m[i] == 0.0 && v[i] < 0.0 ? -1.0 : s1[i]);
+    }
+  }
+  for (int i = 0; i < 4; ++i)
+    if (s0[i] < s1[i]) term(sx[i] + s0[i] * ux[i], sy[i] + s0[i] * uy[i], sx[i] + s1[i] * ux[i], sy[i] + s1[i] * uy[i]);
+  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
 }
 
 }  // namespace
@@ -158,6 +186,17 @@ inline int lowest_bit(std::uint64_t word) noexcept {
 // face's N / 2).
 inline std::size_t face_row_base(int n, int face) noexcept {
   return face == 0 ? 0 : static_cast<std::size_t>(n) + static_cast<std::size_t>(face - 1) * static_cast<std::size_t>(n / 2);
+}
+
+// floor(x) and ceil(x) as integers, for |x| < 2^62 (not NaN): a conversion and a compare (the
+// library's floor is a call or a long sequence without SSE4.1).
+inline std::int64_t floor_int(double x) noexcept {
+  const auto i = static_cast<std::int64_t>(x);  // truncates toward zero
+  return i - (x < static_cast<double>(i) ? 1 : 0);
+}
+inline std::int64_t ceil_int(double x) noexcept {
+  const auto i = static_cast<std::int64_t>(x);
+  return i + (x > static_cast<double>(i) ? 1 : 0);
 }
 
 std::uint32_t bits_of(float f) noexcept {
@@ -246,7 +285,35 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
   edge_facing_.assign(edge_planes_.size(), 0);
 }
 
+// The slopes of each texel's weight density (edge_density_), once per resolution (and the
+// per-texel front_cover_, front_z_ sized). The
+// integrator weights a texel by the projected solid angle over it, of density (1 + u^2 + v^2)^-2
+// on the top face (z = 1) and v (1 + u^2 + v^2)^-2 on the side faces (v = height); relative to
+// the centre's and per texel unit, its derivatives there are wx = -4 u / q step and
+// wy = -4 v / q step (top) or (1 / v - 4 v / q) step (sides), q = 1 + u^2 + v^2, step = 2 / N.
+void raster_detail::rasterizer_impl::edge_make_density() {
+  const int n = n_;
+  edge_density_.resize(2 * hemicube_texel_count(n));
+  front_cover_.resize(hemicube_texel_count(n));
+  front_z_.resize(hemicube_texel_count(n));
+  for (int face = 0; face < 5; ++face) {
+    const int rows = face == 0 ? n : n / 2;
+    const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < n; ++c) {
+        const double u = first_centre_ + texel_step_ * static_cast<double>(c);
+        const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
+        const double q = 1.0 + u * u + v * v;
+        const std::size_t texel = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
+        edge_density_[2 * texel] = static_cast<float>(-4.0 * u / q * texel_step_);
+        edge_density_[2 * texel + 1] = static_cast<float>((face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_);
+      }
+  }
+  edge_density_n_ = n;
+}
+
 void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, const frame& basis) {
+  if (edge_density_n_ != n_) edge_make_density();
   // Facings of the creases' triangles: the sign of the plane's value at the point, 0 within
   // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
   const double px = position.x, py = position.y, pz = position.z;
@@ -309,20 +376,21 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
     const std::size_t row_base = face_row_base(n, face);
     const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
-    const int r_first = std::max(0, static_cast<int>(std::floor(ylo - eps)));
-    const int r_last = std::min(rows - 1, static_cast<int>(std::floor(yhi + eps)));
+    const double inv_dy = yhi - ylo > 1e-12 ? 1.0 / (y1 - y0) : 0.0;  // (the margins dwarf its rounding)
+    const int r_first = std::max(0, static_cast<int>(floor_int(ylo - eps)));
+    const int r_last = std::min(rows - 1, static_cast<int>(floor_int(yhi + eps)));
     for (int r = r_first; r <= r_last; ++r) {
       // The segment's x range within the strip [r - eps, r + 1 + eps].
       double xlo = std::min(x0, x1), xhi = std::max(x0, x1);
       if (yhi - ylo > 1e-12) {
-        const double s0 = std::max(0.0, std::min(1.0, (static_cast<double>(r) - eps - y0) / (y1 - y0)));
-        const double s1 = std::max(0.0, std::min(1.0, (static_cast<double>(r) + 1.0 + eps - y0) / (y1 - y0)));
+        const double s0 = std::max(0.0, std::min(1.0, (static_cast<double>(r) - eps - y0) * inv_dy));
+        const double s1 = std::max(0.0, std::min(1.0, (static_cast<double>(r) + 1.0 + eps - y0) * inv_dy));
         const double xa = x0 + s0 * (x1 - x0), xb = x0 + s1 * (x1 - x0);
         xlo = std::min(xa, xb);
         xhi = std::max(xa, xb);
       }
-      const int c_first = std::max(0, static_cast<int>(std::floor(xlo - eps)));
-      const int c_last = std::min(n - 1, static_cast<int>(std::floor(xhi + eps)));
+      const int c_first = std::max(0, static_cast<int>(floor_int(xlo - eps)));
+      const int c_last = std::min(n - 1, static_cast<int>(floor_int(xhi + eps)));
       if (c_first > c_last) continue;
       std::int32_t& lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
       std::int32_t& hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
@@ -369,9 +437,8 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
   const std::uint64_t* bits = hard_bits_.data() + row * words_per_row_;
   const std::int64_t w0 = c0 >> 6, w1 = c1 >> 6;
   for (std::int64_t w = w0; w <= w1; ++w) {
-    std::uint64_t word = bits[w];
-    if (w == w0) word &= ~std::uint64_t(0) << (c0 & 63);
-    if (w == w1 && (c1 & 63) != 63) word &= (std::uint64_t(1) << ((c1 & 63) + 1)) - 1;
+    const int lo = w == w0 ? static_cast<int>(c0 & 63) : 0, hi = w == w1 ? static_cast<int>(c1 & 63) : 63;
+    std::uint64_t word = bits[w] & (~std::uint64_t(0) << lo) & (~std::uint64_t(0) >> (63 - hi));
     while (word) {
       if (!visit(w * 64 + lowest_bit(word))) return;
       word &= word - 1;
@@ -383,14 +450,16 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
 // clockwise) touches on `face`. A texel it covers whole makes it the texel's whole-texel
 // candidate (whole_z_, whole_id_: the nearest, ties to the earlier draw); one it covers in part
 // gets a fragment with the exact covered fraction of its weight, unless a triangle drawn earlier
-// covers the whole texel in front of it. Row by row: the rows' hard column ranges, cut to the
-// triangle's x extent within the row's strip (its vertices in the strip and its edges' crossings
-// of the strip's lines), bound the texels to classify; they are classified exactly with the
-// integer edge functions at their corners (outside: an edge leaves every corner at <= 0, i.e. no
-// area in common; whole: every corner of every edge >= 0; else partial). `exact`: the unsnapped
-// vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The coverage paths
-// draw the triangle as without the option (centre samples). Cost: O(rows + the hard texels of
-// its rows within its extent).
+// covers the whole texel in front of it or fragments in front of it already fill the texel.
+// Row by row over the box (the snapped box grown by the snapping, cut to the unsnapped
+// triangle's): the rows' hard texels within it (hard_rows_, hard_bits_) are classified exactly
+// with the integer edge functions at their corners (far: an edge leaves every corner more than
+// 1/64 texel outside; whole: every corner of every edge >= 0; else partial). The rows' texels
+// are not cut to the triangle's extent within each row: computing its crossings per row costs
+// about what testing the row's few hard texels does (docs/design/raster.md). `exact`: the
+// unsnapped vertices (x0, x1, x2, y0, y1, y2, fixed-point units), for the covered part. The
+// coverage paths draw the triangle as without the option (centre samples). Cost: O(rows of the
+// box + its hard texels), a partial texel ~100-200 instructions.
 void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3],
                                       const double (&exact)[6], const face_setup& fs, std::uint32_t draw,
                                       bool back) {
@@ -407,39 +476,90 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   const std::int64_t min_y = std::min({py[0], py[1], py[2]}), max_y = std::max({py[0], py[1], py[2]});
   const std::int64_t min_x = std::min({px[0], px[1], px[2]}), max_x = std::max({px[0], px[1], px[2]});
   // Texels the box overlaps, grown by the snapping (half a unit) for the unsnapped triangle.
-  const std::int64_t col_lo = std::max<std::int64_t>(floor_sub(min_x - 1), 0);
-  const std::int64_t col_hi = std::min<std::int64_t>(ceil_sub(max_x + 1) - 1, n - 1);
-  const std::int64_t row_lo = std::max<std::int64_t>(floor_sub(min_y - 1), 0);
-  const std::int64_t row_hi = std::min<std::int64_t>(ceil_sub(max_y + 1) - 1, rows - 1);
-
-  // The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex k
-  // = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel.
+  // Cut to the texels the unsnapped triangle's box overlaps by a positive length (the others
+  // share no area with it; a texel the snapped triangle covers whole is among them, the two
+  // triangles' vertices being within half a unit of each other).
+  const double ux_lo = std::min({exact[0], exact[1], exact[2]}), ux_hi = std::max({exact[0], exact[1], exact[2]});
+  const double uy_lo = std::min({exact[3], exact[4], exact[5]}), uy_hi = std::max({exact[3], exact[4], exact[5]});
+  const double inv_one = 1.0 / static_cast<double>(sub_one);  // (exact: a power of two)
+  const std::int64_t uc_lo = floor_int(ux_lo * inv_one), uc_hi = ceil_int(ux_hi * inv_one) - 1;
+  const std::int64_t ur_lo = floor_int(uy_lo * inv_one), ur_hi = ceil_int(uy_hi * inv_one) - 1;
+  const std::int64_t col_lo = std::max<std::int64_t>({floor_sub(min_x - 1), uc_lo, 0});
+  const std::int64_t col_hi = std::min<std::int64_t>({ceil_sub(max_x + 1) - 1, uc_hi, n - 1});
+  const std::int64_t row_lo = std::max<std::int64_t>({floor_sub(min_y - 1), ur_lo, 0});
+  const std::int64_t row_hi = std::min<std::int64_t>({ceil_sub(max_y + 1) - 1, ur_hi, rows - 1});
+  if (col_lo > col_hi || row_lo > row_hi) return;
+  // The unsnapped triangle's values, made at its first partial texel (many calls have none: all
+  // their hard texels are far, whole, behind or in a silhouette's back sheet).
+  //  - The unsnapped edge functions f_k(x, y) = edx (y - ay) - edy (x - ax) (fixed point, vertex
+  //    k = (ax, ay)), their steps across a texel (gx, gy) and the extremes of those over the texel;
+  //  - the edges for texel_part_inside (texel units; their reciprocals when they first cut a
+  //    texel: have_reciprocals);
+  //  - positive: only a counter-clockwise unsnapped triangle has an inside (snapping, by at most
+  //    half a unit, can turn a sliver around): another gets no partial texels;
+  //  - tiny: a triangle within one texel (the terrain's far triangles): its covered weight is its
+  //    area times the density at its centroid, exact for a density linear over the texel, with
+  //    no clipping (what clipping the square by its three edges gives, to rounding).
   double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
-  for (int k = 0; k < 3; ++k) {
-    const int b = k == 2 ? 0 : k + 1;
-    edx[k] = exact[b] - exact[k];
-    edy[k] = exact[3 + b] - exact[3 + k];
-    gx[k] = -edy[k] * static_cast<double>(sub_one);
-    gy[k] = edx[k] * static_cast<double>(sub_one);
-    gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
-    gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
-  }
-  const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
-    ++stats_.edge_texels_tested;
-    const std::int64_t x0 = c * sub_one, y0 = r * sub_one;
-    // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
-    // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's
-    // edges are within ~2 units of the snapped ones over its box, so it has no area there.
-    bool whole = true, far = false;
+  clip_edge ce[3];
+  unsigned have_reciprocals = 0;
+  bool unsnapped_ready = false, positive = false;
+  const bool tiny = uc_lo == uc_hi && ur_lo == ur_hi;
+  double tiny_area = 0.0, tiny_x = 0.0, tiny_y = 0.0;  // texel units; centroid about the texel's centre
+  const auto make_unsnapped = [&] {
     for (int k = 0; k < 3; ++k) {
-      const std::int64_t e = dx[k] * (y0 - py[k]) - dy[k] * (x0 - px[k]);
-      const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
-      whole = whole && e + std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0) >= 0;
-      far = far || e + std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0) < -4 * (std::abs(dx[k]) + std::abs(dy[k]));
+      const int b = k == 2 ? 0 : k + 1;
+      edx[k] = exact[b] - exact[k];
+      edy[k] = exact[3 + b] - exact[3 + k];
+      gx[k] = -edy[k] * static_cast<double>(sub_one);
+      gy[k] = edx[k] * static_cast<double>(sub_one);
+      gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
+      gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
+      ce[k].ax = exact[k] * inv_one;
+      ce[k].ay = exact[3 + k] * inv_one;
+      ce[k].dx = edx[k] * inv_one;
+      ce[k].dy = edy[k] * inv_one;
+      ce[k].gx = gx[k];
+      ce[k].gy = gy[k];
     }
-    if (far) return;
+    positive = edx[0] * edy[2] - edx[2] * edy[0] < 0.0;
+    if (tiny) {
+      const double ax = exact[1] - exact[0], ay = exact[4] - exact[3], bx = exact[2] - exact[0], by = exact[5] - exact[3];
+      tiny_area = 0.5 * (ax * by - bx * ay) * (inv_one * inv_one);
+      tiny_x = (exact[0] + exact[1] + exact[2]) * (inv_one / 3.0) - static_cast<double>(uc_lo) - 0.5;
+      tiny_y = (exact[3] + exact[4] + exact[5]) * (inv_one / 3.0) - static_cast<double>(ur_lo) - 0.5;
+    }
+    unsnapped_ready = true;
+  };
+  // Whole: every corner of the texel inside the snapped triangle (exact integers). Far: every
+  // corner more than 4 units (1/64 texel) outside an edge of it; the unsnapped triangle's edges
+  // are within ~2 units of the snapped ones over its box, so it has no area there. With the
+  // edge function e_k at the texel's lower left corner, the texel is whole when e_k >=
+  // whole_at[k] for every edge and far when e_k < far_below[k] for some edge; e_k steps by
+  // step_x[k] per column (exact integers: terms below 2^61, see guard_band).
+  std::int64_t step_x[3], whole_at[3], far_below[3];
+  for (int k = 0; k < 3; ++k) {
+    const std::int64_t sx = -dy[k] * sub_one, sy = dx[k] * sub_one;
+    step_x[k] = sx;
+    whole_at[k] = -(std::min<std::int64_t>(sx, 0) + std::min<std::int64_t>(sy, 0));
+    far_below[k] = -4 * (std::abs(dx[k]) + std::abs(dy[k])) - (std::max<std::int64_t>(sx, 0) + std::max<std::int64_t>(sy, 0));
+  }
+  // Per row: the edge functions at its column 0 (snapped: made at the first row with hard
+  // texels, then stepped row by row, exactly; unsnapped: made at the row's first partial texel)
+  // and the depth row.
+  std::int64_t e_row[3] = {0, 0, 0};
+  std::int64_t e_row_at = -1, f_row_at = -1;  // the rows they hold
+  double f_row[3];
+  float zrow = 0.0f;
+  // The statistics, counted here and added at the end (an increment of the member per texel
+  // would chain every iteration through memory).
+  std::size_t tested = 0, kept = 0;
+  const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
+    ++tested;
+    const std::int64_t e0 = e_row[0] + c * step_x[0], e1 = e_row[1] + c * step_x[1], e2 = e_row[2] + c * step_x[2];
+    if ((e0 < far_below[0]) | (e1 < far_below[1]) | (e2 < far_below[2])) return;
+    const bool whole = (e0 >= whole_at[0]) & (e1 >= whole_at[1]) & (e2 >= whole_at[2]);
     // The triangle's depth at the texel centre, as the coverage paths compute it.
-    const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     float z = zrow + fs.dzdx * static_cast<float>(c);
     z = z > FLT_MIN ? z : FLT_MIN;
     if (whole) {
@@ -449,6 +569,8 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       }
       return;
     }
+    if (!unsnapped_ready) make_unsnapped();
+    if (!positive) return;
     // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
     // blend stops at the whole-texel winner, which can only come nearer).
     if (!(z > whole_z_[texel])) return;
@@ -457,37 +579,76 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     // leaves it through the far sheet), which the blend, taking fragments as side by side,
     // would count again in place of what lies behind.
     if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
+    // Behind every fragment the texel has, whose coverages sum to one or more: the blend, front
+    // to back, has given the whole texel away before it reaches this one (each takes min(its
+    // coverage, what is left), or stopped earlier at the whole-texel candidate), so it would
+    // take no share, and the render is the same bits without it. (The margin covers the float
+    // sums' rounding, 6e-8 a fragment, up to the 256 fragments the test allows.)
+    const std::uint32_t count = fragment_count_[texel];
+    if (count != 0 && count <= 256 && z < front_z_[texel] && front_cover_[texel] >= 1.0f + 1e-4f) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
     // triangles sharing an edge clip it from the same unsnapped endpoints, so between them they
     // miss no part of a texel.
-    double f0[3];
-    unsigned clip = 0;  // the unsnapped edges that cut the texel
-    for (int k = 0; k < 3; ++k) {
-      f0[k] = edx[k] * (static_cast<double>(y0) - exact[3 + k]) - edy[k] * (static_cast<double>(x0) - exact[k]);
-      if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
-      if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
-    }
+    //
     // The integrator weights a texel by the projected solid angle over it; within the texel its
     // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
-    // centre's, in texel units): the covered fraction of the texel's weight, to second order.
-    // Top face (z = 1): density (1 + u^2 + v^2)^-2; side faces (v = height): v (1 + u^2 + v^2)^-2.
-    const double u = first_centre_ + texel_step_ * static_cast<double>(c);
-    const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
-    const double q = 1.0 + u * u + v * v;
-    const double wx = -4.0 * u / q * texel_step_;
-    const double wy = (face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_;
-    const double area = square_part_inside(f0, gx, gy, clip, wx, wy);
+    // centre's, in texel units; edge_density_): the covered fraction of the texel's weight, to
+    // second order.
+    const float* slope = edge_density_.data() + 2 * texel;
+    const double wx = slope[0], wy = slope[1];
+    double area;
+    if (tiny) {
+      area = tiny_area * (1.0 + wx * tiny_x + wy * tiny_y);
+    } else {
+      if (f_row_at != r) {
+        const double y0 = static_cast<double>(r * sub_one);
+        for (int k = 0; k < 3; ++k) f_row[k] = edx[k] * (y0 - exact[3 + k]) + edy[k] * exact[k];
+        f_row_at = r;
+      }
+      double f0[3];
+      unsigned clip = 0;  // the unsnapped edges that cut the texel
+      for (int k = 0; k < 3; ++k) {
+        f0[k] = f_row[k] + static_cast<double>(c) * gx[k];
+        if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
+        if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
+      }
+      if ((clip & ~have_reciprocals) != 0) {
+        for (int k = 0; k < 3; ++k)
+          if ((clip & ~have_reciprocals) >> k & 1u) {
+            ce[k].rdx = 1.0 / ce[k].dx;
+            ce[k].rdy = 1.0 / ce[k].dy;
+            ce[k].rgx = 1.0 / ce[k].gx;
+            ce[k].rgy = 1.0 / ce[k].gy;
+          }
+        have_reciprocals |= clip;
+      }
+      if (clip == 0)
+        area = 1.0;
+      else if ((clip & (clip - 1)) == 0) {  // one cutting edge (most partial texels): the corners' form
+        const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
+        area = square_part_inside_one(f0[k], ce[k].gx, ce[k].gy, ce[k].rgx, ce[k].rgy, wx, wy);
+      } else {
+        area = texel_part_inside(ce, f0, clip, static_cast<double>(c) + 0.5, static_cast<double>(r) + 0.5, wx, wy);
+      }
+    }
     if (!(area > 0.0)) return;
     edge_fragment fr;
     fr.texel = static_cast<std::uint32_t>(texel);
     fr.z = z;
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
-    if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
+    if (fragment_count_[texel]++ == 0) {
+      fragment_texels_.push_back(fr.texel);
+      front_cover_[texel] = fr.coverage;
+      front_z_[texel] = z;
+    } else {
+      front_cover_[texel] += fr.coverage;
+      front_z_[texel] = std::min(front_z_[texel], z);
+    }
     fragments_.push_back(fr);
-    ++stats_.edge_fragments;
+    ++kept;
   };
 
   for (std::int64_t r = row_lo; r <= row_hi; ++r) {
@@ -496,11 +657,21 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (hard_lo > col_hi || hard_hi < col_lo) continue;
     const std::int64_t c0 = std::max<std::int64_t>(col_lo, hard_lo), c1 = std::min<std::int64_t>(col_hi, hard_hi);
     const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
+    if (r != e_row_at) {
+      const std::int64_t y0 = r * sub_one;
+      for (int k = 0; k < 3; ++k) e_row[k] = dx[k] * (y0 - py[k]) + dy[k] * px[k];
+    }
+    e_row_at = r + 1;  // the next row's values follow by a step
+    f_row_at = -1;
+    zrow = static_cast<float>(fs.z00 + fs.dzdy * static_cast<double>(r));
     edge_for_hard(row_base + static_cast<std::size_t>(r), c0, c1, [&](std::int64_t c) {
       classify(c, r, row + static_cast<std::size_t>(c));
       return true;
     });
+    for (int k = 0; k < 3; ++k) e_row[k] += dx[k] * sub_one;
   }
+  stats_.edge_texels_tested += tested;
+  stats_.edge_fragments += kept;
 }
 
 // After the resolve (which gave every texel its centre sample, as without the option): each
@@ -547,6 +718,12 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
 // takes the rest. Deterministic: the order is total and the sums run in it.
 void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
   const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
+  // A draw's radiance: its shade (inline; most renders have no texture), else fragment_radiance.
+  const auto radiance = [&](std::uint32_t id, std::size_t texel, float z) {
+    if (textured_) return fragment_radiance(id, texel, z, texture);
+    const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];
+    return glm::vec3(sh.r, sh.g, sh.b);
+  };
   float* red = out.channel(0);
   float* green = out.channel(1);
   float* blue = out.channel(2);
@@ -575,7 +752,7 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
       const float share = std::min(fr.coverage, left);
       if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
-      sum += share * fragment_radiance(fr.id, g.texel, fr.z, texture);
+      sum += share * radiance(fr.id, g.texel, fr.z);
       left -= share;
       if (!(left > 0.0f)) break;
     }
@@ -585,11 +762,14 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
     // at an occluding edge must carry the occluder's distance, or half the edge's radiance step
     // would move with the surface behind; and one whose centre sees nothing must not be at +inf
     // (a wall between two texels at +inf contributes nothing).
-    if (nearest > 0.0f && lengths_[g.texel] / nearest < out.distance[g.texel]) out.distance[g.texel] = lengths_[g.texel] / nearest;
+    if (nearest > 0.0f) {
+      const float distance = lengths_[g.texel] / nearest;
+      if (distance < out.distance[g.texel]) out.distance[g.texel] = distance;
+    }
     if (left > 0.0f) {
       glm::vec3 rest;
       if (full_z > 0.0f)
-        rest = fragment_radiance(full_id, g.texel, full_z, texture);
+        rest = radiance(full_id, g.texel, full_z);
       else if (sky_)
         rest = glm::vec3(sky_->sample(basis.to_world(directions_[g.texel])));
       else

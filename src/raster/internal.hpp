@@ -192,6 +192,14 @@ class alignas(64) rasterizer_impl {
   std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
   std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
   unsigned hard_faces_ = 0;                   // faces with a hard texel
+  // Per texel: the slopes wx, wy of its weight's density across it, relative to the centre's
+  // (texel units; edge_make_density, once per resolution: edge_density_n_).
+  std::vector<float> edge_density_;
+  int edge_density_n_ = 0;
+  // Per texel with fragments (fragment_count_ nonzero): the sum of its fragments' coverages and
+  // their least 1/w (a later fragment behind all of them once they sum to one gets no share).
+  std::vector<float> front_cover_, front_z_;
+  void edge_make_density();
   void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
   glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
