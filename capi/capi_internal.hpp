@@ -25,6 +25,7 @@ struct hemilight_scene {
   std::shared_ptr<const hemilight::scene> scene;
   std::shared_ptr<const hemilight::cubemap> sky;  ///< optional environment sky (null: the scene's constant sky)
   std::shared_ptr<const hemilight::light_set> lights;  ///< optional lights (null: none)
+  bool edge_coverage = false;  ///< hemicubes with exact edge coverage (hemilight_scene_with_edge_coverage)
 };
 
 namespace hemilight::capi {

@@ -102,6 +102,7 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     // Step 2: the sampler and the cache.
     hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
     so.raster.sky = scene->sky;
+    so.raster.edge_coverage = so.raster.edge_coverage || scene->edge_coverage;
     const hemilight::irradiance_sampler sampler =
         hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
     hemilight::cache_result r = hemilight::cache_irradiance(p, n, count, sampler, o);

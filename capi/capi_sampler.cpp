@@ -72,6 +72,7 @@ hemilight_status check_point(const char* function, const std::string& where, con
 void point_sampler::prepare(const hemilight_scene& scene, int resolution) {
   raster_options ro;
   ro.sky = scene.sky;
+  ro.edge_coverage = scene.edge_coverage;
   if (!raster)
     raster = std::make_unique<hemicube_rasterizer>(scene.scene, ro);
   else

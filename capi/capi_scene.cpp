@@ -110,6 +110,7 @@ hemilight_status hemilight_scene_with_lights(const hemilight_scene* scene, const
     auto handle = std::make_unique<hemilight_scene>();
     handle->scene = scene->scene;  // shared geometry and sky, not copied
     handle->sky = scene->sky;
+    handle->edge_coverage = scene->edge_coverage;
     if (!ls.empty()) handle->lights = std::make_shared<const hemilight::light_set>(ls.data(), ls.size());
     *out = handle.release();
     return HEMILIGHT_OK;
@@ -185,7 +186,23 @@ hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, 
     auto handle = std::make_unique<hemilight_scene>();
     handle->scene = scene->scene;  // shared geometry and lights, not copied
     handle->lights = scene->lights;
+    handle->edge_coverage = scene->edge_coverage;
     handle->sky = std::make_shared<const hemilight::cubemap>(hemilight::cubemap::from_image(std::move(faces), false));
+    *out = handle.release();
+    return HEMILIGHT_OK;
+  });
+}
+
+hemilight_status hemilight_scene_with_edge_coverage(const hemilight_scene* scene, int edge_coverage,
+                                                    hemilight_scene** out) {
+  const char* fn = "hemilight_scene_with_edge_coverage";
+  return guarded(fn, [&] {
+    if (!scene) return invalid(fn, "scene is NULL");
+    if (!out) return invalid(fn, "out is NULL");
+    if (edge_coverage != 0 && edge_coverage != 1)
+      return invalid(fn, "edge_coverage is " + std::to_string(edge_coverage) + "; it must be 0 or 1");
+    auto handle = std::make_unique<hemilight_scene>(*scene);  // shared geometry, sky and lights
+    handle->edge_coverage = edge_coverage == 1;
     *out = handle.release();
     return HEMILIGHT_OK;
   });
