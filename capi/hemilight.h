@@ -62,7 +62,7 @@ extern "C" {
 
 /* Compile-time version of this header; hemilight_version() gives the library's. */
 #define HEMILIGHT_VERSION_MAJOR 0
-#define HEMILIGHT_VERSION_MINOR 14
+#define HEMILIGHT_VERSION_MINOR 15
 #define HEMILIGHT_VERSION_PATCH 0
 
 typedef enum hemilight_status {

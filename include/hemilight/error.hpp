@@ -13,7 +13,7 @@ namespace hemilight {
 
 /// Library version (semantic versioning). Matches hemilight_version() of the C ABI.
 inline constexpr int version_major = 0;
-inline constexpr int version_minor = 14;
+inline constexpr int version_minor = 15;
 inline constexpr int version_patch = 0;
 
 /// The status codes of the C ABI, in the same order and with the same values.
