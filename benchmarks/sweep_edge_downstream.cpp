@@ -45,7 +45,9 @@
 // building; "terrain", heightfield(--terrain), K x K over its square (x, z), each point on the
 // heightfield's triangle above it, with that triangle's normal. In each, points inside geometry
 // (the step under the floor slab, ground under buildings and posts, ...) are left out by the
-// reference's back-face rule (step 1).
+// reference's back-face rule (step 1). Nothing in them emits: a hemicube's irradiance is the sky
+// that the point sees. Their rows' scene: open_pavilion_708, open_street_554, heightfield_<2 k^2>
+// (heightfield_10082 for T = 10000).
 //
 // Steps (1-4 per scene, 5 once):
 // 1. Reference: at every S-th point, a hemicube at --converged N (edge coverage unless --reference
@@ -72,6 +74,8 @@
 // Error (steps 1-4): (E - E_ref) / max(E_ref, 5% of the mean E_ref) in luminance, as sweep_cache
 // (umbra points do not divide by ~0).
 // Time with the defaults: ~5 min on a shared 2-core VM with the edge coverage of 0.13.0 (299 s).
+// The open scenes (--scenes pavilion,street,terrain --parts cost,n,cache): 256 s on the shared
+// 2-core VM, of which ~65 s the references and their checks (read back from --truth-cache on reruns).
 //
 // CSV columns: part,scene,mode,N,a,round,points,hemicubes,seconds,hemicubes_per_s,rms_rel_err,
 // max_rel_err,mean_rel_err,target_hemicubes,matched,threads,loadavg. `seconds` is the wall time of the
