@@ -129,8 +129,9 @@ struct settings {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "sweep_edge_downstream: %s\n"
-               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache,silhouette] [--scenes cornell,hexagon,sky,pavilion,street,terrain]\n"
-               "       [--terrain T] [--grid K] [--stride S] [--converged N] [--reference edge|point] [--check N] [--check-point N] [--check-stride S] [--ns N,...]\n"
+               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache,silhouette]\n"
+               "       [--scenes cornell,hexagon,sky,pavilion,street,terrain] [--terrain T] [--grid K] [--stride S]\n"
+               "       [--converged N] [--reference edge|point] [--check N] [--check-point N] [--check-stride S] [--ns N,...]\n"
                "       [--cost-n N] [--rounds R] [--cost-points P] [--time-rounds R] [--time-points P] [--cache-n N]\n"
                "       [--a a,...] [--threads T] [--truth-cache DIR] [--append]\n"
                "(the options are described at the top of benchmarks/sweep_edge_downstream.cpp)\n",
@@ -275,20 +276,31 @@ void grid_on_mesh(point_set& ps, glm::vec3 o, glm::vec3 u, glm::vec3 v, glm::vec
 
 // k x k points over the heightfield's square [-5, 5]^2 (x, z; texel centres as grid_points), each
 // on the topmost upward-facing triangle above it (the heightfield has one), with that triangle's
-// front normal, 1 mm off it along the normal.
+// front normal, 1 mm off it along the normal. The triangles are binned by their x-z bounds on a
+// b x b grid (b^2 ~ triangles / 2), so each point tests a few: O(T + k^2) for T triangles.
 void heightfield_grid(point_set& ps, int k) {
   const scene_mesh& m = ps.mesh;
+  const int b = std::max(1, int(std::sqrt(double(m.triangle_count()) / 2.0)));
+  const auto bin = [b](double v) { return std::clamp(int(std::floor((v + 5.0) / 10.0 * b)), 0, b - 1); };
+  std::vector<std::vector<std::size_t>> bins(std::size_t(b) * std::size_t(b));
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    glm::dvec3 c[3];
+    corners(m, t, c);
+    if (glm::cross(c[1] - c[0], c[2] - c[0]).y <= 0.0) continue;  // faces down or edge-on
+    const glm::dvec3 lo = glm::min(c[0], glm::min(c[1], c[2])), hi = glm::max(c[0], glm::max(c[1], c[2]));
+    for (int j = bin(lo.z); j <= bin(hi.z); ++j)
+      for (int i = bin(lo.x); i <= bin(hi.x); ++i) bins[std::size_t(j) * std::size_t(b) + std::size_t(i)].push_back(t);
+  }
   for (int j = 0; j < k; ++j)
     for (int i = 0; i < k; ++i) {
       const double x = -5.0 + 10.0 * (i + 0.5) / k, z = -5.0 + 10.0 * (j + 0.5) / k;
       bool found = false;
       double best_y = 0.0;
       glm::dvec3 best_n(0.0);
-      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      for (const std::size_t t : bins[std::size_t(bin(z)) * std::size_t(b) + std::size_t(bin(x))]) {
         glm::dvec3 c[3];
         corners(m, t, c);
         const glm::dvec3 g = glm::cross(c[1] - c[0], c[2] - c[0]);
-        if (g.y <= 0.0) continue;
         // Barycentric coordinates of (x, z) in the triangle's x-z projection (g.y is twice its area).
         const double ax = c[0].x - x, az = c[0].z - z, bx = c[1].x - x, bz = c[1].z - z, cx = c[2].x - x, cz = c[2].z - z;
         const double w0 = (bz * cx - bx * cz) / g.y, w1 = (cz * ax - cx * az) / g.y, w2 = (az * bx - ax * bz) / g.y;
