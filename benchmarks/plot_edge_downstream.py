@@ -9,7 +9,9 @@ edge coverage at the threshold matched to the same count, with the per-point hem
 at the cache's N as dotted lines (what the cache cannot beat). The silhouette rows (closed boxes
 against their front faces only) are printed, not drawn.
 
-usage: plot_edge_downstream.py [DIR]   (DIR holds edge_downstream.csv; the PNG is written there)
+usage: plot_edge_downstream.py [DIR [NAME]]   (DIR holds NAME.csv, by default edge_downstream.csv; the
+       chart is written there as NAME.png. The open scenes: NAME = edge_downstream_open, the CSV of
+       `benchmarks/run.sh edge_downstream_open`; the same chart, a column per scene.)
 """
 import sys
 from collections import defaultdict
@@ -22,7 +24,8 @@ import matplotlib.pyplot as plt
 from bench_csv import load_csv
 
 out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
-rows = load_csv(f"{out}/edge_downstream.csv")
+csv_name = sys.argv[2] if len(sys.argv) > 2 else "edge_downstream"
+rows = load_csv(f"{out}/{csv_name}.csv")
 scenes = list(dict.fromkeys(r["scene"] for r in rows if r["part"] in ("cost", "per_point", "cache")))
 MODES = (("point", "point sampling", "s--", "tab:orange"), ("edge", "edge coverage", "o-", "tab:blue"))
 
@@ -104,7 +107,7 @@ for shape in dict.fromkeys(r["scene"] for r in sil):
 
 # ---- chart ----------------------------------------------------------------------------------
 if not scenes:
-    sys.exit("plot_edge_downstream: no rows in edge_downstream.csv")
+    sys.exit(f"plot_edge_downstream: no rows in {csv_name}.csv")
 fig, axes = plt.subplots(2, len(scenes), figsize=(5.2 * len(scenes), 8.4), squeeze=False)
 for col, s in enumerate(scenes):
     ax = axes[0][col]
@@ -154,5 +157,5 @@ for col, s in enumerate(scenes):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
 fig.tight_layout()
-fig.savefig(f"{out}/edge_downstream.png", dpi=110)
-print(f"\nwrote {out}/edge_downstream.png")
+fig.savefig(f"{out}/{csv_name}.png", dpi=110)
+print(f"\nwrote {out}/{csv_name}.png")

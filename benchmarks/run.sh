@@ -12,6 +12,8 @@
 #                                     both weights (docs/cache.md; ~25 min; not run by default)
 #   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
+#   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
+#                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -126,6 +128,17 @@ for n in "${names[@]}"; do
     # shellcheck disable=SC2086  # the flags are words on purpose
     "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream.csv ${EDGE_DOWNSTREAM_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench
+    continue
+  fi
+  if [ "$n" = edge_downstream_open ]; then
+    # The same on open scenes like game content under a sky (open_pavilion, open_street, heightfield(10000)):
+    # parts cost, n and cache; not in the default run (the silhouette part is edge_downstream's). ~4.5 min on
+    # 2 cores. EDGE_DOWNSTREAM_FLAGS apply here too, after these (e.g. "--truth-cache build-bench/edge_truth").
+    echo "== sweep_edge_downstream (open scenes)"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream_open.csv --scenes pavilion,street,terrain \
+      --parts cost,n,cache ${EDGE_DOWNSTREAM_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench edge_downstream_open
     continue
   fi
   if [ "$n" = edge ]; then

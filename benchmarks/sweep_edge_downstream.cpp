@@ -5,7 +5,9 @@
 //
 //   usage: sweep_edge_downstream out.csv [options]
 //     --parts LIST        any of cost,n,cache,silhouette (default all four)
-//     --scenes LIST       any of cornell,hexagon,sky (default all three)
+//     --scenes LIST       any of cornell,hexagon,sky,pavilion,street,terrain (default cornell,hexagon,sky;
+//                         the open scenes: benchmarks/run.sh edge_downstream_open)
+//     --terrain T         triangles of the terrain scene, heightfield(T) (default 10000)
 //     --grid K            points per side of each surface (default 64)
 //     --stride S          the converged reference (and the per-point sweep) use every S-th point (default 5)
 //     --converged N       resolution of the converged reference (default 512)
@@ -35,6 +37,17 @@
 // K x K lightmap of the surface) 1 mm off each surface. Every hemicube goes through
 // make_hemicube_sampler (its defaults: rolled, the cache's integrate options), the two ways differing
 // only in hemicube_sampler_options::raster.edge_coverage.
+// The open scenes (like game content under a sky of 1: thin parts, many silhouettes, terrain; not
+// in the default --scenes): "pavilion", open_pavilion() (708 triangles), K x K points on the step's
+// top, the floor slab's top and the roof's underside (the roof's top sees nothing but the sky: left
+// out); "street", open_street(), K x K on the ground and on each of the two planes of the building
+// fronts along the street (z = -4 and 4, up to 12 m high), of those only the points that lie on a
+// building; "terrain", heightfield(--terrain), K x K over its square (x, z), each point on the
+// heightfield's triangle above it, with that triangle's normal. In each, points inside geometry
+// (the step under the floor slab, ground under buildings and posts, ...) are left out by the
+// reference's back-face rule (step 1). Nothing in them emits: a hemicube's irradiance is the sky
+// that the point sees. Their rows' scene: open_pavilion_708, open_street_554, heightfield_<2 k^2>
+// (heightfield_10082 for T = 10000).
 //
 // Steps (1-4 per scene, 5 once):
 // 1. Reference: at every S-th point, a hemicube at --converged N (edge coverage unless --reference
@@ -61,6 +74,8 @@
 // Error (steps 1-4): (E - E_ref) / max(E_ref, 5% of the mean E_ref) in luminance, as sweep_cache
 // (umbra points do not divide by ~0).
 // Time with the defaults: ~5 min on a shared 2-core VM with the edge coverage of 0.13.0 (299 s).
+// The open scenes (--scenes pavilion,street,terrain --parts cost,n,cache): 256 s on the shared
+// 2-core VM, of which ~65 s the references and their checks (read back from --truth-cache on reruns).
 //
 // CSV columns: part,scene,mode,N,a,round,points,hemicubes,seconds,hemicubes_per_s,rms_rel_err,
 // max_rel_err,mean_rel_err,target_hemicubes,matched,threads,loadavg. `seconds` is the wall time of the
@@ -104,6 +119,7 @@ struct settings {
   std::vector<float> thresholds{0.1f, 0.2f, 0.4f, 0.7f};
   bool reference_edge = true;
   int threads = 0;
+  std::size_t terrain = 10000;
   std::string truth_dir;
   bool append = false;
 
@@ -113,8 +129,9 @@ struct settings {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "sweep_edge_downstream: %s\n"
-               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache,silhouette] [--scenes cornell,hexagon,sky] [--grid K]\n"
-               "       [--stride S] [--converged N] [--reference edge|point] [--check N] [--check-point N] [--check-stride S] [--ns N,...]\n"
+               "usage: sweep_edge_downstream out.csv [--parts cost,n,cache,silhouette]\n"
+               "       [--scenes cornell,hexagon,sky,pavilion,street,terrain] [--terrain T] [--grid K] [--stride S]\n"
+               "       [--converged N] [--reference edge|point] [--check N] [--check-point N] [--check-stride S] [--ns N,...]\n"
                "       [--cost-n N] [--rounds R] [--cost-points P] [--time-rounds R] [--time-points P] [--cache-n N]\n"
                "       [--a a,...] [--threads T] [--truth-cache DIR] [--append]\n"
                "(the options are described at the top of benchmarks/sweep_edge_downstream.cpp)\n",
@@ -157,7 +174,8 @@ settings parse(int argc, char** argv) {
       return v;
     };
     if (arg == "--parts") st.parts = list({"cost", "n", "cache", "silhouette"});
-    else if (arg == "--scenes") st.scenes = list({"cornell", "hexagon", "sky"});
+    else if (arg == "--scenes") st.scenes = list({"cornell", "hexagon", "sky", "pavilion", "street", "terrain"});
+    else if (arg == "--terrain") st.terrain = std::size_t(to_int(value(), "--terrain", 2, 1 << 22));
     else if (arg == "--grid") st.grid = to_int(value(), "--grid", 2, 1024);
     else if (arg == "--stride") st.stride = to_int(value(), "--stride", 1, 1 << 20);
     else if (arg == "--converged") st.converged = to_resolution(value(), "--converged");
@@ -200,7 +218,9 @@ settings parse(int argc, char** argv) {
 // ---- scenes and points -------------------------------------------------------------------------
 
 struct point_set {
-  std::string key;
+  std::string key;   // the --scenes entry
+  std::string name;  // the CSV's scene column
+  std::string file;  // the --truth-cache files' scene part (the key, with the terrain's triangle count)
   scene_mesh mesh;
   std::shared_ptr<const scene> sc;
   std::vector<glm::vec3> p, n;
@@ -211,13 +231,103 @@ void grid(point_set& ps, glm::vec3 o, glm::vec3 u, glm::vec3 v, glm::vec3 n, int
   bench::grid_points(ps.p, ps.n, o, u, v, n, k);
 }
 
-point_set make_points(const std::string& key, int k) {
+// The corners of triangle t of m.
+void corners(const scene_mesh& m, std::size_t t, glm::dvec3 c[3]) {
+  for (int j = 0; j < 3; ++j) c[j] = glm::dvec3(m.positions[m.indices[3 * t + std::size_t(j)]]);
+}
+
+// Does q lie on the triangle with corners c (within 1e-4 m of its plane, and within its edges in
+// the plane, 1e-6 relative slack)?
+bool on_triangle(const glm::dvec3 c[3], const glm::dvec3& q) {
+  const glm::dvec3 e1 = c[1] - c[0], e2 = c[2] - c[0], g = glm::cross(e1, e2);
+  const double len = glm::length(g);
+  if (len == 0.0) return false;
+  const glm::dvec3 d = q - c[0];
+  if (std::fabs(glm::dot(d, g)) / len > 1e-4) return false;
+  const double u = glm::dot(glm::cross(d, e2), g) / (len * len), v = glm::dot(glm::cross(e1, d), g) / (len * len);
+  return u >= -1e-6 && v >= -1e-6 && u + v <= 1.0 + 1e-6;
+}
+
+// Appends the k x k points of the parallelogram (grid_points) that lie on a triangle of m facing
+// along n: the parts of a plane the mesh covers (the building fronts along a street).
+void grid_on_mesh(point_set& ps, glm::vec3 o, glm::vec3 u, glm::vec3 v, glm::vec3 n, int k) {
+  point_set all;
+  grid(all, o, u, v, n, k);
+  std::vector<std::size_t> facing;  // the triangles whose front faces along n
+  for (std::size_t t = 0; t < ps.mesh.triangle_count(); ++t) {
+    glm::dvec3 c[3];
+    corners(ps.mesh, t, c);
+    const glm::dvec3 g = glm::cross(c[1] - c[0], c[2] - c[0]);
+    if (glm::length(g) > 0.0 && glm::dot(g, glm::dvec3(n)) > 0.999 * glm::length(g)) facing.push_back(t);
+  }
+  for (std::size_t i = 0; i < all.p.size(); ++i) {
+    const glm::dvec3 q = glm::dvec3(all.p[i]) - 1e-3 * glm::dvec3(n);  // on the plane (grid_points lifts by 1 mm)
+    for (const std::size_t t : facing) {
+      glm::dvec3 c[3];
+      corners(ps.mesh, t, c);
+      if (on_triangle(c, q)) {
+        ps.p.push_back(all.p[i]);
+        ps.n.push_back(all.n[i]);
+        break;
+      }
+    }
+  }
+}
+
+// k x k points over the heightfield's square [-5, 5]^2 (x, z; texel centres as grid_points), each
+// on the topmost upward-facing triangle above it (the heightfield has one), with that triangle's
+// front normal, 1 mm off it along the normal. The triangles are binned by their x-z bounds on a
+// b x b grid (b^2 ~ triangles / 2), so each point tests a few: O(T + k^2) for T triangles.
+void heightfield_grid(point_set& ps, int k) {
+  const scene_mesh& m = ps.mesh;
+  const int b = std::max(1, int(std::sqrt(double(m.triangle_count()) / 2.0)));
+  const auto bin = [b](double v) { return std::clamp(int(std::floor((v + 5.0) / 10.0 * b)), 0, b - 1); };
+  std::vector<std::vector<std::size_t>> bins(std::size_t(b) * std::size_t(b));
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    glm::dvec3 c[3];
+    corners(m, t, c);
+    if (glm::cross(c[1] - c[0], c[2] - c[0]).y <= 0.0) continue;  // faces down or edge-on
+    const glm::dvec3 lo = glm::min(c[0], glm::min(c[1], c[2])), hi = glm::max(c[0], glm::max(c[1], c[2]));
+    for (int j = bin(lo.z); j <= bin(hi.z); ++j)
+      for (int i = bin(lo.x); i <= bin(hi.x); ++i) bins[std::size_t(j) * std::size_t(b) + std::size_t(i)].push_back(t);
+  }
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) {
+      const double x = -5.0 + 10.0 * (i + 0.5) / k, z = -5.0 + 10.0 * (j + 0.5) / k;
+      bool found = false;
+      double best_y = 0.0;
+      glm::dvec3 best_n(0.0);
+      for (const std::size_t t : bins[std::size_t(bin(z)) * std::size_t(b) + std::size_t(bin(x))]) {
+        glm::dvec3 c[3];
+        corners(m, t, c);
+        const glm::dvec3 g = glm::cross(c[1] - c[0], c[2] - c[0]);
+        // Barycentric coordinates of (x, z) in the triangle's x-z projection (g.y is twice its area).
+        const double ax = c[0].x - x, az = c[0].z - z, bx = c[1].x - x, bz = c[1].z - z, cx = c[2].x - x, cz = c[2].z - z;
+        const double w0 = (bz * cx - bx * cz) / g.y, w1 = (cz * ax - cx * az) / g.y, w2 = (az * bx - ax * bz) / g.y;
+        if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
+        const double y = w0 * c[0].y + w1 * c[1].y + w2 * c[2].y;
+        if (!found || y > best_y) {
+          found = true;
+          best_y = y;
+          best_n = glm::normalize(g);
+        }
+      }
+      if (!found) continue;  // outside the heightfield (not for points inside its square)
+      const glm::vec3 nrm(best_n);
+      ps.p.push_back(glm::vec3(float(x), float(best_y), float(z)) + 1e-3f * nrm);
+      ps.n.push_back(nrm);
+    }
+}
+
+point_set make_points(const std::string& key, int k, std::size_t terrain_triangles) {
   point_set ps;
-  ps.key = key;
+  ps.key = ps.file = key;
   if (key == "cornell") {
+    ps.name = "cornell_box_32";
     ps.mesh = cornell_box();
     bench::cornell_box_grid(ps.p, ps.n, k);
   } else if (key == "hexagon") {
+    ps.name = "hexagon_room_1062";
     ps.mesh = hexagon_room(3);
     point_set square;
     grid(square, {-4, 3, -4}, {8, 0, 0}, {0, 0, 8}, {0, -1, 0}, k);  // the ceiling's bounding square
@@ -229,16 +339,33 @@ point_set make_points(const std::string& key, int k) {
         ps.n.push_back(square.n[i]);
       }
     }
-  } else {
+  } else if (key == "sky") {
+    ps.name = "sky_and_occluders_42";
     ps.mesh = sky_and_occluders();
     grid(ps, {-10, 0, -10}, {20, 0, 0}, {0, 0, 20}, {0, 1, 0}, k);  // the ground
+  } else if (key == "pavilion") {
+    ps.mesh = open_pavilion();
+    grid(ps, {-7, 0.02f, -5}, {14, 0, 0}, {0, 0, 10}, {0, 1, 0}, k);     // the step's top (its middle under the floor slab)
+    grid(ps, {-6, 0.3f, -4}, {12, 0, 0}, {0, 0, 8}, {0, 1, 0}, k);       // the floor slab's top (parts under plinths)
+    grid(ps, {-6.5f, 3.8f, -4.5f}, {13, 0, 0}, {0, 0, 9}, {0, -1, 0}, k);  // the roof's underside (parts above capitals)
+  } else if (key == "street") {
+    ps.mesh = open_street();
+    grid(ps, {-20, 0, -8}, {40, 0, 0}, {0, 0, 16}, {0, 1, 0}, k);  // the ground (parts under buildings and posts)
+    // The building fronts along the street (the planes z = -4 facing +z and z = 4 facing -z, up to
+    // the tallest building): the points on a building.
+    grid_on_mesh(ps, {-19, 0, -4}, {38, 0, 0}, {0, 12, 0}, {0, 0, 1}, k);
+    grid_on_mesh(ps, {-19, 0, 4}, {38, 0, 0}, {0, 12, 0}, {0, 0, -1}, k);
+  } else {
+    ps.mesh = heightfield(terrain_triangles);
+    ps.file = key + "_t" + std::to_string(terrain_triangles);
+    heightfield_grid(ps, k);
+  }
+  if (ps.name.empty()) {
+    const char* base = key == "pavilion" ? "open_pavilion_" : key == "street" ? "open_street_" : "heightfield_";
+    ps.name = base + std::to_string(ps.mesh.triangle_count());
   }
   ps.sc = scene::create(ps.mesh.desc());
   return ps;
-}
-
-const char* scene_name(const std::string& key) {
-  return key == "cornell" ? "cornell_box_32" : key == "hexagon" ? "hexagon_room_1062" : "sky_and_occluders_42";
 }
 
 // ---- rendering ---------------------------------------------------------------------------------
@@ -268,7 +395,7 @@ luminances render(const settings& st, const point_set& ps, const std::vector<std
   out.backface.resize(idx.size());
   std::string file;
   if (!st.truth_dir.empty() && !cache_key.empty()) {
-    file = st.truth_dir + "/edge_downstream_" + ps.key + "_k" + std::to_string(st.grid) + "_" + cache_key + "_N" +
+    file = st.truth_dir + "/edge_downstream_" + ps.file + "_k" + std::to_string(st.grid) + "_" + cache_key + "_N" +
            std::to_string(n) + (edge ? "_edge" : "_point") + ".bin";
     if (FILE* f = std::fopen(file.c_str(), "rb")) {
       std::uint64_t count = 0;
@@ -476,14 +603,14 @@ reference make_reference(const settings& st, const point_set& ps, FILE* out) {
     }
   for (double v : ref.e) ref.mean += v;
   ref.mean /= double(std::max<std::size_t>(ref.e.size(), 1));
-  row r{"reference", scene_name(ps.key), mode_name(st.reference_edge)};
+  row r{"reference", ps.name, mode_name(st.reference_edge)};
   r.n = st.converged;
   r.points = ref.idx.size();
   r.hemicubes = secs > 0 ? every.size() : 0;
   r.seconds = secs;
   r.threads = resolve_thread_count(st.threads);
   write(out, r);
-  std::printf("%s: %zu points, reference (%s, N = %d) at %zu of them (every %d-th, valid): %.1f s\n", scene_name(ps.key),
+  std::printf("%s: %zu points, reference (%s, N = %d) at %zu of them (every %d-th, valid): %.1f s\n", ps.name.c_str(),
               ps.p.size(), st.reference_edge ? "edge coverage" : "point sampling", st.converged, ref.idx.size(), st.stride,
               secs);
   std::fflush(stdout);
@@ -506,7 +633,7 @@ reference make_reference(const settings& st, const point_set& ps, FILE* out) {
       bias += d;
       worst = std::max(worst, std::fabs(d));
     }
-    row cr{"check", scene_name(ps.key), mode_name(edge)};
+    row cr{"check", ps.name, mode_name(edge)};
     cr.n = n;
     cr.points = cidx.size();
     cr.hemicubes = secs > 0 ? cidx.size() : 0;
@@ -546,7 +673,7 @@ void cost_part(const settings& st, const point_set& ps, FILE* out) {
       rp = rate(point, sp.points, normals, &sp_s);
     }
     for (const bool e : {false, true}) {
-      row r{"cost", scene_name(ps.key), mode_name(e)};
+      row r{"cost", ps.name, mode_name(e)};
       r.n = st.cost_n;
       r.round = k;
       r.points = r.hemicubes = sp.points.size();
@@ -575,7 +702,7 @@ void n_part(const settings& st, const point_set& ps, const reference& ref, FILE*
     for (const bool edge : {false, true}) {
       double secs = 0.0;
       const luminances l = render(st, ps, ref.idx, n, edge, "", &secs);
-      row r{"per_point", scene_name(ps.key), mode_name(edge)};
+      row r{"per_point", ps.name, mode_name(edge)};
       ref.error([&](std::size_t j) { return l.value[j]; }, r);
       r.n = n;
       r.points = r.hemicubes = ref.idx.size();
@@ -595,7 +722,7 @@ void n_part(const settings& st, const point_set& ps, const reference& ref, FILE*
         const bool e = (m == 1) != (k % 2 == 1);  // A B, then B A
         rate(e ? edge : point, tp, tn, &secs);
         per[e ? 1 : 0].push_back(secs / double(tp.size()));
-        row r{"time", scene_name(ps.key), mode_name(e)};
+        row r{"time", ps.name, mode_name(e)};
         r.n = n;
         r.round = k;
         r.points = r.hemicubes = tp.size();
@@ -620,7 +747,7 @@ void cache_part(const settings& st, const point_set& ps, const reference& ref, F
     o.error_threshold = a;
     o.thread_count = workers;
     const cache_result res = cache_irradiance(ps.p.data(), ps.n.data(), ps.p.size(), samplers[edge ? 1 : 0], o);
-    row r{"cache", scene_name(ps.key), mode_name(edge)};
+    row r{"cache", ps.name, mode_name(edge)};
     r.n = st.cache_n;
     r.a = double(a);
     r.points = ps.p.size();
@@ -687,15 +814,15 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   if (st.has_part("silhouette")) silhouette_part(st, out);
   for (const std::string& key : st.scenes) {
-    const point_set ps = make_points(key, st.grid);
+    const point_set ps = make_points(key, st.grid, st.terrain);
     if (st.has_part("cost")) {
-      std::printf("%s:\n", scene_name(key));
+      std::printf("%s:\n", ps.name.c_str());
       cost_part(st, ps, out);
     }
     if (!st.has_part("n") && !st.has_part("cache")) continue;
     const reference ref = make_reference(st, ps, out);
     if (ref.idx.empty()) {
-      std::printf("  no valid reference point (every one sees > 10%% back faces): no errors for %s\n", scene_name(key));
+      std::printf("  no valid reference point (every one sees > 10%% back faces): no errors for %s\n", ps.name.c_str());
       continue;
     }
     if (st.has_part("n")) n_part(st, ps, ref, out);
