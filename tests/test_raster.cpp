@@ -1238,6 +1238,61 @@ TEST_CASE("raster: exact edge coverage finds silhouettes and material changes of
   }
 }
 
+TEST_CASE("raster: exact edge coverage hides a partial triangle behind another over the same part of a texel", "[raster]") {
+  // Two black quads under a sky of 1, seen from the origin with normal +z: a near one, and behind
+  // it at twice the distance the same quad grown 1% about its centre and scaled by 2 about the
+  // origin, so that its outline projects just outside the near one's, into the same texels. Both
+  // partial in those texels, the far one behind the near one over the near one's part: taken as
+  // side by side, the far one's share counted again over what the near one covers, and the sky
+  // lost it (1.6% at N = 16, 0.34% at 64 on these quads). E = pi - L(the grown quad) (Lambert's formula; the
+  // projections are nested). What remains is the density's linearisation within partial texels,
+  // as for the black box above: measured 2e-6 at N = 16, 5e-8 at 64; asserted 1e-4.
+  std::mt19937 rng(59);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  raster_options on;
+  on.edge_coverage = true;
+  const frame up{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const double pi = 3.14159265358979323846;
+  hemicube_buffer buf;
+  double worst[2] = {0.0, 0.0}, worst_point = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    // A quad at height ~1 with a random turn about z, tilt and place (above the horizon).
+    const double turn = 2.0 * pi * u(rng), w = 0.2 + 0.4 * u(rng), h = 0.2 + 0.4 * u(rng);
+    const glm::dvec3 centre(-0.4 + 0.8 * u(rng), -0.4 + 0.8 * u(rng), 0.8 + 0.4 * u(rng));
+    const glm::dvec3 a(std::cos(turn), std::sin(turn), 0.3 * (u(rng) - 0.5)), b(-std::sin(turn), std::cos(turn), 0.3 * (u(rng) - 0.5));
+    std::vector<glm::dvec3> near_quad, grown;
+    for (int c = 0; c < 4; ++c) {
+      const double su = (c == 1 || c == 2) ? 0.5 : -0.5, sv = c >= 2 ? 0.5 : -0.5;
+      near_quad.push_back(centre + su * w * a + sv * h * b);
+      grown.push_back(centre + 1.01 * (su * w * a + sv * h * b));
+    }
+    scene_mesh m;
+    const material black{glm::vec3(0.0f), glm::vec3(0.5f), true};
+    for (double scale : {1.0, 2.0}) {
+      const std::vector<glm::dvec3>& q = scale == 1.0 ? near_quad : grown;
+      const glm::vec3 v0(q[0] * scale), v1(q[1] * scale), v2(q[2] * scale), v3(q[3] * scale);
+      m.add_triangle(v0, v1, v2, black);
+      m.add_triangle(v0, v2, v3, black);
+    }
+    m.sky_radiance = glm::vec3(1.0f);
+    // The grown quad as the float vertices the scene holds (scaled back: the projection is the same).
+    std::vector<glm::dvec3> held;
+    for (const glm::dvec3& g : grown) held.push_back(glm::dvec3(glm::vec3(g * 2.0)) * 0.5);
+    const double want = pi - lambert_polygon(held);
+    const auto s = scene::create(m.desc());
+    hemicube_rasterizer edge(s, on), point(s);
+    for (int i = 0; i < 2; ++i) {
+      edge.render({0, 0, 0}, up, i == 0 ? 16 : 64, buf);
+      worst[i] = std::max(worst[i], std::fabs(integrate(buf).irradiance.x - want) / want);
+    }
+    point.render({0, 0, 0}, up, 16, buf);
+    worst_point = std::max(worst_point, std::fabs(integrate(buf).irradiance.x - want) / want);
+  }
+  INFO("worst relative error: edge coverage N = 16 " << worst[0] << ", N = 64 " << worst[1] << "; point sampling N = 16 " << worst_point);
+  CHECK(worst[0] <= 1e-4);
+  CHECK(worst[1] <= 1e-4);
+}
+
 TEST_CASE("raster: exact edge coverage keeps the texel centres' flags and triangle, bitwise on every path", "[raster]") {
   // flags and seen_triangle() are documented as what the texel centre sees: bit for bit what a
   // render without the option gives; the distance is the centre's, or nearer where a nearer

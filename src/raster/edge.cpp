@@ -182,6 +182,94 @@ inline int lowest_bit(std::uint64_t word) noexcept {
 #endif
 }
 
+// The number of set bits of a word.
+inline int popcount64(std::uint64_t word) noexcept {
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_popcountll(word);
+#else
+  int count = 0;
+  for (; word; word &= word - 1) ++count;
+  return count;
+#endif
+}
+
+// The texel's 8 x 8 samples inside the half-planes f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of
+// the edges in `clip` (bit k; x, y in texel units from the texel's corner): bit 8 j + i for the
+// sample at x_i = (i + 1/2) / 8 + 0.0137, y_j = (j + 1/2) / 8 + 0.0291. The small offsets keep
+// samples off the multiples of 1/64 texel, where grid-aligned edges (through texel centres,
+// corners and halves) would pass exactly through them. The blend uses the masks only to measure
+// how much of a fragment's part a fragment in front already covers; the covered fraction itself
+// stays the exact one. Cost: 64 multiply-adds and compares per cutting edge.
+std::uint64_t edge_sample_mask(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3],
+                               unsigned clip) noexcept {
+  std::uint64_t mask = ~std::uint64_t(0);
+  for (int k = 0; k < 3; ++k) {
+    if (!(clip >> k & 1u)) continue;
+    std::uint64_t inside = 0;
+    for (int j = 0; j < 8; ++j) {
+      const double row = f0[k] + gy[k] * ((j + 0.5) * 0.125 + 0.0291);
+      unsigned bits = 0;
+      for (int i = 0; i < 8; ++i) bits |= static_cast<unsigned>(row + gx[k] * ((i + 0.5) * 0.125 + 0.0137) >= 0.0) << i;
+      inside |= static_cast<std::uint64_t>(bits) << (8 * j);
+    }
+    mask &= inside;
+  }
+  return mask;
+}
+
+// The part of a texel (the unit square, texel units from its corner) inside both fragments'
+// triangles (the half-planes f0 + gx x + gy y >= 0 of the edges that cut it, `clip`, of each):
+// the square clipped by them (Sutherland-Hodgman, at most 4 + 6 vertices), then its area and
+// first moments about the centre, weighted by the density 1 + wx (x - 1/2) + wy (y - 1/2) as the
+// coverages are. Writes the part's centroid (about the centre; 0 for an empty part) to cx, cy.
+double overlap_part(const fragment_shape& a, const fragment_shape& b, double wx, double wy, double& cx,
+                    double& cy) noexcept {
+  double ax_[10] = {0.0, 1.0, 1.0, 0.0}, ay_[10] = {0.0, 0.0, 1.0, 1.0}, bx_[10], by_[10];
+  double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;
+  int count = 4;
+  cx = cy = 0.0;
+  for (int e = 0; e < 6 && count >= 3; ++e) {
+    const fragment_shape& s = e < 3 ? a : b;
+    const int k = e % 3;
+    if (!(s.clip >> k & 1u)) continue;
+    double value[10];
+    for (int i = 0; i < count; ++i) value[i] = s.f0[k] + s.gx[k] * px[i] + s.gy[k] * py[i];
+    int out = 0;
+    for (int i = 0; i < count; ++i) {
+      const int j = i + 1 == count ? 0 : i + 1;
+      const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
+      if (in_i) {
+        qx[out] = px[i];
+        qy[out] = py[i];
+        ++out;
+      }
+      if (in_i != in_j) {
+        const double u = value[i] / (value[i] - value[j]);
+        qx[out] = px[i] + u * (px[j] - px[i]);
+        qy[out] = py[i] + u * (py[j] - py[i]);
+        ++out;
+      }
+    }
+    count = out;
+    std::swap(px, qx);
+    std::swap(py, qy);
+  }
+  if (count < 3) return 0.0;
+  double twice = 0.0, mx = 0.0, my = 0.0;
+  for (int i = 0; i < count; ++i) {
+    const int j = i + 1 == count ? 0 : i + 1;
+    const double x0 = px[i] - 0.5, y0 = py[i] - 0.5, x1 = px[j] - 0.5, y1 = py[j] - 0.5;
+    const double cross = x0 * y1 - x1 * y0;
+    twice += cross;
+    mx += (x0 + x1) * cross;
+    my += (y0 + y1) * cross;
+  }
+  if (!(twice > 0.0)) return 0.0;
+  cx = mx / (3.0 * twice);
+  cy = my / (3.0 * twice);
+  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+}
+
 // The first of `face`'s rows in the per-row hard-texel tables (face 0's N rows, then each side
 // face's N / 2).
 inline std::size_t face_row_base(int n, int face) noexcept {
@@ -285,8 +373,7 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
   edge_facing_.assign(edge_planes_.size(), 0);
 }
 
-// The slopes of each texel's weight density (edge_density_), once per resolution (and the
-// per-texel front_cover_, front_z_ sized). The
+// The slopes of each texel's weight density (edge_density_), once per resolution. The
 // integrator weights a texel by the projected solid angle over it, of density (1 + u^2 + v^2)^-2
 // on the top face (z = 1) and v (1 + u^2 + v^2)^-2 on the side faces (v = height); relative to
 // the centre's and per texel unit, its derivatives there are wx = -4 u / q step and
@@ -294,8 +381,6 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
 void raster_detail::rasterizer_impl::edge_make_density() {
   const int n = n_;
   edge_density_.resize(2 * hemicube_texel_count(n));
-  front_cover_.resize(hemicube_texel_count(n));
-  front_z_.resize(hemicube_texel_count(n));
   for (int face = 0; face < 5; ++face) {
     const int rows = face == 0 ? n : n / 2;
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
@@ -554,6 +639,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   // The statistics, counted here and added at the end (an increment of the member per texel
   // would chain every iteration through memory).
   std::size_t tested = 0, kept = 0;
+  const float dzdy = static_cast<float>(fs.dzdy);  // (the fragments' plane, for their samples' depths)
   const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
     ++tested;
     const std::int64_t e0 = e_row[0] + c * step_x[0], e1 = e_row[1] + c * step_x[1], e2 = e_row[2] + c * step_x[2];
@@ -579,13 +665,6 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     // leaves it through the far sheet), which the blend, taking fragments as side by side,
     // would count again in place of what lies behind.
     if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
-    // Behind every fragment the texel has, whose coverages sum to one or more: the blend, front
-    // to back, has given the whole texel away before it reaches this one (each takes min(its
-    // coverage, what is left), or stopped earlier at the whole-texel candidate), so it would
-    // take no share, and the render is the same bits without it. (The margin covers the float
-    // sums' rounding, 6e-8 a fragment, up to the 256 fragments the test allows.)
-    const std::uint32_t count = fragment_count_[texel];
-    if (count != 0 && count <= 256 && z < front_z_[texel] && front_cover_[texel] >= 1.0f + 1e-4f) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
@@ -598,22 +677,24 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     // second order.
     const float* slope = edge_density_.data() + 2 * texel;
     const double wx = slope[0], wy = slope[1];
+    if (f_row_at != r) {
+      const double y0 = static_cast<double>(r * sub_one);
+      for (int k = 0; k < 3; ++k) f_row[k] = edx[k] * (y0 - exact[3 + k]) + edy[k] * exact[k];
+      f_row_at = r;
+    }
+    fragment_shape shape;  // the unsnapped edges over this texel (for the blend's overlaps)
+    unsigned clip = 0;     // the unsnapped edges that cut the texel
+    for (int k = 0; k < 3; ++k) {
+      shape.f0[k] = f_row[k] + static_cast<double>(c) * gx[k];
+      shape.gx[k] = gx[k];
+      shape.gy[k] = gy[k];
+      if (shape.f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
+      if (shape.f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
+    }
     double area;
     if (tiny) {
       area = tiny_area * (1.0 + wx * tiny_x + wy * tiny_y);
     } else {
-      if (f_row_at != r) {
-        const double y0 = static_cast<double>(r * sub_one);
-        for (int k = 0; k < 3; ++k) f_row[k] = edx[k] * (y0 - exact[3 + k]) + edy[k] * exact[k];
-        f_row_at = r;
-      }
-      double f0[3];
-      unsigned clip = 0;  // the unsnapped edges that cut the texel
-      for (int k = 0; k < 3; ++k) {
-        f0[k] = f_row[k] + static_cast<double>(c) * gx[k];
-        if (f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
-        if (f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
-      }
       if ((clip & ~have_reciprocals) != 0) {
         for (int k = 0; k < 3; ++k)
           if ((clip & ~have_reciprocals) >> k & 1u) {
@@ -628,25 +709,26 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
         area = 1.0;
       else if ((clip & (clip - 1)) == 0) {  // one cutting edge (most partial texels): the corners' form
         const int k = clip == 1 ? 0 : (clip == 2 ? 1 : 2);
-        area = square_part_inside_one(f0[k], ce[k].gx, ce[k].gy, ce[k].rgx, ce[k].rgy, wx, wy);
+        area = square_part_inside_one(shape.f0[k], ce[k].gx, ce[k].gy, ce[k].rgx, ce[k].rgy, wx, wy);
       } else {
-        area = texel_part_inside(ce, f0, clip, static_cast<double>(c) + 0.5, static_cast<double>(r) + 0.5, wx, wy);
+        area = texel_part_inside(ce, shape.f0, clip, static_cast<double>(c) + 0.5, static_cast<double>(r) + 0.5, wx, wy);
       }
     }
     if (!(area > 0.0)) return;
+    shape.clip = clip;
     edge_fragment fr;
     fr.texel = static_cast<std::uint32_t>(texel);
     fr.z = z;
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
-    if (fragment_count_[texel]++ == 0) {
-      fragment_texels_.push_back(fr.texel);
-      front_cover_[texel] = fr.coverage;
-      front_z_[texel] = z;
-    } else {
-      front_cover_[texel] += fr.coverage;
-      front_z_[texel] = std::min(front_z_[texel], z);
-    }
+    // Which of the texel's 8 x 8 samples it covers: a cheap test for the blend of whether two
+    // fragments may overlap (edge_sample_mask).
+    fr.mask = edge_sample_mask(shape.f0, shape.gx, shape.gy, clip);
+    fr.dzdx = fs.dzdx;
+    fr.dzdy = dzdy;
+    fr.shape = static_cast<std::uint32_t>(fragment_shapes_.size());
+    fragment_shapes_.push_back(shape);
+    if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
     fragments_.push_back(fr);
     ++kept;
   };
@@ -711,6 +793,34 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
   return {sh.r, sh.g, sh.b};
 }
 
+// For the blend of one texel: hidden_[i] = the part of fragment i of order[0, count) (its
+// covered fraction of the texel's weight) that a nearer fragment covers. For each pair that may
+// overlap (their samples overlap, or one has none: a sliver or a triangle between samples) the
+// part inside both (overlap_part) goes to the farther one, by their planes' 1/w at its centroid
+// (1/w is linear across the texel). Fragments side by side (triangles sharing an edge, most
+// texels) have no such pair: nothing is hidden, and the blend is as without this step. Exact when
+// the nearer fragments do not overlap each other over the part (up to double rounding); where
+// three or more overlap at once the part may be counted twice (the share is then clamped at 0).
+// Cost: O(count^2) mask tests, one polygon clip per overlapping pair.
+void raster_detail::rasterizer_impl::edge_hidden_parts(const edge_fragment* order, std::uint32_t count,
+                                                       std::size_t texel) {
+  if (hidden_.size() < count) hidden_.resize(count);
+  for (std::uint32_t i = 0; i < count; ++i) hidden_[i] = 0.0;
+  const float* slope = edge_density_.data() + 2 * texel;
+  const double wx = slope[0], wy = slope[1];
+  for (std::uint32_t i = 0; i < count; ++i)
+    for (std::uint32_t j = i + 1; j < count; ++j) {
+      const edge_fragment &a = order[i], &b = order[j];
+      if (a.mask != 0 && b.mask != 0 && (a.mask & b.mask) == 0) continue;
+      double cx, cy;
+      const double part = overlap_part(fragment_shapes_[a.shape], fragment_shapes_[b.shape], wx, wy, cx, cy);
+      if (!(part > 0.0)) continue;
+      const float za = a.z + a.dzdx * static_cast<float>(cx) + a.dzdy * static_cast<float>(cy);
+      const float zb = b.z + b.dzdx * static_cast<float>(cx) + b.dzdy * static_cast<float>(cy);
+      hidden_[zb > za ? i : j] += part;  // ties: the earlier (front to back at the centre) stays
+    }
+}
+
 // After the resolve: each texel with fragments gets the blend of what covers it. Its fragments,
 // front to back (1/w at the texel centre, larger first; ties: the earlier draw first, then the
 // order they were added), each take min(coverage, what is left) until the whole-texel winner
@@ -746,11 +856,20 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       order[j] = f;
     }
     glm::vec3 sum(0.0f);
+    // The fragments in front of the whole-texel candidate, and the part of each that a nearer
+    // one covers (edge_hidden_parts).
+    std::uint32_t front = 0;
+    while (front < g.count && !(full_z > 0.0f && (order[front].z < full_z ||
+                                                  (order[front].z == full_z && draw_of(order[front].id) > draw_of(full_id)))))
+      ++front;
+    edge_hidden_parts(order, front, g.texel);
     float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share
-    for (std::uint32_t i = 0; i < g.count; ++i) {
+    for (std::uint32_t i = 0; i < front; ++i) {
       const edge_fragment& fr = order[i];
-      if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
-      const float share = std::min(fr.coverage, left);
+      // Its coverage less what nearer partial triangles cover of it (all of it for fragments
+      // side by side: the same bits as without this step).
+      const float own = hidden_[i] > 0.0 ? static_cast<float>(std::max(0.0, static_cast<double>(fr.coverage) - hidden_[i])) : fr.coverage;
+      const float share = std::min(own, left);
       if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
       sum += share * radiance(fr.id, g.texel, fr.z);
       left -= share;

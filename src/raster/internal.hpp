@@ -78,6 +78,14 @@ struct draw_record {
 };
 /// What the resolve pass copies to the texels of a draw: the sky, a back face, or the front of
 /// a triangle with one of the scene's emissions.
+// A partial fragment's triangle over its texel (exact edge coverage, edge.cpp): the unsnapped
+// edge functions f0[k] + gx[k] x + gy[k] y (x, y in texel units from the texel's corner; inside
+// where all are >= 0) and the edges that cut the texel (bit k of clip).
+struct fragment_shape {
+  double f0[3], gx[3], gy[3];
+  unsigned clip;
+};
+
 struct shade {
   float r, g, b;
   std::uint32_t flags;
@@ -162,6 +170,9 @@ class alignas(64) rasterizer_impl {
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
     float coverage;       // the covered fraction of the texel's weight, [0, 1]
     std::uint32_t id;     // the draw's texel id (as in ids_)
+    std::uint64_t mask;   // which of the texel's 8 x 8 samples it covers (edge_sample_mask; 0: none)
+    float dzdx, dzdy;     // its 1/w's steps per texel in x and y (its plane over the texel)
+    std::uint32_t shape;  // its entry in fragment_shapes_
   };
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
@@ -198,7 +209,9 @@ class alignas(64) rasterizer_impl {
   int edge_density_n_ = 0;
   // Per texel with fragments (fragment_count_ nonzero): the sum of its fragments' coverages and
   // their least 1/w (a later fragment behind all of them once they sum to one gets no share).
-  std::vector<float> front_cover_, front_z_;
+  std::vector<fragment_shape> fragment_shapes_;  // per fragment (edge_fragment::shape)
+  std::vector<double> hidden_;                   // the blend's scratch (edge_hidden_parts)
+  void edge_hidden_parts(const edge_fragment* order, std::uint32_t count, std::size_t texel);
   void edge_make_density();
   void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);

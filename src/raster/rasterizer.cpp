@@ -366,6 +366,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
     else
       for (const std::uint32_t t : fragment_texels_) fragment_count_[t] = 0u;
     fragments_.clear();
+    fragment_shapes_.clear();
     fragment_texels_.clear();
     edge_groups_.clear();
     if (whole_z_.size() != count) {
