@@ -193,41 +193,56 @@ inline int popcount64(std::uint64_t word) noexcept {
 #endif
 }
 
-// The texel's 8 x 8 samples inside the half-planes f_k(x, y) = f0[k] + gx[k] x + gy[k] y >= 0 of
-// the edges in `clip` (bit k; x, y in texel units from the texel's corner): bit 8 j + i for the
-// sample at x_i = (i + 1/2) / 8 + 0.0137, y_j = (j + 1/2) / 8 + 0.0291. The small offsets keep
-// samples off the multiples of 1/64 texel, where grid-aligned edges (through texel centres,
-// corners and halves) would pass exactly through them. The blend uses the masks only to measure
-// how much of a fragment's part a fragment in front already covers; the covered fraction itself
-// stays the exact one. Cost: 64 multiply-adds and compares per cutting edge.
-std::uint64_t edge_sample_mask(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3],
-                               unsigned clip) noexcept {
+// The cells of the texel's 8 x 8 grid that the part inside the half-planes f_k(x, y) = f0[k] +
+// gx[k] x + gy[k] y >= 0 of the edges in `clip` (bit k; x, y in texel units from the texel's
+// corner) may touch: bit 8 j + i for cell [i / 8, (i + 1) / 8] x [j / 8, (j + 1) / 8], set when
+// every clipping edge's function is >= 0 at some point of the cell (its corner farthest along
+// the edge's gradient). Conservative: a part that touches a cell has its bit; two parts with no
+// common bit do not overlap (the blend's cheap test). Cost: 64 multiply-adds and compares per
+// cutting edge.
+std::uint64_t edge_cell_mask(const double (&f0)[3], const double (&gx)[3], const double (&gy)[3],
+                             unsigned clip) noexcept {
   std::uint64_t mask = ~std::uint64_t(0);
   for (int k = 0; k < 3; ++k) {
     if (!(clip >> k & 1u)) continue;
-    std::uint64_t inside = 0;
+    const double ox = gx[k] > 0.0 ? 0.125 : 0.0, oy = gy[k] > 0.0 ? 0.125 : 0.0;  // the farthest corner
+    std::uint64_t touched = 0;
     for (int j = 0; j < 8; ++j) {
-      const double row = f0[k] + gy[k] * ((j + 0.5) * 0.125 + 0.0291);
+      const double row = f0[k] + gy[k] * (j * 0.125 + oy);
       unsigned bits = 0;
-      for (int i = 0; i < 8; ++i) bits |= static_cast<unsigned>(row + gx[k] * ((i + 0.5) * 0.125 + 0.0137) >= 0.0) << i;
-      inside |= static_cast<std::uint64_t>(bits) << (8 * j);
+      for (int i = 0; i < 8; ++i) bits |= static_cast<unsigned>(row + gx[k] * (i * 0.125 + ox) >= 0.0) << i;
+      touched |= static_cast<std::uint64_t>(bits) << (8 * j);
     }
-    mask &= inside;
+    mask &= touched;
   }
   return mask;
+}
+
+// Whether two fragments' triangles have an edge on the same line with their insides on opposite
+// sides of it (triangles sharing an edge, as a mesh's neighbours do): they cannot overlap. The
+// edges' functions are then negative multiples of each other, to rounding (they are computed from
+// the same unsnapped endpoints in another order): tested to 1e-9 relative.
+bool edge_shared_opposite(const fragment_shape& a, const fragment_shape& b) noexcept {
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 3; ++m) {
+      const double na = a.norm[k], nb = b.norm[m];
+      if (a.gx[k] * b.gx[m] + a.gy[k] * b.gy[m] >= 0.0) continue;  // not opposite (or a zero edge)
+      if (std::fabs(a.gx[k] * b.gy[m] - a.gy[k] * b.gx[m]) > 1e-9 * na * nb) continue;  // not parallel
+      const double ea = std::fabs(a.f0[k]) + na, eb = std::fabs(b.f0[m]) + nb;
+      if (std::fabs(a.f0[k] * nb + b.f0[m] * na) <= 1e-9 * (ea * nb + eb * na)) return true;
+    }
+  return false;
 }
 
 // The part of a texel (the unit square, texel units from its corner) inside both fragments'
 // triangles (the half-planes f0 + gx x + gy y >= 0 of the edges that cut it, `clip`, of each):
 // the square clipped by them (Sutherland-Hodgman, at most 4 + 6 vertices), then its area and
 // first moments about the centre, weighted by the density 1 + wx (x - 1/2) + wy (y - 1/2) as the
-// coverages are. Writes the part's centroid (about the centre; 0 for an empty part) to cx, cy.
-double overlap_part(const fragment_shape& a, const fragment_shape& b, double wx, double wy, double& cx,
-                    double& cy) noexcept {
+// coverages are.
+double overlap_part(const fragment_shape& a, const fragment_shape& b, double wx, double wy) noexcept {
   double ax_[10] = {0.0, 1.0, 1.0, 0.0}, ay_[10] = {0.0, 0.0, 1.0, 1.0}, bx_[10], by_[10];
   double *px = ax_, *py = ay_, *qx = bx_, *qy = by_;
   int count = 4;
-  cx = cy = 0.0;
   for (int e = 0; e < 6 && count >= 3; ++e) {
     const fragment_shape& s = e < 3 ? a : b;
     const int k = e % 3;
@@ -265,8 +280,6 @@ double overlap_part(const fragment_shape& a, const fragment_shape& b, double wx,
     my += (y0 + y1) * cross;
   }
   if (!(twice > 0.0)) return 0.0;
-  cx = mx / (3.0 * twice);
-  cy = my / (3.0 * twice);
   return 0.5 * twice + (wx * mx + wy * my) / 6.0;
 }
 
@@ -585,7 +598,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   //  - tiny: a triangle within one texel (the terrain's far triangles): its covered weight is its
   //    area times the density at its centroid, exact for a density linear over the texel, with
   //    no clipping (what clipping the square by its three edges gives, to rounding).
-  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3];
+  double edx[3], edy[3], gx[3], gy[3], gx_lo[3], gx_hi[3], edge_norm[3];
   clip_edge ce[3];
   unsigned have_reciprocals = 0;
   bool unsnapped_ready = false, positive = false;
@@ -600,6 +613,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       gy[k] = edx[k] * static_cast<double>(sub_one);
       gx_lo[k] = std::min(gx[k], 0.0) + std::min(gy[k], 0.0);
       gx_hi[k] = std::max(gx[k], 0.0) + std::max(gy[k], 0.0);
+      edge_norm[k] = std::sqrt(gx[k] * gx[k] + gy[k] * gy[k]);
       ce[k].ax = exact[k] * inv_one;
       ce[k].ay = exact[3 + k] * inv_one;
       ce[k].dx = edx[k] * inv_one;
@@ -639,7 +653,6 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
   // The statistics, counted here and added at the end (an increment of the member per texel
   // would chain every iteration through memory).
   std::size_t tested = 0, kept = 0;
-  const float dzdy = static_cast<float>(fs.dzdy);  // (the fragments' plane, for their samples' depths)
   const auto classify = [&](std::int64_t c, std::int64_t r, std::size_t texel) {
     ++tested;
     const std::int64_t e0 = e_row[0] + c * step_x[0], e1 = e_row[1] + c * step_x[1], e2 = e_row[2] + c * step_x[2];
@@ -688,6 +701,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
       shape.f0[k] = f_row[k] + static_cast<double>(c) * gx[k];
       shape.gx[k] = gx[k];
       shape.gy[k] = gy[k];
+      shape.norm[k] = edge_norm[k];
       if (shape.f0[k] + gx_hi[k] <= 0.0) return;  // no area in common
       if (shape.f0[k] + gx_lo[k] < 0.0) clip |= 1u << k;
     }
@@ -721,11 +735,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     fr.z = z;
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
-    // Which of the texel's 8 x 8 samples it covers: a cheap test for the blend of whether two
-    // fragments may overlap (edge_sample_mask).
-    fr.mask = edge_sample_mask(shape.f0, shape.gx, shape.gy, clip);
-    fr.dzdx = fs.dzdx;
-    fr.dzdy = dzdy;
+    fr.mask = 0;  // (made by the blend where the texel has several fragments)
     fr.shape = static_cast<std::uint32_t>(fragment_shapes_.size());
     fragment_shapes_.push_back(shape);
     if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
@@ -793,32 +803,29 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
   return {sh.r, sh.g, sh.b};
 }
 
-// For the blend of one texel: hidden_[i] = the part of fragment i of order[0, count) (its
-// covered fraction of the texel's weight) that a nearer fragment covers. For each pair that may
-// overlap (their samples overlap, or one has none: a sliver or a triangle between samples) the
-// part inside both (overlap_part) goes to the farther one, by their planes' 1/w at its centroid
-// (1/w is linear across the texel). Fragments side by side (triangles sharing an edge, most
-// texels) have no such pair: nothing is hidden, and the blend is as without this step. Exact when
-// the nearer fragments do not overlap each other over the part (up to double rounding); where
-// three or more overlap at once the part may be counted twice (the share is then clamped at 0).
-// Cost: O(count^2) mask tests, one polygon clip per overlapping pair.
-void raster_detail::rasterizer_impl::edge_hidden_parts(const edge_fragment* order, std::uint32_t count,
-                                                       std::size_t texel) {
-  if (hidden_.size() < count) hidden_.resize(count);
-  for (std::uint32_t i = 0; i < count; ++i) hidden_[i] = 0.0;
-  const float* slope = edge_density_.data() + 2 * texel;
-  const double wx = slope[0], wy = slope[1];
-  for (std::uint32_t i = 0; i < count; ++i)
-    for (std::uint32_t j = i + 1; j < count; ++j) {
-      const edge_fragment &a = order[i], &b = order[j];
-      if (a.mask != 0 && b.mask != 0 && (a.mask & b.mask) == 0) continue;
-      double cx, cy;
-      const double part = overlap_part(fragment_shapes_[a.shape], fragment_shapes_[b.shape], wx, wy, cx, cy);
-      if (!(part > 0.0)) continue;
-      const float za = a.z + a.dzdx * static_cast<float>(cx) + a.dzdy * static_cast<float>(cy);
-      const float zb = b.z + b.dzdx * static_cast<float>(cx) + b.dzdy * static_cast<float>(cy);
-      hidden_[zb > za ? i : j] += part;  // ties: the earlier (front to back at the centre) stays
-    }
+// For the blend of one texel: the part of fragment i of order (its covered fraction of the
+// texel's weight) that the fragments before it (front to back) cover. For each of them that may
+// overlap it (they touch a common cell of the texel's 8 x 8 grid, edge_cell_mask, and do not share
+// an edge from opposite sides, edge_shared_opposite) the part inside both (overlap_part) is
+// added. Exact when those earlier fragments do not overlap each other over it (up to double
+// rounding); where three or more overlap at once a part may be counted twice (the share is then
+// clamped at 0 by the caller). Fragments side by side (triangles sharing an edge, most texels)
+// give 0: the blend is as without this step. Cost: i cell-mask tests, one polygon clip per
+// overlapping pair.
+double raster_detail::rasterizer_impl::edge_hidden_part(const edge_fragment* order, std::uint32_t i, double wx,
+                                                        double wy) const {
+  double hidden = 0.0;
+  const edge_fragment& b = order[i];
+  for (std::uint32_t j = 0; j < i; ++j) {
+    const edge_fragment& a = order[j];
+    // Disjoint cells, or two parts of one clipped triangle (its fan): no overlap.
+    if ((a.mask & b.mask) == 0 || a.id == b.id) continue;
+    const fragment_shape &sa = fragment_shapes_[a.shape], &sb = fragment_shapes_[b.shape];
+    if (edge_shared_opposite(sa, sb)) continue;
+    const double part = overlap_part(sa, sb, wx, wy);
+    if (part > 0.0) hidden += part;
+  }
+  return hidden;
 }
 
 // After the resolve: each texel with fragments gets the blend of what covers it. Its fragments,
@@ -856,19 +863,23 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       order[j] = f;
     }
     glm::vec3 sum(0.0f);
-    // The fragments in front of the whole-texel candidate, and the part of each that a nearer
-    // one covers (edge_hidden_parts).
-    std::uint32_t front = 0;
-    while (front < g.count && !(full_z > 0.0f && (order[front].z < full_z ||
-                                                  (order[front].z == full_z && draw_of(order[front].id) > draw_of(full_id)))))
-      ++front;
-    edge_hidden_parts(order, front, g.texel);
+    const float* slope = edge_density_.data() + 2 * g.texel;
+    const double wx = slope[0], wy = slope[1];
+
     float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share
-    for (std::uint32_t i = 0; i < front; ++i) {
+    for (std::uint32_t i = 0; i < g.count; ++i) {
       const edge_fragment& fr = order[i];
+      if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
       // Its coverage less what nearer partial triangles cover of it (all of it for fragments
       // side by side: the same bits as without this step).
-      const float own = hidden_[i] > 0.0 ? static_cast<float>(std::max(0.0, static_cast<double>(fr.coverage) - hidden_[i])) : fr.coverage;
+      // The cells it may touch (edge_cell_mask), for edge_hidden_part's first test of the
+      // fragments after it; made as the blend reaches it (it often stops early).
+      if (g.count > 1) {
+        const fragment_shape& s = fragment_shapes_[order[i].shape];
+        order[i].mask = edge_cell_mask(s.f0, s.gx, s.gy, s.clip);
+      }
+      const double hidden = edge_hidden_part(order, i, wx, wy);
+      const float own = hidden > 0.0 ? static_cast<float>(std::max(0.0, static_cast<double>(fr.coverage) - hidden)) : fr.coverage;
       const float share = std::min(own, left);
       if (share > 0.0f && nearest == 0.0f) nearest = fr.z;
       sum += share * radiance(fr.id, g.texel, fr.z);
