@@ -735,7 +735,7 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     fr.z = z;
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
-    fr.mask = 0;  // (made by the blend where the texel has several fragments)
+    fr.mask = 0;  // (made by the blend when first needed)
     fr.shape = static_cast<std::uint32_t>(fragment_shapes_.size());
     fragment_shapes_.push_back(shape);
     if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
@@ -803,25 +803,34 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
   return {sh.r, sh.g, sh.b};
 }
 
+// The fragments of a texel, front to back, whose overlaps with those before them the blend
+// measures (edge_hidden_part): the pairs' work is at most edge_overlap_limit^2 / 2 per texel.
+constexpr std::uint32_t edge_overlap_limit = 16;
+
 // For the blend of one texel: the part of fragment i of order (its covered fraction of the
 // texel's weight) that the fragments before it (front to back) cover. For each of them that may
-// overlap it (they touch a common cell of the texel's 8 x 8 grid, edge_cell_mask, and do not share
-// an edge from opposite sides, edge_shared_opposite) the part inside both (overlap_part) is
-// added. Exact when those earlier fragments do not overlap each other over it (up to double
+// overlap it (not a part of the same draw, no edge shared from opposite sides
+// (edge_shared_opposite), a common cell of the texel's 8 x 8 grid (edge_cell_mask, made here when
+// first needed)) the part inside both (overlap_part) is added. Exact when those earlier fragments do not overlap each other over it (up to double
 // rounding); where three or more overlap at once a part may be counted twice (the share is then
 // clamped at 0 by the caller). Fragments side by side (triangles sharing an edge, most texels)
-// give 0: the blend is as without this step. Cost: i cell-mask tests, one polygon clip per
+// give 0: the blend is as without this step. Cost: i pair tests, one polygon clip per
 // overlapping pair.
-double raster_detail::rasterizer_impl::edge_hidden_part(const edge_fragment* order, std::uint32_t i, double wx,
+double raster_detail::rasterizer_impl::edge_hidden_part(edge_fragment* order, std::uint32_t i, double wx,
                                                         double wy) const {
   double hidden = 0.0;
-  const edge_fragment& b = order[i];
+  edge_fragment& b = order[i];
+  const fragment_shape& sb = fragment_shapes_[b.shape];
   for (std::uint32_t j = 0; j < i; ++j) {
-    const edge_fragment& a = order[j];
-    // Disjoint cells, or two parts of one clipped triangle (its fan): no overlap.
-    if ((a.mask & b.mask) == 0 || a.id == b.id) continue;
-    const fragment_shape &sa = fragment_shapes_[a.shape], &sb = fragment_shapes_[b.shape];
+    edge_fragment& a = order[j];
+    // Two parts of one clipped triangle (its fan), or neighbours across an edge: no overlap.
+    if (a.id == b.id) continue;
+    const fragment_shape& sa = fragment_shapes_[a.shape];
     if (edge_shared_opposite(sa, sb)) continue;
+    // No common cell: no overlap. (The cells are made when first needed; 0 = not yet.)
+    if (a.mask == 0) a.mask = edge_cell_mask(sa.f0, sa.gx, sa.gy, sa.clip);
+    if (b.mask == 0) b.mask = edge_cell_mask(sb.f0, sb.gx, sb.gy, sb.clip);
+    if ((a.mask & b.mask) == 0) continue;
     const double part = overlap_part(sa, sb, wx, wy);
     if (part > 0.0) hidden += part;
   }
@@ -872,13 +881,10 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       if (full_z > 0.0f && (fr.z < full_z || (fr.z == full_z && draw_of(fr.id) > draw_of(full_id)))) break;
       // Its coverage less what nearer partial triangles cover of it (all of it for fragments
       // side by side: the same bits as without this step).
-      // The cells it may touch (edge_cell_mask), for edge_hidden_part's first test of the
-      // fragments after it; made as the blend reaches it (it often stops early).
-      if (g.count > 1) {
-        const fragment_shape& s = fragment_shapes_[order[i].shape];
-        order[i].mask = edge_cell_mask(s.f0, s.gx, s.gy, s.clip);
-      }
-      const double hidden = edge_hidden_part(order, i, wx, wy);
+      // (Past the first edge_overlap_limit fragments of a texel, as at the horizon of a terrain
+      // at small N with hundreds of tiny triangles in a texel, the rest are taken side by side:
+      // the pairs' cost would grow as their square.)
+      const double hidden = i < edge_overlap_limit ? edge_hidden_part(order, i, wx, wy) : 0.0;
       const float own = hidden > 0.0 ? static_cast<float>(std::max(0.0, static_cast<double>(fr.coverage) - hidden)) : fr.coverage;
       const float share = std::min(own, left);
       if (share > 0.0f && nearest == 0.0f) nearest = fr.z;

@@ -171,7 +171,7 @@ class alignas(64) rasterizer_impl {
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
     float coverage;       // the covered fraction of the texel's weight, [0, 1]
     std::uint32_t id;     // the draw's texel id (as in ids_)
-    std::uint64_t mask;   // the cells of the texel's 8 x 8 grid it may touch (edge_cell_mask)
+    std::uint64_t mask;   // the cells of the texel's 8 x 8 grid it may touch (edge_cell_mask; 0: not made yet)
     std::uint32_t shape;  // its entry in fragment_shapes_
   };
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
@@ -210,7 +210,7 @@ class alignas(64) rasterizer_impl {
   // Per texel with fragments (fragment_count_ nonzero): the sum of its fragments' coverages and
   // their least 1/w (a later fragment behind all of them once they sum to one gets no share).
   std::vector<fragment_shape> fragment_shapes_;  // per fragment (edge_fragment::shape)
-  double edge_hidden_part(const edge_fragment* order, std::uint32_t i, double wx, double wy) const;
+  double edge_hidden_part(edge_fragment* order, std::uint32_t i, double wx, double wy) const;
   void edge_make_density();
   void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
