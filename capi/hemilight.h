@@ -186,7 +186,7 @@ HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_
  * hemilight_cache_irradiance uses it when the scene has it or its options ask for it. The other
  * scene_with_* entries keep the setting. Errors (nothing written to *out): INVALID_ARGUMENT for
  * NULL scene or out, edge_coverage not 0 or 1. Cost: O(1) here; each hemicube then costs about
- * 1.5x (rooms) to 13x (a terrain seen from its own surface) at N = 64, and binding a rasterizer
+ * 1.7x (rooms) to 28x (a terrain seen from its own surface) at N = 64, and binding a rasterizer
  * to the scene (hemilight_sampler_create; hemilight_sample_irradiance on every call, so prefer a
  * sampler) sorts the scene's edges, O(T log T) for T triangles. */
 HEMILIGHT_API hemilight_status hemilight_scene_with_edge_coverage(const hemilight_scene* scene, int edge_coverage,
@@ -428,7 +428,7 @@ typedef struct hemilight_cache_options {
                                      covered fraction of its weight instead of what its centre sees (no
                                      edge aliasing: an emitter's irradiance to about 1e-4 where point
                                      sampling is off by up to 18% at N = 16; docs/raster.md, "Exact edge
-                                     coverage"). Render time 1.5x on tessellated rooms to 15x on terrain
+                                     coverage"). Render time 1.7x on tessellated rooms to 28x on terrain
                                      seen from itself at N = 64 (default 0) */
 } hemilight_cache_options;
 

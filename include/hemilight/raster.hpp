@@ -134,8 +134,8 @@ struct raster_options {
   /// without the option); a blended texel's distance is to the plane of the nearest triangle
   /// with a share of it (along the centre's direction), which is the centre's distance unless a
   /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost at N = 64 (render + integration): 1.5x on tessellated rooms, 5x on the Cornell
-  /// box (material changes all around), 15x on a terrain seen from its own surface
+  /// path. Cost at N = 64 (render + integration): 1.7x on tessellated rooms, 6x on the Cornell
+  /// box (material changes all around), 28x on a terrain seen from its own surface
   /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
   bool edge_coverage = false;
 
