@@ -21,6 +21,20 @@ using namespace raster_detail;
 
 namespace {
 
+// The shoelace sums of a polygon given edge by edge (points about the texel's centre): twice its
+// area and six times its first moments; weighted(wx, wy) = its weight under the density
+// 1 + wx x + wy y (texel units about the centre).
+struct polygon_moments {
+  double twice = 0.0, mx = 0.0, my = 0.0;
+  void add(double ax, double ay, double bx, double by) noexcept {
+    const double cross = ax * by - bx * ay;
+    twice += cross;
+    mx += (ax + bx) * cross;
+    my += (ay + by) * cross;
+  }
+  double weighted(double wx, double wy) const noexcept { return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0); }
+};
+
 // The covered part of a texel (as texel_part_inside, below) for one clipping edge
 // f0 + gx x + gy y >= 0, with rgx = 1 / gx and
 // rgy = 1 / gy (made once per triangle edge; infinite for a zero step, never selected then: a
@@ -35,14 +49,8 @@ double square_part_inside_one(double f0, double gx, double gy, double rgx, doubl
   double value[4];
   for (int i = 0; i < 4; ++i) value[i] = f0 + gx * (cx[i] + 0.5) + gy * (cy[i] + 0.5);
   const double step[4] = {-rgx, -rgy, rgx, rgy};  // 1 / (value[i] - value[i + 1]) per side
-  double twice = 0.0, mx = 0.0, my = 0.0;
+  polygon_moments sums;
   double out_x = 0.0, out_y = 0.0, in_x = 0.0, in_y = 0.0;  // where the boundary leaves and re-enters
-  const auto term = [&](double ax, double ay, double bx, double by) {
-    const double cross = ax * by - bx * ay;
-    twice += cross;
-    mx += (ax + bx) * cross;
-    my += (ay + by) * cross;
-  };
   for (int i = 0; i < 4; ++i) {
     const int j = (i + 1) & 3;
     const bool in_i = value[i] >= 0.0, in_j = value[j] >= 0.0;
@@ -51,14 +59,14 @@ double square_part_inside_one(double f0, double gx, double gy, double rgx, doubl
     const double hx = cx[i] + t * (cx[j] - cx[i]), hy = cy[i] + t * (cy[j] - cy[i]);  // the crossing
     const double ax = in_i ? cx[i] : hx, ay = in_i ? cy[i] : hy;
     const double bx = in_j ? cx[j] : hx, by = in_j ? cy[j] : hy;
-    if (in_i || in_j) term(ax, ay, bx, by);
+    if (in_i || in_j) sums.add(ax, ay, bx, by);
     out_x = in_i && !in_j ? hx : out_x;
     out_y = in_i && !in_j ? hy : out_y;
     in_x = !in_i && in_j ? hx : in_x;
     in_y = !in_i && in_j ? hy : in_y;
   }
-  term(out_x, out_y, in_x, in_y);  // (zero when the square is all in or all out)
-  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
+  sums.add(out_x, out_y, in_x, in_y);  // (zero when the square is all in or all out)
+  return sums.weighted(wx, wy);
 }
 
 // One edge of a triangle, for texel_part_inside (texel units, the face's origin): from vertex
@@ -84,13 +92,7 @@ struct clip_edge {
 // the caller gives a triangle that is not counter-clockwise nothing.
 double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigned clip, double cx, double cy,
                          double wx, double wy) noexcept {
-  double twice = 0.0, mx = 0.0, my = 0.0;  // 2 area, 6 first moments (about the centre)
-  const auto term = [&](double px, double py, double qx, double qy) {
-    const double cross = px * qy - qx * py;
-    twice += cross;
-    mx += (px + qx) * cross;
-    my += (py + qy) * cross;
-  };
+  polygon_moments sums;
   // 1. The cutting edges within the square [-1/2, 1/2]^2 (about the centre).
   for (int k = 0; k < 3; ++k) {
     if (!(clip >> k & 1u)) continue;
@@ -111,7 +113,7 @@ double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigne
     } else if (!(std::fabs(ay) <= 0.5)) {
       continue;
     }
-    if (t0 < t1) term(ax + t0 * g.dx, ay + t0 * g.dy, ax + t1 * g.dx, ay + t1 * g.dy);
+    if (t0 < t1) sums.add(ax + t0 * g.dx, ay + t0 * g.dy, ax + t1 * g.dx, ay + t1 * g.dy);
   }
   // 2. The square's sides (bottom, right, top, left) within the cutting half-planes. Side i
   // runs from corner (sx, sy) by (ux, uy), over s in [s0, s1]; along it f_k starts at its
@@ -133,8 +135,8 @@ double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigne
     }
   }
   for (int i = 0; i < 4; ++i)
-    if (s0[i] < s1[i]) term(sx[i] + s0[i] * ux[i], sy[i] + s0[i] * uy[i], sx[i] + s1[i] * ux[i], sy[i] + s1[i] * uy[i]);
-  return 0.5 * twice + (wx * mx + wy * my) * (1.0 / 6.0);
+    if (s0[i] < s1[i]) sums.add(sx[i] + s0[i] * ux[i], sy[i] + s0[i] * uy[i], sx[i] + s1[i] * ux[i], sy[i] + s1[i] * uy[i]);
+  return sums.weighted(wx, wy);
 }
 
 }  // namespace
@@ -270,17 +272,13 @@ double overlap_part(const fragment_shape& a, const fragment_shape& b, double wx,
     std::swap(py, qy);
   }
   if (count < 3) return 0.0;
-  double twice = 0.0, mx = 0.0, my = 0.0;
+  polygon_moments sums;
   for (int i = 0; i < count; ++i) {
     const int j = i + 1 == count ? 0 : i + 1;
-    const double x0 = px[i] - 0.5, y0 = py[i] - 0.5, x1 = px[j] - 0.5, y1 = py[j] - 0.5;
-    const double cross = x0 * y1 - x1 * y0;
-    twice += cross;
-    mx += (x0 + x1) * cross;
-    my += (y0 + y1) * cross;
+    sums.add(px[i] - 0.5, py[i] - 0.5, px[j] - 0.5, py[j] - 0.5);
   }
-  if (!(twice > 0.0)) return 0.0;
-  return 0.5 * twice + (wx * mx + wy * my) / 6.0;
+  if (!(sums.twice > 0.0)) return 0.0;
+  return sums.weighted(wx, wy);
 }
 
 // The first of `face`'s rows in the per-row hard-texel tables (face 0's N rows, then each side
