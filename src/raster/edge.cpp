@@ -99,20 +99,16 @@ double texel_part_inside(const clip_edge (&e)[3], const double (&f0)[3], unsigne
     const clip_edge& g = e[k];
     const double ax = g.ax - cx, ay = g.ay - cy;
     double t0 = 0.0, t1 = 1.0;
-    if (g.dx != 0.0) {
-      const double ta = (-0.5 - ax) * g.rdx, tb = (0.5 - ax) * g.rdx;
+    // The edge's parameter range within the slab [-1/2, 1/2] of one axis (a: its start on that
+    // axis, d: its step, rd = 1 / d); false when it runs parallel to the slab outside it.
+    const auto slab = [&](double a, double d, double rd) {
+      if (d == 0.0) return std::fabs(a) <= 0.5;
+      const double ta = (-0.5 - a) * rd, tb = (0.5 - a) * rd;
       t0 = std::max(t0, std::min(ta, tb));
       t1 = std::min(t1, std::max(ta, tb));
-    } else if (!(std::fabs(ax) <= 0.5)) {
-      continue;
-    }
-    if (g.dy != 0.0) {
-      const double ta = (-0.5 - ay) * g.rdy, tb = (0.5 - ay) * g.rdy;
-      t0 = std::max(t0, std::min(ta, tb));
-      t1 = std::min(t1, std::max(ta, tb));
-    } else if (!(std::fabs(ay) <= 0.5)) {
-      continue;
-    }
+      return true;
+    };
+    if (!slab(ax, g.dx, g.rdx) || !slab(ay, g.dy, g.rdy)) continue;
     if (t0 < t1) sums.add(ax + t0 * g.dx, ay + t0 * g.dy, ax + t1 * g.dx, ay + t1 * g.dy);
   }
   // 2. The square's sides (bottom, right, top, left) within the cutting half-planes. Side i
@@ -181,17 +177,6 @@ inline int lowest_bit(std::uint64_t word) noexcept {
     ++i;
   }
   return i;
-#endif
-}
-
-// The number of set bits of a word.
-inline int popcount64(std::uint64_t word) noexcept {
-#if defined(__GNUC__) || defined(__clang__)
-  return __builtin_popcountll(word);
-#else
-  int count = 0;
-  for (; word; word &= word - 1) ++count;
-  return count;
 #endif
 }
 
