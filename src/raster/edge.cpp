@@ -530,8 +530,9 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
 // The hard texels (edge_mark_hard) that the snapped triangle (px, py: fixed point, counter-
 // clockwise) touches on `face`. A texel it covers whole makes it the texel's whole-texel
 // candidate (whole_z_, whole_id_: the nearest, ties to the earlier draw); one it covers in part
-// gets a fragment with the exact covered fraction of its weight, unless a triangle drawn earlier
-// covers the whole texel in front of it or fragments in front of it already fill the texel.
+// gets a fragment with the exact covered fraction of its weight and the triangle's unsnapped
+// edges over the texel (fragment_shapes_, for the blend's overlaps), unless a triangle drawn
+// earlier covers the whole texel in front of it.
 // Row by row over the box (the snapped box grown by the snapping, cut to the unsnapped
 // triangle's): the rows' hard texels within it (hard_rows_, hard_bits_) are classified exactly
 // with the integer edge functions at their corners (far: an edge leaves every corner more than
@@ -822,9 +823,10 @@ double raster_detail::rasterizer_impl::edge_hidden_part(edge_fragment* order, st
 
 // After the resolve: each texel with fragments gets the blend of what covers it. Its fragments,
 // front to back (1/w at the texel centre, larger first; ties: the earlier draw first, then the
-// order they were added), each take min(coverage, what is left) until the whole-texel winner
-// (or the first fragment behind it), which takes the rest; with no whole-texel winner the sky
-// takes the rest. Deterministic: the order is total and the sums run in it.
+// order they were added), each take min(its own part, what is left) until the whole-texel
+// winner (or the first fragment behind it), which takes the rest; with no whole-texel winner the
+// sky takes the rest. A fragment's own part is its coverage less what the fragments before it
+// cover of it (edge_hidden_part). Deterministic: the order is total and the sums run in it.
 void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture) {
   const auto draw_of = [this](std::uint32_t id) { return id >> key_bits_; };
   // A draw's radiance: its shade (inline; most renders have no texture), else fragment_radiance.
