@@ -22,7 +22,7 @@
 
 #include "bench_points.hpp"
 #include "host_steal.hpp"
-#include "rays_internal.hpp"
+#include "rays/ray_accel.hpp"
 
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore.h>

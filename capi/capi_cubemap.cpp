@@ -5,7 +5,7 @@
 
 #include "hemilight/cubemap.hpp"
 
-#include "../src/cubemap_internal.hpp"
+#include "../src/cubemap/cubemap_internal.hpp"
 
 #include <algorithm>
 #include <cmath>

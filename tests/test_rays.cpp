@@ -7,7 +7,7 @@
 #include "hemilight/reference_scenes.hpp"
 
 #include "raycast_reference.hpp"
-#include "rays_internal.hpp"
+#include "rays/ray_accel.hpp"
 
 #include <catch2/catch.hpp>
 #include <embree3/rtcore.h>

@@ -3,7 +3,7 @@
 // closed forms written here, and edge-incidence counting done in the test.
 #include "hemilight/reference_scenes.hpp"
 #include "hemilight/scene.hpp"
-#include "scene_internal.hpp"  // the SIMD vertex arrays (src/)
+#include "scene/scene_access.hpp"  // the SIMD vertex arrays (src/)
 
 #include <catch2/catch.hpp>
 

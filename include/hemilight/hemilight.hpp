@@ -8,7 +8,6 @@
 //   parallel.hpp  parallel_for: the one way hemilight uses several cores
 //   hemicube.hpp  the hemicube buffer: radiance, distance and flags per texel
 //   scene.hpp     immutable triangle scenes with materials, lightmap UVs, sky and BVH
-//   reference_scenes.hpp  the reference scenes (Cornell box, hexagon room, ...) by name
 //   raster.hpp    the software hemicube rasterizer
 //   integrate.hpp irradiance, gradients and split-sphere distances from a hemicube buffer
 //   rays.hpp      shadow and closest-hit ray queries against a scene
@@ -33,5 +32,4 @@
 #include "hemilight/probes.hpp"
 #include "hemilight/raster.hpp"
 #include "hemilight/rays.hpp"
-#include "hemilight/reference_scenes.hpp"
 #include "hemilight/scene.hpp"

@@ -6,7 +6,7 @@
 
 #include "isa.hpp"
 #include "kernel_common.hpp"
-#include "../scene_internal.hpp"
+#include "../scene/scene_access.hpp"
 
 #include <cfloat>
 #include <cstddef>

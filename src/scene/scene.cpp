@@ -1,5 +1,5 @@
 #include "hemilight/scene.hpp"
-#include "rays_internal.hpp"
+#include "../rays/ray_accel.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 // Second-order terms of the cache: the Hessian fit (hessian.hpp, fit_record_hessians in cache.hpp).
-#include "hessian.hpp"
+#include "fit_record_hessians.hpp"
 
 #include "record_index.hpp"
 #include "weights.hpp"

@@ -1,6 +1,6 @@
 // cache_irradiance (cache.hpp): the placement of records in rounds, and the final
 // interpolation, as a chain of named stages (the class placement below).
-#include "hessian.hpp"
+#include "fit_record_hessians.hpp"
 #include "pseudo_random.hpp"
 #include "record_index.hpp"
 #include "validation.hpp"

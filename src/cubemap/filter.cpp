@@ -4,7 +4,7 @@
 #include "hemilight/parallel.hpp"
 
 #include "cubemap_internal.hpp"
-#include "table_cache.hpp"
+#include "../core/table_cache.hpp"
 
 #include <algorithm>
 #include <array>

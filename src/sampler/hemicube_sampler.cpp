@@ -1,10 +1,10 @@
 // The cache's sampler factory (cache.hpp, make_hemicube_sampler): a hemicube per call, rendered
 // and integrated with one context per worker, plus the optional directional projections
 // (src/directional/).
-#include "pseudo_random.hpp"
+#include "../core/hash.hpp"
 
-#include "../directional/hl2_cone.hpp"
-#include "../directional/sh_l1.hpp"
+#include "hl2_cone.hpp"
+#include "sh_l1.hpp"
 
 #include "hemilight/cache.hpp"
 
@@ -42,7 +42,7 @@ frame sample_frame(const glm::vec3& x, const glm::vec3& n, bool roll) {
   if (roll) {
     std::uint32_t bits[3];
     std::memcpy(bits, &x, sizeof bits);
-    const std::uint64_t h = cache_detail::mix((std::uint64_t(bits[0]) << 32 | bits[1]) ^ cache_detail::mix(bits[2]));
+    const std::uint64_t h = core_detail::mix((std::uint64_t(bits[0]) << 32 | bits[1]) ^ core_detail::mix(bits[2]));
     const float angle = float(h >> 40) * (6.2831853f / float(1u << 24));
     const glm::vec3 t = std::cos(angle) * f.t + std::sin(angle) * f.b;
     f.b = glm::cross(f.n, t);

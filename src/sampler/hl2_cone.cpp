@@ -4,7 +4,7 @@
 
 #include "weighted_sums.hpp"
 
-#include "../table_cache.hpp"
+#include "../core/table_cache.hpp"
 
 #include "hemilight/geometry.hpp"
 #include "hemilight/integrate.hpp"

@@ -15,8 +15,8 @@
 //
 // Compiled with -ffp-contract=off (CMakeLists.txt): the edge functions of two triangles that share
 // an edge must be exact negations of each other, which a fused multiply-add would break.
-#include "rays_internal.hpp"
-#include "scene_internal.hpp"
+#include "ray_accel.hpp"
+#include "../scene/scene_access.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Ray queries through Embree 3 (rays.hpp): one process-wide RTCDevice, one RTCScene per scene built
 // on its first query (std::call_once), the fallback traversal of rays_bvh.cpp when that build fails.
-#include "rays_internal.hpp"
+#include "ray_accel.hpp"
 
 #include "hemilight/error.hpp"
 

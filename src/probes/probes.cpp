@@ -8,7 +8,7 @@
 #include "hemilight/parallel.hpp"
 #include "hemilight/raster.hpp"
 
-#include "table_cache.hpp"
+#include "../core/table_cache.hpp"
 
 #include <algorithm>
 #include <cmath>
