@@ -120,7 +120,7 @@ std::vector<double> converged_truth(const bake_input& in, const bake_options& o,
   const lightmap_samples s = compute_lightmap_samples(in, o.width, o.height);
   const auto sc = scene::create(in.scene);
   const float min_offset = 2.0f * default_near_distance(*sc);  // bake.hpp, step 2
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = n;
   const irradiance_sampler sampler = make_hemicube_sampler(sc, so, o.thread_count);
   const auto t0 = std::chrono::steady_clock::now();
@@ -230,7 +230,7 @@ int target(const char* path, int runs, const std::vector<std::string>& only, con
     in.scene = ts.mesh.desc();
     bake_options o;
     o.width = o.height = size;
-    o.resolution = 64;
+    o.sampler.resolution = 64;
     o.bounces = 1;
     o.thread_count = 2;
     std::printf("%s: %zu triangles\n", ts.name.c_str(), ts.mesh.triangle_count());
@@ -338,7 +338,7 @@ int main(int argc, char** argv) {
       for (int bounces : {1, 3}) {
         bake_options o;
         o.width = o.height = size;
-        o.resolution = 64;
+        o.sampler.resolution = 64;
         o.bounces = bounces;
         o.thread_count = 2;
         o.use_cache = false;

@@ -117,7 +117,7 @@ int bake_one(const std::string& scene_name, std::size_t triangles, int size, int
   in.scene = m.desc();
   bake_options o;
   o.width = o.height = size;
-  o.resolution = 64;
+  o.sampler.resolution = 64;
   o.bounces = 1;
   o.thread_count = threads;
   const bake_result r = bake_lightmap(in, o);

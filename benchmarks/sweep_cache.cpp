@@ -128,7 +128,7 @@ std::vector<truth_entry> render_luminance(const point_set& ps, const std::vector
       }
     }
   auto sc = scene::create(ps.mesh.desc());
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = resolution;
   const irradiance_sampler sampler = make_hemicube_sampler(sc, so, threads);
   const auto t0 = std::chrono::steady_clock::now();
@@ -168,9 +168,9 @@ int main(int argc, char** argv) {
   std::vector<bool> gradient_modes{true, false};
   std::string variant = "default";
   int worst_k = 0;
-  float second_opinion = cache_options{}.second_opinion;
-  float nearby_opinion = cache_options{}.nearby_opinion;
-  float sole_reach = cache_options{}.sole_record_reach;
+  float second_opinion = cache_options{}.expert.lone_record_change_limit;
+  float nearby_opinion = cache_options{}.expert.lone_record_neighbour_reach;
+  float sole_reach = cache_options{}.expert.lone_record_reach;
   cache_weight weight = cache_options{}.weight;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
   bool second_order = cache_options{}.second_order;
@@ -380,7 +380,7 @@ int main(int argc, char** argv) {
     };
 
     for (int resolution : resolutions) {
-      hemicube_sampler_options so;
+      sampler_options so;
       so.resolution = resolution;
       so.integrate.extrapolate_wall_depth = extrapolate_wall_depth;
       const irradiance_sampler sampler = make_hemicube_sampler(sc, so, threads);
@@ -411,14 +411,15 @@ int main(int argc, char** argv) {
           cache_options o;
           o.error_threshold = a;
           o.use_gradients = gradients;
-          o.second_opinion = second_opinion;
-          o.nearby_opinion = nearby_opinion;
-          o.sole_record_reach = sole_reach;
+          o.expert.lone_record_change_limit = second_opinion;
+          o.expert.lone_record_neighbour_reach = nearby_opinion;
+          o.expert.lone_record_reach = sole_reach;
           o.weight = weight;
           o.second_order = second_order;
-          o.thread_count = threads;
+          cache_run run;
+          run.thread_count = threads;
           const double load = loadavg();
-          const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o);
+          const cache_result r = cache_irradiance(ps.p.data(), ps.n.data(), count, sampler, o, run);
           // Relative error of each point against the per-point reference; -1 where left out (inside
           // geometry, or filled).
           std::vector<double> err_of(count, -1.0);

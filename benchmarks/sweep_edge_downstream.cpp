@@ -375,7 +375,7 @@ using bench::loadavg;
 using bench::seconds_since;
 
 irradiance_sampler sampler_for(const point_set& ps, int n, bool edge, int workers) {
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = n;
   so.raster.edge_coverage = edge;
   return make_hemicube_sampler(ps.sc, so, workers);
@@ -415,7 +415,7 @@ luminances render(const settings& st, const point_set& ps, const std::vector<std
   const auto t0 = std::chrono::steady_clock::now();
   parallel_for(idx.size(), workers, 4, [&](int w, std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
-      const cache_sample s = sampler(w, ps.p[idx[k]], ps.n[idx[k]]);
+      const sampler_result s = sampler(w, ps.p[idx[k]], ps.n[idx[k]]);
       out.value[k] = lum(s.irradiance);
       out.backface[k] = s.backface_fraction;
     }
@@ -745,8 +745,9 @@ void cache_part(const settings& st, const point_set& ps, const reference& ref, F
   const auto cache = [&](bool edge, float a, std::size_t target) {
     cache_options o;
     o.error_threshold = a;
-    o.thread_count = workers;
-    const cache_result res = cache_irradiance(ps.p.data(), ps.n.data(), ps.p.size(), samplers[edge ? 1 : 0], o);
+    cache_run run;
+    run.thread_count = workers;
+    const cache_result res = cache_irradiance(ps.p.data(), ps.n.data(), ps.p.size(), samplers[edge ? 1 : 0], o, run);
     row r{"cache", ps.name, mode_name(edge)};
     r.n = st.cache_n;
     r.a = double(a);

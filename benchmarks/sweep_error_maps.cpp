@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     in.scene = m.desc();
     bake_options o;
     o.width = o.height = size;
-    o.resolution = 64;
+    o.sampler.resolution = 64;
     o.bounces = 3;
     o.lights = sc.scene.lights;
     const bake_result cached = bake_lightmap(in, o);

@@ -114,7 +114,7 @@ void direct_target(const std::string& path, int runs) {
   in.scene = m.desc();
   bake_options o;
   o.width = o.height = 654;
-  o.resolution = 64;
+  o.sampler.resolution = 64;
   o.bounces = 1;
   o.thread_count = 2;
   o.lights = room_lights();
@@ -306,7 +306,7 @@ void cornell(const std::string& path, const std::vector<int>& sizes, const std::
       o.thread_count = 2;
       o.lights = ls.lights;
       o.use_cache = false;
-      o.resolution = 256;
+      o.sampler.resolution = 256;
       bake_result ref;
       const std::string cached = reference_cache.empty() ? std::string()
                                                          : reference_cache + "/cornell_" + (rect ? "rect_" : "quad_") + std::to_string(size) + ".bin";
@@ -321,7 +321,7 @@ void cornell(const std::string& path, const std::vector<int>& sizes, const std::
       o.use_cache = true;
       for (const int n : resolutions)
         for (const float a : {0.1f, 0.2f, 0.35f, 0.5f, 0.7f, 1.0f}) {
-          o.resolution = n;
+          o.sampler.resolution = n;
           o.cache.error_threshold = a;
           const bake_result r = bake_lightmap(in, o);
           const double fraction = double(r.stats.hemicubes) / double(r.stats.sampled_texels * std::size_t(bounces));

@@ -21,8 +21,8 @@ using hemilight::capi::guarded;
 using hemilight::capi::invalid;
 
 // The option fields hemilight_cache_irradiance checks itself, each named as the C caller wrote it:
-// the resolution, the thread count, the 0/1 switches and the weight (the C++ options' own ranges
-// follow through validate_cache_options).
+// the resolution, the thread count, the 0/1 switches, the placement rules (whose C++ names differ)
+// and the weight (the other ranges follow through validate_cache_options).
 hemilight_status check_c_options(const char* fn, const hemilight_cache_options& o) {
   if (const hemilight_status st = hemilight::capi::check_resolution(fn, o.resolution, "options->resolution")) return st;
   if (o.thread_count < 0) return invalid(fn, "options->thread_count is " + std::to_string(o.thread_count) + "; it must be >= 0");
@@ -37,6 +37,13 @@ hemilight_status check_c_options(const char* fn, const hemilight_cache_options& 
   for (const auto& sw : switches)
     if (sw.second != 0 && sw.second != 1)
       return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
+  // The placement rules' ranges (cache_expert_options), named as the C caller wrote them.
+  if (!(o.second_opinion >= 0.0f) || !std::isfinite(o.second_opinion))
+    return invalid(fn, "options->second_opinion is " + std::to_string(o.second_opinion) + "; it must be finite and >= 0 (0 = off)");
+  if (!(o.nearby_opinion >= 0.0f && o.nearby_opinion <= 16.0f))
+    return invalid(fn, "options->nearby_opinion is " + std::to_string(o.nearby_opinion) + "; it must be in [0, 16] (0 = off)");
+  if (!(o.sole_record_reach > 0.0f && o.sole_record_reach <= 1.0f))
+    return invalid(fn, "options->sole_record_reach is " + std::to_string(o.sole_record_reach) + "; it must be in (0, 1] (1 = off)");
   // Read as an int: a C caller may store any int in an enum field (a C++ load of such a value is
   // undefined behaviour).
   const int weight = hemilight::capi::enum_value(o.weight);
@@ -100,14 +107,15 @@ hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const 
     const auto* n = reinterpret_cast<const glm::vec3*>(normals);
     hemilight::validate_cache_points(p, n, count, fn);  // "hemilight_cache_irradiance: positions[3] = ..."
     // Step 2: the sampler and the cache.
-    hemilight::hemicube_sampler_options so = hemilight::capi::hemicube_sampler_options_of(full);
+    const hemilight::cache_run run = hemilight::capi::cache_run_of(full);
+    hemilight::sampler_options so = hemilight::capi::sampler_options_of(full);
     so.raster.sky = scene->sky;
     so.raster.edge_coverage = so.raster.edge_coverage || scene->edge_coverage;
     const hemilight::irradiance_sampler sampler =
-        hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(o.thread_count));
-    hemilight::cache_result r = hemilight::cache_irradiance(p, n, count, sampler, o);
+        hemilight::make_hemicube_sampler(scene->scene, so, hemilight::resolve_thread_count(run.thread_count));
+    hemilight::cache_result r = hemilight::cache_irradiance(p, n, count, sampler, o, run);
     // Step 3: the lights' direct part.
-    if (scene->lights) add_direct_light(*scene, p, n, count, o.thread_count, r.irradiance);
+    if (scene->lights) add_direct_light(*scene, p, n, count, run.thread_count, r.irradiance);
     // Step 4: the outputs, only when everything is finite (radiance is bounded by max_radiance,
     // but a light's I / d^2 next to a point is not).
     for (size_t i = 0; i < count; ++i)

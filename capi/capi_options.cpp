@@ -112,13 +112,13 @@ hemilight_cache_options default_cache_options() {
   o.progress_user = nullptr;
   const cache_options d;
   o.weight = HEMILIGHT_CACHE_WEIGHT_WARD;
-  o.gradient_radius_limit = d.gradient_radius_limit ? 1 : 0;
-  o.neighbour_clamp = d.neighbour_clamp ? 1 : 0;
-  o.shrink_disagreeing = d.shrink_disagreeing ? 1 : 0;
-  o.refine_disagreement = d.refine_disagreement ? 1 : 0;
-  o.second_opinion = d.second_opinion;
-  o.nearby_opinion = d.nearby_opinion;
-  o.sole_record_reach = d.sole_record_reach;
+  o.gradient_radius_limit = d.expert.limit_radius_by_gradient ? 1 : 0;
+  o.neighbour_clamp = d.expert.limit_radius_by_neighbours ? 1 : 0;
+  o.shrink_disagreeing = d.expert.shrink_disagreeing_records ? 1 : 0;
+  o.refine_disagreement = d.expert.refine_where_records_disagree ? 1 : 0;
+  o.second_opinion = d.expert.lone_record_change_limit;
+  o.nearby_opinion = d.expert.lone_record_neighbour_reach;
+  o.sole_record_reach = d.expert.lone_record_reach;
   o.invalid_backface_fraction = d.invalid_backface_fraction;
   o.extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth ? 1 : 0;
   o.second_order = d.second_order ? 1 : 0;
@@ -148,7 +148,7 @@ hemilight_bake_options default_bake_options() {
   for (int& l : o.shadow_mask_lights) l = -1;
   o.shadow_mask_rgba = nullptr;
   o.shadow_mask_capacity = 0;
-  o.edge_coverage = bake_options{}.edge_coverage ? 1 : 0;
+  o.edge_coverage = bake_options{}.sampler.raster.edge_coverage ? 1 : 0;
   return o;
 }
 
@@ -198,32 +198,37 @@ cache_options to_cpp(const hemilight_cache_options& c) {
   o.min_radius = c.min_radius;
   o.max_radius = c.max_radius;
   o.use_gradients = c.use_gradients == 1;
-  o.thread_count = c.thread_count;
   int weight = 0;
   std::memcpy(&weight, &c.weight, sizeof weight);  // any int a C caller stored (checked before)
   o.weight = weight == HEMILIGHT_CACHE_WEIGHT_WARD                   ? cache_weight::ward
              : weight == HEMILIGHT_CACHE_WEIGHT_TABELLION_LAMORLETTE ? cache_weight::tabellion_lamorlette
                                                                      : cache_weight::ward_continuous;
-  o.gradient_radius_limit = c.gradient_radius_limit == 1;
-  o.neighbour_clamp = c.neighbour_clamp == 1;
-  o.shrink_disagreeing = c.shrink_disagreeing == 1;
-  o.refine_disagreement = c.refine_disagreement == 1;
+  o.expert.limit_radius_by_gradient = c.gradient_radius_limit == 1;
+  o.expert.limit_radius_by_neighbours = c.neighbour_clamp == 1;
+  o.expert.shrink_disagreeing_records = c.shrink_disagreeing == 1;
+  o.expert.refine_where_records_disagree = c.refine_disagreement == 1;
   o.second_order = c.second_order == 1;
   // Range-checked (with the field named) by cache_irradiance.
-  o.second_opinion = c.second_opinion;
-  o.nearby_opinion = c.nearby_opinion;
-  o.sole_record_reach = c.sole_record_reach;
+  o.expert.lone_record_change_limit = c.second_opinion;
+  o.expert.lone_record_neighbour_reach = c.nearby_opinion;
+  o.expert.lone_record_reach = c.sole_record_reach;
   o.invalid_backface_fraction = c.invalid_backface_fraction;
-  if (c.progress) {
-    const hemilight_progress_fn progress = c.progress;
-    void* user = c.progress_user;
-    o.progress = [progress, user](float f) { return progress(user, f) != 0; };
-  }
   return o;
 }
 
-hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_options& c) {
-  hemicube_sampler_options so;
+cache_run cache_run_of(const hemilight_cache_options& c) {
+  cache_run run;
+  run.thread_count = c.thread_count;
+  if (c.progress) {
+    const hemilight_progress_fn progress = c.progress;
+    void* user = c.progress_user;
+    run.progress = [progress, user](float f) { return progress(user, f) != 0; };
+  }
+  return run;
+}
+
+sampler_options sampler_options_of(const hemilight_cache_options& c) {
+  sampler_options so;
   so.resolution = c.resolution;
   so.integrate.extrapolate_wall_depth = c.extrapolate_wall_depth == 1;
   so.raster.edge_coverage = c.edge_coverage == 1;
@@ -235,7 +240,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   bake_options o;
   o.width = c.width;
   o.height = c.height;
-  o.resolution = c.resolution;
+  o.sampler.resolution = c.resolution;
   o.bounces = c.bounces;
   o.indirect_only = c.indirect_only == 1;
   o.cache.error_threshold = c.error_threshold;
@@ -243,12 +248,12 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.dilation = c.dilation;
   o.use_cache = c.use_cache == 1;
   o.thread_count = c.thread_count;
-  o.environment = std::move(environment);
+  o.sampler.raster.sky = std::move(environment);
   o.lights = std::move(lights);
   o.output_sh_l1 = output_sh_l1;
   o.output_hl2 = output_hl2;
   for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
-  o.edge_coverage = c.edge_coverage == 1;
+  o.sampler.raster.edge_coverage = c.edge_coverage == 1;
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;

@@ -34,11 +34,13 @@ std::string check_sized(const hemilight_bake_stats* stats);
 void write_sized(const hemilight_cache_stats& from, hemilight_cache_stats* out);
 void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out);
 
-/// The C++ options of checked C options (switches already 0 or 1, the weight a known value).
-/// Every field of the C struct but resolution, extrapolate_wall_depth and edge_coverage (which
-/// belong to the hemicube sampler: hemicube_sampler_options_of) lands here.
+/// The C++ options of checked C options (switches already 0 or 1, the weight a known value). The
+/// C struct is flat; its fields land in one of three C++ homes: the cache's options (to_cpp), how
+/// the call runs (thread_count, progress: cache_run_of) and the sampler's options (resolution,
+/// extrapolate_wall_depth, edge_coverage: sampler_options_of).
 cache_options to_cpp(const hemilight_cache_options& c);
-hemicube_sampler_options hemicube_sampler_options_of(const hemilight_cache_options& c);
+cache_run cache_run_of(const hemilight_cache_options& c);
+sampler_options sampler_options_of(const hemilight_cache_options& c);
 
 /// The C++ bake options of checked C options, with the environment map and the lights already
 /// converted (they need checks that name their elements) and the directional outputs asked for.

@@ -39,9 +39,9 @@ hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, con
     hemilight::probe_options o;
     o.resolution = resolution;
     o.thread_count = thread_count;
-    o.sky = scene->sky;
+    o.raster.sky = scene->sky;
     o.lights = scene->lights;
-    o.edge_coverage = scene->edge_coverage;
+    o.raster.edge_coverage = scene->edge_coverage;
     const hemilight::probe_result r = hemilight::sample_probes(scene->scene, p.data(), count, o);
     // Finite on OK: radiance is bounded (max_radiance) but a light's I / d^2 next to a probe is not.
     for (std::size_t i = 0; i < count; ++i)

@@ -167,8 +167,8 @@ settings parse(int argc, char** argv) {
     } else if (a == "--size") {
       s.options.width = s.options.height = parse_int("--size", value(), 1, max_lightmap_size);
     } else if (a == "--resolution") {
-      s.options.resolution = parse_int("--resolution", value(), 2, 4096);
-      if (s.options.resolution % 2) fail("--resolution " + std::to_string(s.options.resolution) + " is invalid: it must be even", 2);
+      s.options.sampler.resolution = parse_int("--resolution", value(), 2, 4096);
+      if (s.options.sampler.resolution % 2) fail("--resolution " + std::to_string(s.options.sampler.resolution) + " is invalid: it must be even", 2);
     } else if (a == "--error") {
       s.options.cache.error_threshold = parse_float("--error", value(), 0.001f, 1.0f, false);
     } else if (a == "--bounces") {
@@ -436,7 +436,7 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
   }
   const bake_stats& st = sr.stats;
   std::printf("%s: %zu triangles, %zu page%s of %d x %d, N = %d, %d bounce%s%s, %d threads\n", name.c_str(),
-              in.geometry.scene.triangle_count, sr.pages.size(), sr.pages.size() > 1 ? "s" : "", o.width, o.height, o.resolution,
+              in.geometry.scene.triangle_count, sr.pages.size(), sr.pages.size() > 1 ? "s" : "", o.width, o.height, o.sampler.resolution,
               o.bounces, o.bounces > 1 ? "s" : "", o.indirect_only ? " (indirect only)" : "", resolve_thread_count(o.thread_count));
   const bool textured = std::any_of(in.pages.begin(), in.pages.end(), [](const lightmap_page& p) { return p.albedo.width > 0 || p.emission.width > 0; });
   if (textured) std::printf("  per-texel albedo/emission from the model's textures\n");
@@ -459,13 +459,13 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
   const image texture = bake_radiance_texture(in.geometry, o, sr.pages[0]);
   const radiance_texture view(texture);
   probe_options po;
-  po.resolution = o.resolution;
+  po.resolution = o.sampler.resolution;
   po.thread_count = o.thread_count;
-  po.sky = o.environment;
+  po.raster.sky = o.sampler.raster.sky;
   po.texture = &view;
   if (!o.lights.empty()) po.lights = std::make_shared<const light_set>(o.lights.data(), o.lights.size());
   const probe_result pr = sample_probes(sc, points.data(), points.size(), po);
-  write_probes_json(base + "_probes.json", points, pr, o.resolution, grid, sc->bounds_lo(), sc->bounds_hi());
+  write_probes_json(base + "_probes.json", points, pr, o.sampler.resolution, grid, sc->bounds_lo(), sc->bounds_hi());
   std::size_t inside = 0;
   for (float b : pr.backface_fraction) inside += b > 0.1f ? 1 : 0;
   std::printf("  %zu probes (%zu inside geometry: back-face fraction > 0.1), %.2f s; wrote %s_probes.json\n", points.size(), inside,
@@ -481,7 +481,7 @@ void run(const settings& s) {
   settings with_env = s;
   if (!s.environment.empty()) {
     if (!std::filesystem::is_regular_file(s.environment, ec)) fail("cannot read '" + s.environment + "': no such file");
-    with_env.options.environment = std::make_shared<const cubemap>(cubemap::from_image(read_exr_cubemap(s.environment, 3), false));
+    with_env.options.sampler.raster.sky = std::make_shared<const cubemap>(cubemap::from_image(read_exr_cubemap(s.environment, 3), false));
   }
   run_scenes(with_env);
 }

@@ -54,7 +54,7 @@ struct small_cornell {
   small_cornell() {
     generate_lightmap_uvs(mesh, 32, 2);
     options.width = options.height = 32;
-    options.resolution = 16;
+    options.sampler.resolution = 16;
     options.bounces = 2;
   }
 };
@@ -209,7 +209,7 @@ TEST_CASE("Closed box lit by an emissive ceiling: floor irradiance matches Lambe
   generate_lightmap_uvs(m, 64, 2);
   bake_options o;
   o.width = o.height = 64;
-  o.resolution = 32;
+  o.sampler.resolution = 32;
   o.cache.error_threshold = 0.1f;
   o.thread_count = 2;
   const bake_result r = bake_lightmap(input_of(m), o);
@@ -244,7 +244,7 @@ TEST_CASE("White furnace: bounces converge along the geometric series and indire
   generate_lightmap_uvs(room, 32, 2);
   bake_options o;
   o.width = o.height = 32;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.thread_count = 2;
   for (int bounces = 1; bounces <= 4; ++bounces) {
     o.bounces = bounces;
@@ -294,7 +294,7 @@ TEST_CASE("Dilation grows charts ring by ring with the mean of filled neighbours
     generate_lightmap_uvs(room, 32, 2);
     bake_options o;
     o.width = o.height = 32;
-    o.resolution = 16;
+    o.sampler.resolution = 16;
     o.dilation = 2;
     const bake_result r = bake_lightmap(input_of(room), o);
     CHECK(r.stats.dilated_texels > 0);
@@ -406,7 +406,7 @@ TEST_CASE("Bad input to the baker names the problem", "[bake]") {
   m.add({0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0}, {1, 0}, {0, 1});
   bake_options o;
   o.width = o.height = 8;
-  o.resolution = 8;
+  o.sampler.resolution = 8;
   const auto throws_with = [&](const bake_input& in, const bake_options& opt, const std::string& part) {
     try {
       (void)bake_lightmap(in, opt);
@@ -522,7 +522,7 @@ TEST_CASE("Directional maps under a uniform sky match the closed forms in right-
     bake_options o;
     o.width = 16;
     o.height = 8;
-    o.resolution = 16;
+    o.sampler.resolution = 16;
     o.use_cache = cache;
     o.output_sh_l1 = o.output_hl2 = true;
     const bake_result r = bake_lightmap(in, o);
@@ -574,7 +574,7 @@ TEST_CASE("Directional maps against Lambert's closed form and per-texel hemicube
   bake_options o;
   o.width = 32;
   o.height = 16;
-  o.resolution = 64;
+  o.sampler.resolution = 64;
   o.output_sh_l1 = o.output_hl2 = true;
   o.cache.error_threshold = 0.1f;
   bake_options ref_o = o;
@@ -680,8 +680,8 @@ TEST_CASE("Environment sky: an upward and a sideways quad match the cube map's c
   bake_options o;
   o.width = 16;
   o.height = 8;
-  o.resolution = 64;
-  o.environment = map;
+  o.sampler.resolution = 64;
+  o.sampler.raster.sky = map;
   o.output_sh_l1 = true;
   const bake_result r = bake_lightmap(in, o);
   const float* up = filtered.at(2, 2, 2);    // face +Y, centre: +y
@@ -698,8 +698,8 @@ TEST_CASE("Environment sky: an upward and a sideways quad match the cube map's c
   // 2 pi + 0.3 pi (integral of w_y) = 2.3 pi, times Y00; midpoint sampling of the map: 1e-3.
   CHECK(r.sh_l1[0].pixels[0] == Approx(0.28209479 * 2.3 * pi).epsilon(1e-3));
   // Bad maps are refused by name.
-  o.environment = std::make_shared<const cubemap>();
-  test::require_error([&] { bake_lightmap(in, o); }, status::invalid_argument, "environment");
+  o.sampler.raster.sky = std::make_shared<const cubemap>();
+  test::require_error([&] { bake_lightmap(in, o); }, status::invalid_argument, "sampler: raster: the sky cube map");
 }
 
 TEST_CASE("write_bake_exrs writes the irradiance, mask and the requested directional maps", "[bake]") {
@@ -729,7 +729,7 @@ TEST_CASE("White furnace: directional maps of the full and the indirect-only bak
   const lightmap_samples smp = compute_lightmap_samples(input_of(room), 32, 32);
   bake_options o;
   o.width = o.height = 32;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.bounces = 3;
   o.output_sh_l1 = o.output_hl2 = true;
   for (bool indirect : {false, true}) {
@@ -775,7 +775,7 @@ TEST_CASE("HL2 maps of a grazing side light in right- and left-handed charts aga
   bake_options o;
   o.width = 64;
   o.height = 16;
-  o.resolution = 64;
+  o.sampler.resolution = 64;
   o.cache.error_threshold = 0.1f;
   o.output_sh_l1 = o.output_hl2 = true;
   const bake_result r = bake_lightmap(in, o);
@@ -833,7 +833,7 @@ struct post_on_slab {
     mesh.sky_radiance = glm::vec3(1.0f);
     generate_lightmap_uvs(mesh, 256, 2);
     options.width = options.height = 256;
-    options.resolution = 64;
+    options.sampler.resolution = 64;
     options.bounces = 1;
   }
   // Distance in x-z from the post's footprint (0 on it).
@@ -855,7 +855,7 @@ TEST_CASE("A post on a slab under the sky keeps its contact shadow: floor texels
   // bake's N = 64: the reference's own aliasing is ~4x smaller.
   const auto sc = scene::create(in.scene);
   const float min_offset = 2.0f * default_near_distance(*sc);
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = 256;
   const irradiance_sampler reference = make_hemicube_sampler(sc, so, 1);
   const float bins[] = {0.0f, 0.05f, 0.1f, 0.2f, 0.4f};
@@ -952,7 +952,7 @@ TEST_CASE("Bake with a hard sun: the floor gets E cos theta, the SH and HL2 maps
   const int size = 16;
   bake_options o;
   o.width = o.height = size;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.lights = {hard_sun(travel, e_sun)};
   o.output_sh_l1 = o.output_hl2 = true;
   const bake_result r = bake_lightmap(m.input(), o);
@@ -991,7 +991,7 @@ TEST_CASE("Bake with a hard sun: a square occluder's umbra is exactly 0, the res
   const int size = 64;
   bake_options o;
   o.width = o.height = size;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.lights = {hard_sun({0.0f, -1.0f, 0.0f}, 3.0f)};
   o.shadow_mask_lights = {{0, -1, -1, -1}};
   const bake_result r = bake_lightmap(m.input(), o);
@@ -1048,7 +1048,7 @@ TEST_CASE("White furnace lit by a point light: the mean irradiance follows the g
   l.color = glm::vec3(intensity);
   bake_options o;
   o.width = o.height = 64;
-  o.resolution = 32;
+  o.sampler.resolution = 32;
   o.thread_count = 2;
   o.lights = {l};
   const double direct_mean = 4.0 * pi * intensity / 6.0;

@@ -103,7 +103,7 @@ double worst_relative(const bake_result& a, const bake_result& b, double floor_v
 
 bake_options reference_options() {
   bake_options o;
-  o.resolution = 32;
+  o.sampler.resolution = 32;
   o.bounces = 2;
   o.use_cache = false;  // a hemicube per texel: no interpolation between the two bakes' records
   o.thread_count = 2;
@@ -227,7 +227,7 @@ TEST_CASE("Scene bake: an occluder-only mesh shadows the sky as Lambert's formul
   mm.add(floor, 0);
   mm.add(roof, -1);
   bake_options o;
-  o.resolution = 64;
+  o.sampler.resolution = 64;
   o.bounces = 1;
   o.use_cache = false;
   o.thread_count = 2;
@@ -266,7 +266,7 @@ TEST_CASE("Scene bake: an occluder-only mesh casts an exact sun shadow through t
   mm.add(floor, 0);
   mm.add(roof, -1);
   bake_options o;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.thread_count = 2;
   light sun;
   sun.type = light_type::directional;
@@ -307,7 +307,7 @@ TEST_CASE("Scene bake: occluders' radiance modes against the occluder baked on i
   scene_mesh roof_uv = roof;
   generate_lightmap_uvs(roof_uv, 16, 2);
   bake_options o = reference_options();
-  o.resolution = 32;
+  o.sampler.resolution = 32;
   o.bounces = 3;
   const glm::vec3 sky(1.0f);
   multi_mesh baked;
@@ -358,7 +358,7 @@ TEST_CASE("Scene bake: per-page images equal to the triangles' values give the s
     multi_mesh mm;
     mm.add(a, 0);
     bake_options o;
-    o.resolution = 16;
+    o.sampler.resolution = 16;
     o.bounces = 3;
     o.thread_count = 2;
     scene_bake_input in = mm.input({page_of(32, 32)}, glm::vec3(1.0f));
@@ -386,7 +386,7 @@ TEST_CASE("Scene bake: per-page images equal to the triangles' values give the s
     in.pages[0].emission = image::make(32, 32, 3, le);
     in.pages[0].albedo = image::make(32, 32, 3, a);
     bake_options o;
-    o.resolution = 16;
+    o.sampler.resolution = 16;
     o.bounces = 3;
     o.thread_count = 2;
     const scene_bake_result r = bake_scene(in, o);
@@ -421,7 +421,7 @@ TEST_CASE("Scene bake: bitwise identical for 1 and 2 threads with pages, occlude
   scene_bake_input in = mm.input({page_of(24, 24), page_of(16, 16)}, glm::vec3(1.0f));
   in.occluders = occluder_radiance::emission_plus_mean_bounce;
   bake_options o;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.bounces = 2;
   o.thread_count = 1;
   const scene_bake_result one = bake_scene(in, o);
@@ -441,7 +441,7 @@ TEST_CASE("Scene bake: bad pages, meshes and images name the page or mesh", "[ba
   mm.add(wall, 1);
   const scene_bake_input good = mm.input({page_of(16, 16), page_of(16, 16)}, glm::vec3(1.0f));
   bake_options o;
-  o.resolution = 8;
+  o.sampler.resolution = 8;
   const auto fails = [&](const scene_bake_input& in, const std::string& needle) {
     test::require_error([&] { bake_scene(in, o); }, status::invalid_argument, needle);
   };

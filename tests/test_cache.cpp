@@ -351,7 +351,7 @@ TEST_CASE("cache: radius clamps and the gradient limit on crafted samples", "[ca
   cache_options o;
   o.min_radius = 0.5f;
   o.max_radius = 8.0f;
-  o.neighbour_clamp = o.shrink_disagreeing = false;
+  o.expert.limit_radius_by_neighbours = o.expert.shrink_disagreeing_records = false;
   cache_result r = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
   REQUIRE(r.records.size() == 4);
   for (const cache_record& rec : r.records) {
@@ -360,7 +360,7 @@ TEST_CASE("cache: radius clamps and the gradient limit on crafted samples", "[ca
     if (rec.position == p[2]) CHECK(rec.radius == 5.0f);
     if (rec.position == p[3]) CHECK(rec.radius == Approx(2.0f));
   }
-  o.gradient_radius_limit = false;
+  o.expert.limit_radius_by_gradient = false;
   r = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
   for (const cache_record& rec : r.records)
     if (rec.position == p[3]) CHECK(rec.radius == 5.0f);
@@ -379,9 +379,9 @@ TEST_CASE("cache: neighbour clamping and shrinking place more records near a wal
   };
   cache_options plain;
   plain.error_threshold = 0.3f;
-  plain.neighbour_clamp = plain.shrink_disagreeing = plain.gradient_radius_limit = false;
+  plain.expert.limit_radius_by_neighbours = plain.expert.shrink_disagreeing_records = plain.expert.limit_radius_by_gradient = false;
   cache_options limited = plain;
-  limited.neighbour_clamp = limited.shrink_disagreeing = true;
+  limited.expert.limit_radius_by_neighbours = limited.expert.shrink_disagreeing_records = true;
   const cache_result a = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 32), plain);
   const cache_result b = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 32), limited);
   INFO("records near the wall: " << near_wall(a) << " without limits, " << near_wall(b) << " with; total " << a.records.size()
@@ -395,10 +395,11 @@ TEST_CASE("cache: bitwise identical for one and two threads", "[cache]") {
   std::vector<glm::vec3> p, n;
   floor_grid(-0.95f, 0.95f, -0.95f, 0.95f, 0.05f, p, n);
   cache_options o;
-  o.thread_count = 1;
-  const cache_result one = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
-  o.thread_count = 2;
-  const cache_result two = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o);
+  cache_run run;
+  run.thread_count = 1;
+  const cache_result one = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o, run);
+  run.thread_count = 2;
+  const cache_result two = cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 16), o, run);
   check_same_records(one, two);
   CHECK(std::memcmp(one.irradiance.data(), two.irradiance.data(), sizeof(glm::vec3) * p.size()) == 0);
 }
@@ -420,7 +421,7 @@ TEST_CASE("cache: each point's value is the brute-force interpolation over all r
       p.push_back({(float(i) + 0.5f) / float(k) * W, (float(j) + 0.5f) / float(k) * H, D - 1e-3f});
       n.push_back({0.0f, 0.0f, -1.0f});
     }
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = 32;
   const irradiance_sampler sampler = make_hemicube_sampler(scene::create(mesh.desc()), so, resolve_thread_count(0));
   for (const cache_weight weight : {cache_weight::ward, cache_weight::ward_continuous, cache_weight::tabellion_lamorlette})
@@ -472,7 +473,8 @@ TEST_CASE("cache: cancellation throws and returns nothing", "[cache]") {
   int calls = 0;
   float last = 0.0f;
   cache_options o;
-  o.progress = [&](float f) {
+  cache_run run;
+  run.progress = [&](float f) {
     CHECK((f >= 0.0f && f <= 1.0f));
     CHECK(f >= last);  // never goes backwards
     last = f;
@@ -480,7 +482,7 @@ TEST_CASE("cache: cancellation throws and returns nothing", "[cache]") {
   };
   bool cancelled = false;
   try {
-    cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 8), o);
+    cache_irradiance(p.data(), n.data(), p.size(), raycast_sampler(s, 8), o, run);
   } catch (const error& e) {
     cancelled = e.code() == status::cancelled;
   }
@@ -514,15 +516,15 @@ TEST_CASE("cache: bad input gets a clear error", "[cache]") {
   o.min_radius = 0.0f;
   o.max_radius = 0.0f;
   for (float v : {-0.5f, 17.0f, NAN, INFINITY}) {
-    o.nearby_opinion = v;
-    CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("nearby_opinion"));
+    o.expert.lone_record_neighbour_reach = v;
+    CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("expert.lone_record_neighbour_reach"));
   }
-  o.nearby_opinion = 2.0f;
+  o.expert.lone_record_neighbour_reach = 2.0f;
   for (float v : {0.0f, -0.5f, 1.5f, NAN}) {
-    o.sole_record_reach = v;
-    CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("sole_record_reach"));
+    o.expert.lone_record_reach = v;
+    CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("expert.lone_record_reach"));
   }
-  o.sole_record_reach = 0.99f;
+  o.expert.lone_record_reach = 0.99f;
   o.invalid_backface_fraction = 2.0f;
   CHECK_THROWS_WITH(cache_irradiance(p.data(), n.data(), 2, sampler, o), Catch::Contains("invalid_backface_fraction"));
 }
@@ -641,8 +643,9 @@ TEST_CASE("cache: directional records carry world-space L1 SH - uniform sky clos
   };
   cache_options o;
   o.error_threshold = 0.2f;
-  o.directional = true;
-  const cache_result r = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
+  cache_run directional;
+  directional.directional = true;
+  const cache_result r = cache_irradiance(p.data(), n.data(), p.size(), sampler, o, directional);
   REQUIRE(r.sh_l1.size() == p.size());
   double worst0 = 0.0, worst1 = 0.0, worst_record = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -673,26 +676,24 @@ TEST_CASE("cache: directional records carry world-space L1 SH - uniform sky clos
   for (int k = 0; k < 4; ++k) CHECK(glm::length(b[std::size_t(k)] - r.sh_l1[5][std::size_t(k)]) < 1e-4f);
 
   // Off (the default): no coefficients anywhere.
-  cache_options plain = o;
-  plain.directional = false;
-  const cache_result q = cache_irradiance(p.data(), n.data(), p.size(), sampler, plain);
+  const cache_result q = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
   CHECK(q.sh_l1.empty());
   for (const cache_record& rec : q.records) CHECK(rec.sh_l1[0] == glm::vec3(0.0f));
   CHECK(q.irradiance == r.irradiance);  // E does not depend on the option
 }
 
 TEST_CASE("cache: the sampler's cheap L1 SH equals the integrator's directional SH", "[cache]") {
-  // hemicube_sampler_options::sh_l1 derives band 1 from the rotation gradient (Phi = E n + g_r x n)
+  // sampler_pass::sh_l1 derives band 1 from the rotation gradient (Phi = E n + g_r x n)
   // and band 0 from one solid-angle sum; integrate_options::directional sums both directly. Same
   // hemicubes (same roll), so they must agree to float rounding of 12k-texel sums: 1e-5 of c_00.
   auto sc = scene::create(cornell_box().desc());
-  hemicube_sampler_options cheap;
+  sampler_options cheap;
   cheap.resolution = 32;
-  cheap.sh_l1 = true;
-  hemicube_sampler_options full = cheap;
-  full.sh_l1 = false;
+  sampler_pass cheap_sh;
+  cheap_sh.sh_l1 = true;
+  sampler_options full = cheap;
   full.integrate.directional = true;
-  const irradiance_sampler a = make_hemicube_sampler(sc, cheap, 1), b = make_hemicube_sampler(sc, full, 1);
+  const irradiance_sampler a = make_hemicube_sampler(sc, cheap, 1, cheap_sh), b = make_hemicube_sampler(sc, full, 1);
   const glm::vec3 points[][2] = {{{0.28f, 0.01f, 0.28f}, {0, 1, 0}},
                                  {{0.01f, 0.3f, 0.2f}, {1, 0, 0}},
                                  {{0.3f, 0.54f, 0.1f}, {0, -1, 0}},
@@ -709,9 +710,9 @@ TEST_CASE("cache: the sampler's cheap L1 SH equals the integrator's directional 
     CHECK(sa.irradiance == sb.irradiance);
   }
   CHECK(lit >= 3);  // all but the point under the ceiling facing down see the lamp (emission only)
-  hemicube_sampler_options bad = cheap;
+  sampler_options bad = cheap;
   bad.integrate.rotation_gradient = false;
-  CHECK_THROWS_WITH(make_hemicube_sampler(sc, bad, 1), Catch::Contains("rotation_gradient"));
+  CHECK_THROWS_WITH(make_hemicube_sampler(sc, bad, 1, cheap_sh), Catch::Contains("rotation_gradient"));
 }
 
 TEST_CASE("cache: HL2 cone series - uniform sky closed form and exact rotation", "[cache]") {
@@ -721,12 +722,13 @@ TEST_CASE("cache: HL2 cone series - uniform sky closed form and exact rotation",
   // clamped cosine by the midpoint rule on 8 x 8 sub-rectangles (N = 32 here): 1e-4 relative.
   scene_mesh empty;
   empty.sky_radiance = glm::vec3(1.0f, 2.0f, 0.5f);
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = 32;
-  so.hl2_cone = true;
-  const irradiance_sampler sampler = make_hemicube_sampler(scene::create(empty.desc()), so, 1);
+  sampler_pass cone;
+  cone.hl2_cone = true;
+  const irradiance_sampler sampler = make_hemicube_sampler(scene::create(empty.desc()), so, 1, cone);
   const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.8f, -0.5f));
-  const cache_sample s = sampler(0, glm::vec3(1.0f, 2.0f, 3.0f), n);
+  const sampler_result s = sampler(0, glm::vec3(1.0f, 2.0f, 3.0f), n);
   const double closed = 3.14159265358979 * (1.0 + 1.0 / std::sqrt(3.0)) / 2.0;
   for (int c = 0; c < 3; ++c) {
     CHECK(s.cone.coefficients[0][c] == Approx(closed * empty.sky_radiance[c]).epsilon(1e-4));
@@ -769,7 +771,7 @@ TEST_CASE("cache: second opinion - the Cornell box wall just below the emitter's
       p.push_back({1e-3f, (float(j) + 0.5f) / float(k) * H, (float(i) + 0.5f) / float(k) * D});
       n.push_back({1.0f, 0.0f, 0.0f});
     }
-  hemicube_sampler_options so;
+  sampler_options so;
   so.resolution = 64;
   const irradiance_sampler sampler = make_hemicube_sampler(scene::create(mesh.desc()), so, resolve_thread_count(0));
   std::vector<glm::vec3> ref(p.size());
@@ -788,11 +790,11 @@ TEST_CASE("cache: second opinion - the Cornell box wall just below the emitter's
   };
   cache_options off;
   off.error_threshold = 0.3f;
-  off.second_opinion = 0.0f;
-  off.nearby_opinion = 0.0f;     // the rules added after this one, off: the second opinion alone
-  off.sole_record_reach = 1.0f;
+  off.expert.lone_record_change_limit = 0.0f;
+  off.expert.lone_record_neighbour_reach = 0.0f;     // the rules added after this one, off: the second opinion alone
+  off.expert.lone_record_reach = 1.0f;
   cache_options on = off;
-  on.second_opinion = 0.25f;
+  on.expert.lone_record_change_limit = 0.25f;
   const cache_result a = cache_irradiance(p.data(), n.data(), p.size(), sampler, off);
   const cache_result b = cache_irradiance(p.data(), n.data(), p.size(), sampler, on);
   double a_max = 0.0, b_max = 0.0;
@@ -847,9 +849,9 @@ TEST_CASE("cache: sole record reach - no lone extrapolation from the rim of a re
   for (const float a : {0.1f, 0.2f, 0.3f, 0.5f, 0.7f}) {
     cache_options off;
     off.error_threshold = a;
-    off.sole_record_reach = 1.0f;
+    off.expert.lone_record_reach = 1.0f;
     cache_options on = off;
-    on.sole_record_reach = 0.99f;
+    on.expert.lone_record_reach = 0.99f;
     const cache_result r_off = cache_irradiance(p.data(), n.data(), p.size(), sampler, off);
     const cache_result r_on = cache_irradiance(p.data(), n.data(), p.size(), sampler, on);
     INFO("a = " << a << ": off " << wrong_points(r_off) << " wrong points; on " << wrong_points(r_on));
@@ -888,12 +890,12 @@ TEST_CASE("cache: nearby opinion - a hard edge between two columns of points", "
   for (const float a : {0.2f, 0.25f, 0.3f, 0.35f, 0.4f, 0.5f}) {
     cache_options off;
     off.error_threshold = a;
-    off.nearby_opinion = 0.0f;
+    off.expert.lone_record_neighbour_reach = 0.0f;
     // The rule alone: sole_record_reach and disagreement shrinking also catch this crafted edge.
-    off.sole_record_reach = 1.0f;
-    off.shrink_disagreeing = false;
+    off.expert.lone_record_reach = 1.0f;
+    off.expert.shrink_disagreeing_records = false;
     cache_options on = off;
-    on.nearby_opinion = 2.0f;
+    on.expert.lone_record_neighbour_reach = 2.0f;
     const cache_result r_off = cache_irradiance(p.data(), n.data(), p.size(), sampler, off);
     const cache_result r_on = cache_irradiance(p.data(), n.data(), p.size(), sampler, on);
     INFO("a = " << a << ": off " << wrong_points(r_off, a) << " wrong points, " << r_off.stats.hemicubes << " hemicubes; on "
@@ -947,8 +949,9 @@ TEST_CASE("cache: fill_invalid = false leaves points inside geometry at 0 and ev
   const irradiance_sampler sampler = raycast_sampler(s, 16);
   cache_options o;
   const cache_result filled = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
-  o.fill_invalid = false;
-  const cache_result bare = cache_irradiance(p.data(), n.data(), p.size(), sampler, o);
+  cache_run run;
+  run.fill_invalid = false;
+  const cache_result bare = cache_irradiance(p.data(), n.data(), p.size(), sampler, o, run);
   REQUIRE(bare.stats.invalid_points > 0);
   CHECK(bare.stats.invalid_points == filled.stats.invalid_points);
   CHECK(bare.valid == filled.valid);
@@ -980,8 +983,9 @@ TEST_CASE("cache: known_inside points get no hemicube and stay invalid; the rest
     return inner(worker, x, nx);
   };
   cache_options o;
-  o.fill_invalid = false;
-  const cache_result first = cache_irradiance(p.data(), n.data(), p.size(), counting, o);
+  cache_run run;
+  run.fill_invalid = false;
+  const cache_result first = cache_irradiance(p.data(), n.data(), p.size(), counting, o, run);
   std::vector<std::uint8_t> inside(p.size());
   std::size_t inside_count = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -992,8 +996,8 @@ TEST_CASE("cache: known_inside points get no hemicube and stay invalid; the rest
   }
   REQUIRE(inside_count > 0);
   sampled_at.clear();
-  o.known_inside = inside.data();
-  const cache_result second = cache_irradiance(p.data(), n.data(), p.size(), counting, o);
+  run.known_inside = inside.data();
+  const cache_result second = cache_irradiance(p.data(), n.data(), p.size(), counting, o, run);
   CHECK(second.stats.invalid_samples == 0);  // nothing left inside to find: no hemicube saw back faces
   CHECK(second.stats.hemicubes == sampled_at.size());
   CHECK(second.stats.hemicubes < first.stats.hemicubes);

@@ -44,7 +44,8 @@ TEST_CASE("C ABI options: every cache option reaches the C++ side", "[capi]") {
   c.second_order = 0;
   c.edge_coverage = 1;
   const cache_options o = capi::to_cpp(c);
-  const hemicube_sampler_options so = capi::hemicube_sampler_options_of(c);
+  const cache_run run = capi::cache_run_of(c);
+  const sampler_options so = capi::sampler_options_of(c);
   CHECK(so.resolution == 48);
   CHECK(so.integrate.extrapolate_wall_depth);
   CHECK(so.raster.edge_coverage);
@@ -52,20 +53,20 @@ TEST_CASE("C ABI options: every cache option reaches the C++ side", "[capi]") {
   CHECK(o.min_radius == 0.011f);
   CHECK(o.max_radius == 2.5f);
   CHECK(!o.use_gradients);
-  CHECK(o.thread_count == 3);
+  CHECK(run.thread_count == 3);
   CHECK(o.weight == cache_weight::tabellion_lamorlette);
-  CHECK(!o.gradient_radius_limit);
-  CHECK(!o.neighbour_clamp);
-  CHECK(!o.shrink_disagreeing);
-  CHECK(!o.refine_disagreement);
-  CHECK(o.second_opinion == 0.4f);
-  CHECK(o.nearby_opinion == 3.0f);
-  CHECK(o.sole_record_reach == 0.5f);
+  CHECK(!o.expert.limit_radius_by_gradient);
+  CHECK(!o.expert.limit_radius_by_neighbours);
+  CHECK(!o.expert.shrink_disagreeing_records);
+  CHECK(!o.expert.refine_where_records_disagree);
+  CHECK(o.expert.lone_record_change_limit == 0.4f);
+  CHECK(o.expert.lone_record_neighbour_reach == 3.0f);
+  CHECK(o.expert.lone_record_reach == 0.5f);
   CHECK(o.invalid_backface_fraction == 0.3f);
   CHECK(!o.second_order);
-  REQUIRE(o.progress);
+  REQUIRE(run.progress);
   progress_calls = 0;
-  CHECK(o.progress(0.5f));
+  CHECK(run.progress(0.5f));
   CHECK(progress_calls == 1);
   c.weight = HEMILIGHT_CACHE_WEIGHT_WARD_CONTINUOUS;
   CHECK(capi::to_cpp(c).weight == cache_weight::ward_continuous);
@@ -80,24 +81,23 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(o.min_radius == d.min_radius);
   CHECK(o.max_radius == d.max_radius);
   CHECK(o.use_gradients == d.use_gradients);
-  CHECK(o.thread_count == d.thread_count);
+  CHECK(capi::cache_run_of(capi::default_cache_options()).thread_count == cache_run{}.thread_count);
   CHECK(o.weight == d.weight);
-  CHECK(o.gradient_radius_limit == d.gradient_radius_limit);
-  CHECK(o.neighbour_clamp == d.neighbour_clamp);
-  CHECK(o.shrink_disagreeing == d.shrink_disagreeing);
-  CHECK(o.refine_disagreement == d.refine_disagreement);
-  CHECK(o.second_opinion == d.second_opinion);
-  CHECK(o.nearby_opinion == d.nearby_opinion);
-  CHECK(o.sole_record_reach == d.sole_record_reach);
+  CHECK(o.expert.limit_radius_by_gradient == d.expert.limit_radius_by_gradient);
+  CHECK(o.expert.limit_radius_by_neighbours == d.expert.limit_radius_by_neighbours);
+  CHECK(o.expert.shrink_disagreeing_records == d.expert.shrink_disagreeing_records);
+  CHECK(o.expert.refine_where_records_disagree == d.expert.refine_where_records_disagree);
+  CHECK(o.expert.lone_record_change_limit == d.expert.lone_record_change_limit);
+  CHECK(o.expert.lone_record_neighbour_reach == d.expert.lone_record_neighbour_reach);
+  CHECK(o.expert.lone_record_reach == d.expert.lone_record_reach);
   CHECK(o.invalid_backface_fraction == d.invalid_backface_fraction);
   CHECK(o.second_order == d.second_order);
-  CHECK(!o.progress);
-  CHECK(capi::hemicube_sampler_options_of(capi::default_cache_options()).resolution == hemicube_sampler_options{}.resolution);
-  CHECK(capi::hemicube_sampler_options_of(capi::default_cache_options()).raster.edge_coverage ==
-        hemicube_sampler_options{}.raster.edge_coverage);
+  CHECK(!capi::cache_run_of(capi::default_cache_options()).progress);
+  CHECK(capi::sampler_options_of(capi::default_cache_options()).resolution == sampler_options{}.resolution);
+  CHECK(capi::sampler_options_of(capi::default_cache_options()).raster.edge_coverage == sampler_options{}.raster.edge_coverage);
   const bake_options bd;
   const bake_options b = capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false);
-  CHECK(b.resolution == bd.resolution);
+  CHECK(b.sampler.resolution == bd.sampler.resolution);
   CHECK(b.bounces == bd.bounces);
   CHECK(b.indirect_only == bd.indirect_only);
   CHECK(b.cache.error_threshold == bd.cache.error_threshold);
@@ -105,7 +105,7 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(b.dilation == bd.dilation);
   CHECK(b.use_cache == bd.use_cache);
   CHECK(b.thread_count == bd.thread_count);
-  CHECK(b.edge_coverage == bd.edge_coverage);
+  CHECK(b.sampler.raster.edge_coverage == bd.sampler.raster.edge_coverage);
 }
 
 TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
@@ -131,7 +131,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   const bake_options o = capi::to_cpp(c, env, {l}, true, false);
   CHECK(o.width == 300);
   CHECK(o.height == 200);
-  CHECK(o.resolution == 32);
+  CHECK(o.sampler.resolution == 32);
   CHECK(o.bounces == 4);
   CHECK(o.indirect_only);
   CHECK(o.cache.error_threshold == 0.3f);
@@ -139,7 +139,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.dilation == 3);
   CHECK(!o.use_cache);
   CHECK(o.thread_count == 2);
-  CHECK(o.environment == env);
+  CHECK(o.sampler.raster.sky == env);
   REQUIRE(o.lights.size() == 1);
   CHECK(o.lights[0].position.z == 3.0f);
   CHECK(o.output_sh_l1);
@@ -147,7 +147,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.shadow_mask_lights[0] == 2);
   CHECK(o.shadow_mask_lights[1] == -1);
   CHECK(o.shadow_mask_lights[3] == 0);
-  CHECK(o.edge_coverage);
+  CHECK(o.sampler.raster.edge_coverage);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
@@ -221,7 +221,7 @@ TEST_CASE("C ABI options: cube-map irradiance options reach the C++ side, defaul
   const filter_options o = capi::to_cpp(c, edge_fixup::none);
   CHECK(c.method == HEMILIGHT_IRRADIANCE_FILTER);
   CHECK(o.irradiance_input_size == d.irradiance_input_size);
-  CHECK(o.thread_count == d.thread_count);
+  CHECK(capi::cache_run_of(capi::default_cache_options()).thread_count == cache_run{}.thread_count);
   c.input_size = 48;
   c.thread_count = 3;
   const filter_options m = capi::to_cpp(c, edge_fixup::warp);

@@ -255,7 +255,7 @@ struct two_floors {
 TEST_CASE("Preview: every pixel shows lightmap x albedo exactly where the bake is uniform, across pages, or the sky", "[preview]") {
   const two_floors s;
   bake_options o;
-  o.resolution = 16;
+  o.sampler.resolution = 16;
   o.bounces = 2;
   o.thread_count = 2;
   const scene_bake_result r = bake_scene(s.in, o);

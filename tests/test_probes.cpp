@@ -151,7 +151,7 @@ TEST_CASE("probes: exact edge coverage removes the edge aliasing of an emitter's
     o.resolution = c.n;
     const glm::vec3 p(eye);
     const probe_result point = sample_probes(s, &p, 1, o);
-    o.edge_coverage = true;
+    o.raster.edge_coverage = true;
     const probe_result exact = sample_probes(s, &p, 1, o);
     double worst_point = 0.0, worst_exact = 0.0;
     for (std::size_t k = 0; k < 9; ++k) {

@@ -67,7 +67,6 @@
 #pragma once
 
 #include "hemilight/cache.hpp"
-#include "hemilight/cubemap.hpp"
 #include "hemilight/image_io.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
@@ -90,62 +89,49 @@ namespace hemilight {
 /// error(invalid_argument).
 inline constexpr int max_lightmap_size = 8192;
 
+/// Largest number of light bounces a bake takes (bake_options::bounces).
+inline constexpr int max_bounces = 64;
+
 /// Options of bake_lightmap.
 struct bake_options {
   int width = 256, height = 256;  ///< lightmap size in texels, each in [1, max_lightmap_size]
-  int resolution = 64;            ///< hemicube N (even, 2..4096)
-  /// Number of light bounces, >= 1: 1 = direct light only (emission and sky); each more bounce
-  /// is one more pass of the whole cache. At most 64.
+  /// How each hemicube is rendered and integrated: resolution N, raster (near plane, environment
+  /// sky `raster.sky`, exact edge coverage), integrate. The baker rolls hemicubes unless
+  /// sampler.roll is false.
+  sampler_options sampler;
+  /// The irradiance cache's settings (used when use_cache is on; always validated).
+  cache_options cache;
+  /// false: a hemicube at every sampled texel (no interpolation); the reference the cache's error
+  /// is measured against.
+  bool use_cache = true;
+  /// Light bounces, in [1, max_bounces]: 1 = direct light only (emission and sky); each more
+  /// bounce is one more pass of the whole cache.
   int bounces = 1;
   /// Store only the indirect part: E_bounces - E_1 (clamped at 0), for engines that add direct
   /// light at run time. Needs bounces >= 2 to be nonzero.
   bool indirect_only = false;
   /// Texels whose covered fraction is below this get no sample (they are filled by dilation).
-  /// Range [0, 1]; 0 samples every texel touched by a triangle.
+  /// In [0, 1]; 0 samples every texel touched by a triangle.
   float min_coverage = 0.01f;
-  /// Sample offset along the normal in texel world sizes (see the top of this header), >= 0.
+  /// Sample offset along the normal in texel world sizes (the top of this header), finite, >= 0.
   float offset_texels = 0.05f;
   /// Rings of dilation around every chart, >= 0; -1 fills every empty texel of the lightmap.
   int dilation = 16;
-  /// Cache settings (error_threshold, radii, weights, ...). Its thread_count and progress are
-  /// ignored: the fields below are used instead.
-  cache_options cache;
-  /// false: a hemicube at every sampled texel (no interpolation); the reference the cache's
-  /// error is measured against. (cache.fill_invalid is ignored: the baker fills invalid texels
-  /// by dilation.)
-  bool use_cache = true;
-  int thread_count = 0;  ///< 0 = all cores
-  /// Output the L1 SH lightmaps (bake_result::sh_l1): world-space coefficients of the incoming
-  /// radiance. Costs 3 multiply-adds per hemicube texel in the last pass (and the first with
-  /// indirect_only): a few percent of the bake; off by default.
+  /// Output the L1 SH lightmaps (bake_result::sh_l1). Cost: a few percent of the bake.
   bool output_sh_l1 = false;
-  /// Output the Half-Life 2 basis lightmaps (bake_result::hl2), in each texel's lightmap tangent
-  /// frame, from the interpolated HL2 cone series (top of this header). Costs 21 multiply-adds per
-  /// hemicube texel in the directional passes, 96 bytes per record, and once per process a weight
-  /// table (~0.25 s at N = 64); off by default.
+  /// Output the Half-Life 2 basis lightmaps (bake_result::hl2). Cost: 21 multiply-adds per
+  /// hemicube texel in the directional passes, 96 bytes per record, a table per resolution.
   bool output_hl2 = false;
-  /// Optional environment sky: hemicube texels that hit nothing see this cube map's radiance along
-  /// their world direction (raster_options::sky; seamless bilinear, directions = the scene's world
-  /// axes, OpenGL face table) instead of scene_desc::sky_radiance. Build it with
-  /// cubemap::from_image (which checks every value). null: the constant sky.
-  std::shared_ptr<const cubemap> environment;
-  bool edge_coverage = false;  ///< hemicubes with exact edge coverage (raster_options::edge_coverage; docs/raster.md)
-  /// Analytic lights (lights.hpp): direct light at every sample, added to every pass (step 3b at
-  /// the top of this header). Checked as validate_lights does ("bake_lightmap: lights[2].radius
-  /// = -1 is negative"). Cost: per sample and light one shadow ray (hard) or 12 (soft), 264 in a
-  /// penumbra (direct_options). Empty: no lights.
+  /// Analytic lights (lights.hpp): direct light at every sample, added to every pass; checked as
+  /// validate_lights does. Cost per sample and light: one shadow ray (hard) to 264 (penumbra).
   std::vector<light> lights;
-  /// Shadow rays of the lights: sample counts and ray offset (lights.hpp). Checked as
-  /// validate_direct_options does.
-  direct_options direct;
-  /// Shadow mask (bake_result::shadow_mask): channel c holds, per texel, the visibility in [0, 1]
-  /// of light shadow_mask_lights[c] (an index into lights), the mask that engines with real-time
-  /// direct light multiply it by; -1 leaves the channel 0. All -1 (the default): no mask. An
-  /// index past the lights is an error.
+  direct_options direct;  ///< the lights' shadow rays, checked as validate_direct_options does
+  /// Shadow mask (bake_result::shadow_mask): channel c holds the visibility of light
+  /// shadow_mask_lights[c] (an index into lights), -1 leaves it 0. All -1: no mask.
   std::array<int, 4> shadow_mask_lights{{-1, -1, -1, -1}};
-  /// Called from the calling thread with the fraction of the whole bake done, in [0, 1] and never
-  /// decreasing; return
-  /// false to cancel (error(status::cancelled) is thrown, nothing is returned). May be empty.
+  int thread_count = 0;  ///< >= 0; 0 = all cores. Results do not depend on it.
+  /// Called from the calling thread with the fraction of the bake done, in [0, 1], never
+  /// decreasing; return false to cancel (error(status::cancelled), nothing returned). May be empty.
   std::function<bool(float fraction)> progress;
 };
 
@@ -366,30 +352,6 @@ std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings);
 void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding = 2);
 
 // ---- directional lightmaps ------------------------------------------------------------------
-
-/// The Half-Life 2 basis in a tangent frame (t, b, n): local coordinates of its three unit
-/// vectors, the same as integrate.hpp's irradiance_sample::hl2: (-1/sqrt6, 1/sqrt2, 1/sqrt3),
-/// (-1/sqrt6, -1/sqrt2, 1/sqrt3), (sqrt(2/3), 0, 1/sqrt3). They are mutually orthogonal and each
-/// is 54.7 degrees from n.
-inline constexpr float hl2_basis[3][3] = {
-    {-0.408248290f, 0.707106781f, 0.577350269f},
-    {-0.408248290f, -0.707106781f, 0.577350269f},
-    {0.816496581f, 0.0f, 0.577350269f},
-};
-
-/// Irradiance of a plane of unit normal d from L1 SH coefficients of incoming radiance
-/// (integrate.hpp's order and normalisation, world space): the clamped-cosine convolution of the
-/// L1 radiance, (sqrt(pi)/2) c_00 + sqrt(pi/3) (c_11 d.x + c_1-1 d.y + c_10 d.z), per channel,
-/// clamped at 0. Exact for radiance fields in SH bands 0 and 1 and for a uniform sky over any
-/// hemisphere; otherwise the band-2 part of the true irradiance is missing. Cost: O(1).
-glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept;
-
-/// The three Half-Life 2 values of a texel from L1 SH alone: sh_l1_irradiance along the world
-/// directions of hl2_basis in frame f (f.t, f.b, f.n unit and orthogonal; left-handed frames are
-/// fine: the basis follows the frame). For engines that keep only the SH maps. L1 loses the
-/// band >= 2 part of the clamped cosine: 13% RMS for a small overhead lamp, 25% for a grazing side
-/// light (docs/bake.md); the baker's own HL2 maps use the cone series instead. Cost: O(1).
-std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, const frame& f) noexcept;
 
 /// The lightmap tangent frame of a triangle (positions p, lightmap UVs uv) at a point of unit
 /// shading normal n: t = dP/du projected onto the tangent plane and normalised (Gram-Schmidt);

@@ -1,49 +1,22 @@
 // hemilight/cache.hpp — irradiance caching: render hemicubes at few of the points where
-// irradiance is needed, interpolate the rest with gradients.
+// irradiance is needed, interpolate the rest with gradients (Ward 1988, Ward & Heckbert 1992).
 //
-// Records (Ward 1988, Ward & Heckbert 1992): position x_i, normal n_i, irradiance E_i, gradients
-// g_r,i and g_t,i (convention of integrate.hpp), validity radius R_i. Interpolation at (x, n):
+// Records: position x_i, normal n_i, irradiance E_i, gradients g_r,i and g_t,i (integrate.hpp's
+// convention), validity radius R_i (the split-sphere distance, clamped and limited: docs/cache.md).
+// Interpolation at (x, n), over the records with w_i > 1/a that x is not behind:
 //
 //     E(x, n) = sum_i w_i (E_i + (n_i x n) . g_r,i + (x - x_i) . g_t,i) / sum_i w_i,  clamped >= 0
 //
-// (with second_order, each record's prediction also has 1/2 (x - x_i)^T H_i (x - x_i), H_i fitted
-// after placement from the gradients of the records around it: fit_record_hessians)
+// with Ward's w_i = 1 / (|x - x_i| / R_i + sqrt(1 - n . n_i)) (cache_weight lists the others) and,
+// with second_order, + 1/2 (x - x_i)^T H_i (x - x_i) in each record's prediction.
 //
-// over the records with w_i > 1/a (Ward: w_i = 1 / (|x - x_i| / R_i + sqrt(1 - n . n_i))) that pass
-// the "behind" test (a record is skipped when x lies behind it: (x - x_i) . (n_i + n) / 2 < -eps).
-// With cache_weight::ward_continuous each such record is weighted w_i - 1/a instead, which falls
-// to 0 at the edge of its reach (the coverage tests still use w_i).
-//
-// Radii: R_i = the hemicube's harmonic mean distance (split sphere), clamped to [min_radius,
-// max_radius] and limited by (each a switch of cache_options): the translation gradient,
-// R_i <= E_i / |g_t,i| (on luminance); neighbour clamping R_i <= R_j + |x_i - x_j|; and
-// shrinking of neighbours whose gradients disagree (each predicts the other's irradiance worse
-// than a allows), so that a record is placed between them.
-//
-// Placement is deterministic: the same input gives bitwise the same output for any thread count.
-// It runs in rounds. Each round finds the points no record covers, picks among them, in a fixed
-// pseudo-random order, seeds at least `spacing` apart (spacing halves every round, from
-// a x max_radius down to a x min_radius), renders the seeds' hemicubes in parallel, and appends
-// the new records in seed order. While the spacing s is coarse only a uniform sample of the
-// points, about 9 per s x s of surface (the first ones in that order), are candidates; the others
-// are tested when a finer spacing makes them candidates (at the finest spacing every point is).
-// At the finest spacing neighbour clamping does not shrink older records (it limits the new
-// ones, by each other and by the older ones); a disagreement shrinks both. Interpolation sums the
-// covering records in record order, as interpolate_records does. A point counts as covered when a record's weight passes 1/a
-// and (refine_disagreement) the covering records' predictions agree within a, and
-// (second_opinion) a point covered by one record only is not extrapolated far from it, nor
-// (sole_record_reach) from the rim of its reach, and (nearby_opinion) records near such a point
-// that do not cover it agree with that record there. Samples that see more than
-// invalid_backface_fraction back faces (the point is inside geometry) never become records; the
-// points within 0.9 x such a sample's min distance on the visible side of its tangent plane and
-// with a similar normal are presumed inside too, unless a valid record covers them (then they get
-// their own hemicube, as do points covered by a record that saw back faces: a contact). Points
-// inside are filled at the end from records on their side of the surface (fill_invalid).
-// docs/cache.md, "Points inside geometry, and contacts".
+// Placement runs in rounds of halving seed spacing, in a fixed pseudo-random order: the same input
+// gives bitwise the same output for any thread count. Points whose own hemicube sees back faces
+// (inside geometry) are reported invalid and filled from records on their side of the surface.
+// The rules and their measured effect: docs/cache.md.
 #pragma once
 
-#include "hemilight/integrate.hpp"
-#include "hemilight/raster.hpp"
+#include "hemilight/sampler.hpp"
 
 #include <array>
 #include <cstdint>
@@ -51,41 +24,6 @@
 #include <vector>
 
 namespace hemilight {
-
-/// Order of the azimuthal Fourier series of hl2_cone.
-inline constexpr int hl2_cone_order = 3;
-/// Number of its coefficients: a_0, then a_m, b_m for m = 1..hl2_cone_order.
-inline constexpr int hl2_cone_terms = 2 * hl2_cone_order + 1;
-
-/// The irradiance through every direction on the cone of Half-Life 2 basis vectors at a point:
-/// b(phi) = n / sqrt3 + sqrt(2/3) (cos phi r + sin phi (n x r)), 54.74 degrees from the normal n,
-/// phi the azimuth from the unit tangent `reference` r towards n x r. As a Fourier series
-///     E(b(phi)) ~= a_0 + sum_{m=1..3} (a_m cos(m phi) + b_m sin(m phi)),   per channel,
-/// coefficients = {a_0, a_1, b_1, a_2, b_2, a_3, b_3}. The three HL2 values of any tangent frame
-/// are this function at three azimuths 120 degrees apart (hl2_from_cone), so a cone describes the
-/// HL2 lighting of every frame about n. Exact (to quadrature) while the incoming radiance only comes
-/// from within 35.26 degrees of n (then E(b(phi)) is a first-order series); otherwise the
-/// harmonics above 3 of the clamped cosine are cut (docs/bake.md measures it).
-struct hl2_cone {
-  glm::vec3 reference{1.0f, 0.0f, 0.0f};  ///< unit tangent (world space) at phi = 0
-  std::array<glm::vec3, hl2_cone_terms> coefficients{};  ///< [term][channel], see above
-};
-
-/// The same cone with its azimuth measured from `reference` (a unit tangent of `normal`, the cone's
-/// normal) instead: phi' = phi - delta with delta the azimuth of `reference` in the cone's frame;
-/// exact rotation of the series. When `reference` is not in the cone's tangent plane it is projected
-/// onto it (used when records of neighbouring normals are averaged). Cost: one atan2 and 3 sincos.
-hl2_cone rotate_hl2_cone(const hl2_cone& cone, const glm::vec3& normal, const glm::vec3& reference) noexcept;
-
-/// E(b(phi)) of the series at azimuth phi (radians, from cone.reference towards n x reference),
-/// per channel, not clamped. Cost: O(hl2_cone_order).
-glm::vec3 evaluate_hl2_cone(const hl2_cone& cone, float phi) noexcept;
-
-/// The three HL2 values (integrate.hpp's basis, hl2_basis of bake.hpp) of the tangent frame f
-/// (f.n = the cone's normal; f may be left-handed, the basis follows it) from a cone, clamped at 0:
-/// the series at phi_t + s (120, -120, 0) degrees, phi_t = azimuth of f.t, s = +1 for right-handed
-/// frames and -1 for left-handed ones. Cost: 3 evaluations.
-std::array<glm::vec3, 3> hl2_from_cone(const hl2_cone& cone, const frame& f) noexcept;
 
 /// One cache record (all vectors world space).
 struct cache_record {
@@ -132,90 +70,69 @@ enum class cache_weight {
 /// the spacings a R underflow), so a hemicube per point is the right tool.
 inline constexpr float min_error_threshold = 0.001f;
 
-/// Options of the irradiance cache. Lengths are in scene units.
+/// Expert settings of the cache's placement: each default is the measured best (docs/cache.md,
+/// "Placement", measures each one against its cost). Change them to study the cache, not to tune
+/// a bake.
+struct cache_expert_options {
+  bool limit_radius_by_gradient = true;    ///< R_i <= E_i / |g_t,i| (on luminance)
+  bool limit_radius_by_neighbours = true;  ///< R_i <= R_j + |x_i - x_j|
+  bool shrink_disagreeing_records = true;  ///< shrink neighbours whose predictions of each other miss by more than a
+  /// A point stays uncovered while its covering records' first-order predictions span more than
+  /// a x max(E, 5% of the mean record E): records gather along shadow edges, down to min_radius.
+  bool refine_where_records_disagree = true;
+  /// A point covered by one record only (not its own point) stays uncovered while that record's
+  /// first-order term there exceeds lone_record_change_limit x a x max(E_i, 5% of the mean record
+  /// E). Dimensionless, finite, >= 0; 0 = off.
+  float lone_record_change_limit = 0.25f;
+  /// ... or while a record within lone_record_neighbour_reach x a x min_radius of it that does not
+  /// cover it (similar normal, not behind) predicts a luminance differing by more than a. In
+  /// [0, 16]; 0 = off.
+  float lone_record_neighbour_reach = 2.0f;
+  /// ... and counts as covered only where that record's Ward weight >= 1 / (lone_record_reach x a)
+  /// (ignored with the Tabellion-Lamorlette weight). In (0, 1]; 1 = off.
+  float lone_record_reach = 0.99f;
+};
+
+/// Options of the irradiance cache (what it computes; how one call runs is cache_run). Lengths
+/// are in scene units.
 struct cache_options {
-  /// Ward's a: larger means fewer records and more error. Radiance's defaults are 0.1 (rtrace),
-  /// 0.2 (rpict), 0.3 (rvu). Range [min_error_threshold = 0.001, 1].
+  /// Ward's a: larger means fewer records and more error. In [min_error_threshold, 1].
   float error_threshold = 0.2f;
-  /// Smallest and largest radius. 0 = automatic: min_radius = (median spacing of the points) / a,
-  /// so that a record covers at least its neighbouring points; max_radius = 0.2 x the diagonal of
-  /// the points' bounding box (as Radiance's 0.2 S). After automatic values are derived,
-  /// max_radius is raised to min_radius if smaller.
+  /// Smallest and largest radius, finite, >= 0, min <= max when both are given. 0 = automatic:
+  /// min_radius = (median spacing of the points) / a, max_radius = 0.2 x the diagonal of the
+  /// points' bounding box (raised to min_radius if smaller).
   float min_radius = 0.0f, max_radius = 0.0f;
-  bool use_gradients = true;               ///< interpolate with g_r and g_t
-  bool gradient_radius_limit = true;       ///< R_i <= E_i / |g_t,i|
-  bool neighbour_clamp = true;             ///< R_i <= R_j + |x_i - x_j|
-  bool shrink_disagreeing = true;          ///< shrink records whose gradients disagree
-  /// A point also counts as uncovered while the records covering it disagree: their first-order
-  /// predictions at the point span more than a x max(E, 5% of the mean record E) in luminance.
-  /// This places records along shadow edges and other discontinuities the split-sphere radius
-  /// cannot see, down to min_radius.
-  bool refine_disagreement = true;
-  /// Second opinion for points covered by a single record (other than the record's own point):
-  /// such a point counts as uncovered while that record's first-order term there,
-  /// |lum(E_i + (n_i x n).g_r,i + (x - x_i).g_t,i) - lum(E_i)|, exceeds
-  /// second_opinion x a x max(lum(E_i), 5% of the mean record E). No other record can disagree
-  /// with such an extrapolation, and a large first-order term is where it fails: a hard shadow
-  /// edge between two rows of points, E falling to 0 at an emitter's plane (a second derivative
-  /// the gradient cannot see). Mostly hits records at min_radius, which cover their grid
-  /// neighbours at exactly the threshold weight. Dimensionless, >= 0; 0 = off. Default 0.25
-  /// (docs/cache.md: its error against the share of points given a hemicube).
-  float second_opinion = 0.25f;
-  /// Opinion of nearby records for points covered by a single record (other than its own point):
-  /// such a point counts as uncovered while some record within nearby_opinion x a x min_radius of
-  /// it (a x min_radius: the finest seed spacing, about one point spacing) that does not cover it,
-  /// with a similar normal (n . n_j > 0.9) and not behind, predicts there (E_j plus its gradient
-  /// terms, clamped at 0) a luminance that differs from the covering record's prediction by more
-  /// than a x max(that prediction, 5% of the mean record E). The covering record's gradient cannot
-  /// see a hard shadow edge crossed between two rows of points (a floor point in a block's umbra
-  /// covered by a lit record one row away); a record on the other side of the edge can.
-  /// Dimensionless, in [0, 16]; 0 = off. Default 2 (records one or two rows of points away).
-  float nearby_opinion = 2.0f;
-  /// A point covered by a single record (other than its own point) counts as covered only inside
-  /// this fraction of that record's reach: Ward weight >= 1 / (sole_record_reach x a) (ignored with
-  /// the Tabellion-Lamorlette weight). At the automatic min_radius = spacing / a the grid neighbours
-  /// of a record at min_radius lie exactly on its reach (weight 1/a), where float rounding decided
-  /// whether that one record alone, with no second opinion, extrapolated to them. Points covered
-  /// by two or more records are unaffected. Dimensionless, in (0, 1]; 1 = off. Default 0.99.
-  float sole_record_reach = 0.99f;
+  bool use_gradients = true;  ///< interpolate with g_r and g_t
   cache_weight weight = cache_weight::ward;
-  /// Second-order interpolation (needs use_gradients): after placement, each record gets a Hessian
-  /// of E over its tangent plane fitted from its neighbours (fit_record_hessians), and the
-  /// interpolation adds 1/2 (x - x_i)^T H_i (x - x_i) to each record's first-order prediction.
-  /// Placement and statistics are unchanged (the same records); only the final values differ.
-  /// First-order predictions all miss a curved E the same way (below it where E is convex), so
-  /// averaging them does not cancel that error. The term is clamped to +-a E_i per channel.
-  /// docs/cache.md gives its measured effect on the error. Off when use_gradients is off.
-  /// Cost: O(records x neighbours) once after placement (a few microseconds per record), and 3
-  /// quadratic forms per covering record and point.
+  /// Second-order interpolation (needs use_gradients): each record gets a Hessian fitted from its
+  /// neighbours (fit_record_hessians), clamped to +-a E_i per channel. Placement is unchanged.
+  /// Cost: O(records x neighbours) once, 3 quadratic forms per covering record and point.
   bool second_order = true;
-  float invalid_backface_fraction = 0.1f;  ///< samples seeing more back faces than this are invalid
-  /// Give the points that are not interpolated (inside geometry: cache_result::valid = 0) the
-  /// relaxed-weight average of the nearest records on their side of the surface. Off: they are
-  /// left at 0, for callers that fill them in their own terms (the baker dilates valid texels of
-  /// the same chart into them).
-  bool fill_invalid = true;
-  /// Optional, one entry per point (count entries; not owned, read during the call): nonzero marks
-  /// a point known to be inside geometry, for instance one that an earlier cache_irradiance over
-  /// the same points and scene reported invalid (cache_result::valid = 0: whether a point is
-  /// inside depends on the geometry only, not on the light). Such a point gets no hemicube and no
-  /// coverage test; it is reported invalid and, with fill_invalid, filled like the others. The
-  /// baker passes each bounce pass the points the earlier passes found inside. nullptr = none.
-  const std::uint8_t* known_inside = nullptr;
-  /// Directional records: each record keeps its sample's world-space L1 SH (irradiance_sample::
-  /// sh_l1; the sampler must compute it: make_hemicube_sampler with sh_l1 or
-  /// integrate.directional) and its HL2 cone (cache_sample::cone, hemicube_sampler_options::hl2_cone;
-  /// interpolated into cache_result::cone),
-  /// and cache_result::sh_l1 gets, per point, the plain weighted average of the covering records'
-  /// coefficients with the same weights as E (no gradients: SH coefficients are not extrapolated,
-  /// and not rotated towards the point's normal). Off: records carry zeros and the interpolation
-  /// costs nothing extra.
-  bool directional = false;
-  int thread_count = 0;                    ///< 0 = all cores
-  /// Called from the calling thread between rounds and during rendering with the fraction of
-  /// points covered so far, in [0, 1]; return false to cancel (error(status::cancelled) is thrown
-  /// and nothing is written). May be empty.
+  /// Samples seeing more than this projected-solid-angle fraction of back faces are inside
+  /// geometry: never records, and the points near them on their side are presumed inside too.
+  /// In [0, 1].
+  float invalid_backface_fraction = 0.1f;
+  cache_expert_options expert;  ///< placement rules (the defaults are the measured best)
+};
+
+/// How one call of cache_irradiance runs: threads, progress, what it computes beyond irradiance
+/// and which points it may skip. What a pipeline around the cache decides per call (bake_lightmap
+/// sets it from its own options).
+struct cache_run {
+  int thread_count = 0;  ///< >= 0; 0 = all cores. Results do not depend on it.
+  /// Called from the calling thread with the fraction of points covered so far, in [0, 1]; return
+  /// false to cancel (error(status::cancelled), nothing written). May be empty.
   std::function<bool(float fraction)> progress;
+  /// Records keep their sample's world-space L1 SH and HL2 cone (the sampler must compute them:
+  /// sampler_pass), and cache_result::sh_l1 and ::cone get their weighted averages.
+  bool directional = false;
+  /// Give the points not interpolated (inside geometry) the average of the nearest records on
+  /// their side of the surface; false leaves them at 0 for the caller to fill.
+  bool fill_invalid = true;
+  /// Optional, count entries (not owned, read during the call): nonzero marks a point known to be
+  /// inside geometry (e.g. invalid in an earlier call over the same points and scene): no
+  /// hemicube, reported invalid. nullptr = none.
+  const std::uint8_t* known_inside = nullptr;
 };
 
 /// What one placement round of cache_irradiance did (cache_stats::round_details).
@@ -264,53 +181,6 @@ struct cache_stats {
   }
 };
 
-/// Renders and integrates one hemicube at (position, unit normal). `worker` is in
-/// [0, thread count): use it to pick a per-thread rasterizer/integrator. Must be deterministic
-/// in its arguments (apart from worker) and thread-safe across different workers.
-/// What a sampler returns: integrate()'s sample plus, optionally, the irradiance on the HL2 cone
-/// (zero when not computed). Implicitly made from an irradiance_sample, so a sampler may return one.
-struct cache_sample : irradiance_sample {
-  hl2_cone cone;
-  cache_sample() = default;
-  cache_sample(const irradiance_sample& s) : irradiance_sample(s) {}  // NOLINT: implicit on purpose
-};
-using irradiance_sampler = std::function<cache_sample(int worker, const glm::vec3& position, const glm::vec3& normal)>;
-
-/// How make_hemicube_sampler renders and integrates.
-struct hemicube_sampler_options {
-  int resolution = 64;            ///< hemicube N (even, 2..4096)
-  raster_options raster;          ///< near plane etc.
-  integrate_options integrate;    ///< estimator etc. (the defaults are the cache's)
-  /// Turn each hemicube about its normal by an angle hashed from the position's bits:
-  /// deterministic, and it turns the texel grid's aliasing into fine noise instead of bands.
-  bool roll = true;
-  const radiance_texture* texture = nullptr;  ///< optional radiance texture (bounce passes); must outlive the sampler
-  /// Fill irradiance_sample::sh_l1 (world-space L1 SH, integrate.hpp) cheaply, without
-  /// integrate.directional: band 1 = Y1 Phi with the vector irradiance Phi = E n + g_r x n that
-  /// the rotation gradient already holds (g_r = n x Phi, integrate.hpp), band 0 = Y00 sum_i L_i
-  /// Omega_i over the buffer (exact texel solid angles, summed in double). The same values as the
-  /// integrator's directional SH to float rounding, for one extra pass of 3 multiply-adds per
-  /// texel instead of 15 double ones; irradiance_sample::hl2 stays zero. Needs
-  /// integrate.rotation_gradient (make_hemicube_sampler throws error(invalid_argument) otherwise).
-  bool sh_l1 = false;
-  /// Fill cache_sample::cone: the irradiance on the HL2 cone of directions as a Fourier series in
-  /// azimuth (hl2_cone), reference = the hemicube's (rolled) tangent. Per texel weights from the
-  /// closed-form Fourier series of the clamped cosine max(0, w . b(phi)), integrated over 8 x 8
-  /// sub-rectangles of each texel with exact solid angles, or exactly (the texel's vector solid
-  /// angle) where the whole texel is within 35.26 degrees of the normal. Cost: one table per
-  /// resolution (28 bytes per texel; built on first use and kept in the table cache, memory.hpp: ~0.1 s at N = 64) and
-  /// 21 multiply-adds per texel.
-  bool hl2_cone = false;
-};
-
-/// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker
-/// (`workers` of them: pass resolve_thread_count(options.thread_count) of the cache; each worker
-/// makes its context on its first call, so workers that never run cost nothing). Throws
-/// error(invalid_argument) for a null scene, an invalid resolution or invalid raster/integrate
-/// options, or sh_l1 without integrate.rotation_gradient. The sampler throws error(invalid_argument) for a worker index out of range.
-irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const hemicube_sampler_options& options,
-                                         int workers);
-
 /// What cache_irradiance returns.
 struct cache_result {
   std::vector<glm::vec3> irradiance;  ///< per point, RGB, >= 0
@@ -326,9 +196,9 @@ struct cache_result {
   cache_stats stats;
 };
 
-/// Checks the options as cache_irradiance does (the ranges listed there) and throws
-/// error(invalid_argument) naming the field, the message starting with `who` (e.g.
-/// "bake_lightmap: error_threshold is nan; ..."). Bakes call it whatever use_cache says. Cost: O(1).
+/// Checks every field against the range its comment states and throws error(invalid_argument)
+/// naming the field, the message starting with `who` ("bake_lightmap: cache: error_threshold is
+/// nan; ..."). Cost: O(1).
 void validate_cache_options(const cache_options& options, const std::string& who);
 
 /// Checks the points as cache_irradiance does and throws error(invalid_argument) for the first bad
@@ -343,16 +213,13 @@ void validate_cache_points(const glm::vec3* positions, const glm::vec3* normals,
 inline constexpr double max_point_extent = 1e18;
 
 /// Irradiance at `count` points (positions and unit normals, world space) through the cache.
-/// Throws error(invalid_argument) naming the first bad input: count == 0, NULL arrays, a NaN/Inf
-/// position, points spanning more than max_point_extent, a normal whose length is not 1 within
-/// 1e-3 (zero normals included), options out of
-/// range (error_threshold not in [0.001, 1], negative or NaN radii, min_radius > max_radius when both
-/// are given, second_opinion negative or not finite, nearby_opinion not in [0, 16],
-/// sole_record_reach not in (0, 1], invalid_backface_fraction not in [0, 1]); error(cancelled) if progress returned
-/// false. Exceptions thrown by the sampler propagate unchanged. Cost: one sampler call per
-/// record and invalid sample, plus O(count x log records) for coverage and interpolation.
+/// Throws error(invalid_argument) naming the first bad input: the points as validate_cache_points
+/// checks them, the options as validate_cache_options does, a negative run.thread_count;
+/// error(cancelled) when run.progress returns false. Exceptions thrown by the sampler propagate
+/// unchanged. Cost: one sampler call per record and invalid sample, plus O(count x log records)
+/// for coverage and interpolation.
 cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
-                              const irradiance_sampler& sampler, const cache_options& options);
+                              const irradiance_sampler& sampler, const cache_options& options, const cache_run& run = {});
 
 /// Interpolates the cache at one point from `records` (the formula at the top of this header),
 /// brute force over all records: for tests and tools. Returns the weight sum through
@@ -373,13 +240,13 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
 ///    (n_i x n_j).g_r,i + (x_j - x_i).g_t,i). The values are data the fit did not use: where the
 ///    gradients' differences are not a smooth quadratic (a shadow edge, a ceiling line), s goes
 ///    to 0 and the record stays first-order.
-/// Records with fewer than 2 neighbours get 0. Deterministic for any thread count
-/// (options.thread_count; 0 = all cores). Throws error(invalid_argument), naming the first bad
+/// Records with fewer than 2 neighbours get 0. Deterministic for any thread_count (>= 0; 0 = all
+/// cores). Throws error(invalid_argument), naming the first bad
 /// record, when error_threshold is not in [0.001, 1], a record's radius is negative or not finite, its
 /// position is not finite or its normal's length is not 1 within 1e-3; records are then unchanged.
 /// Irradiance and gradients are not checked: NaN in them gives that record a zero Hessian.
 /// Cost: O(records x neighbours).
-void fit_record_hessians(std::vector<cache_record>& records, const cache_options& options);
+void fit_record_hessians(std::vector<cache_record>& records, const cache_options& options, int thread_count = 0);
 
 /// Interpolates the records' L1 SH at one point with the weights of interpolate_records (plain
 /// weighted average, no gradients, not clamped); zero when no record covers the point. Brute

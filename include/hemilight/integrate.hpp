@@ -37,6 +37,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hemilight {
@@ -70,6 +71,10 @@ struct integrate_options {
   /// both give the same sums up to float rounding order.
   bool simd_kernels = true;
 };
+
+/// Throws error(invalid_argument) naming the field, the message starting with `who`, when
+/// min_wall_distance is negative or not finite. Cost: O(1).
+void validate_integrate_options(const integrate_options& options, const std::string& who);
 
 /// Everything integrate() computes from one hemicube. Vectors are world space.
 struct irradiance_sample {

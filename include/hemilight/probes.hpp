@@ -67,24 +67,18 @@ glm::vec3 sh9_irradiance(const sh9_rgb& coefficients, const glm::vec3& normal) n
 
 /// Options of sample_probes.
 struct probe_options {
-  int resolution = 64;                    ///< hemicube N (even, 2..4096) of each of the two hemicubes
-  int thread_count = 0;                   ///< 0 = all cores; results do not depend on it
-  std::shared_ptr<const cubemap> sky;     ///< environment sky (null: the scene's constant sky)
-  std::shared_ptr<const light_set> lights;///< lights (null: none)
+  int resolution = 64;  ///< hemicube N of each of the two hemicubes: even, in [hemicube_min_resolution, hemicube_max_resolution]
+  /// How the hemicubes are drawn: near plane, environment sky (`raster.sky`; null: the scene's
+  /// constant sky), exact edge coverage (removes the edge aliasing of emitters, docs/probes.md; the
+  /// covered share is measured in projected solid angle, not per basis function).
+  raster_options raster;
+  int thread_count = 0;                    ///< >= 0; 0 = all cores. Results do not depend on it.
+  std::shared_ptr<const light_set> lights; ///< lights (null: none)
   /// Radiance of the surfaces over the scene's lightmap UVs (null: the triangles' emission), e.g.
   /// bake_radiance_texture of a bake (bake.hpp): then the probes see the baked bounce light.
   /// Needs a scene with lightmap UVs; must outlive the call.
   const radiance_texture* texture = nullptr;
   direct_options direct;                  ///< the lights' shadow sampling
-  /// Exact edge coverage in both hemicubes (raster_options::edge_coverage; docs/raster.md, "Exact
-  /// edge coverage"): a texel an emitter's edge crosses gets the emitter's exact share of it
-  /// instead of what its centre sees, which removes the edge aliasing of point sampling (the
-  /// rectangle of docs/probes.md: worst coefficient off by 25.5% of c_0 at N = 16 and 2.6% at
-  /// N = 64 without it, 1.24% and 0.054% with it). The covered fraction is measured in projected
-  /// solid angle, the hemicube's weight, not in each basis function's: that residue is second
-  /// order in the texel size. Cost: several times the render time (docs/raster.md), so off by
-  /// default.
-  bool edge_coverage = false;
 };
 
 /// Probes at points.

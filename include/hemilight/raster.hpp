@@ -76,6 +76,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hemilight {
@@ -157,6 +158,10 @@ struct raster_options {
   /// Diagnostic switches (see diagnostic_switches): for comparisons only.
   diagnostic_switches diagnostics = {};
 };
+
+/// Throws error(invalid_argument) naming the field, the message starting with `who`: a negative
+/// or non-finite near_distance, an empty or inconsistent sky cube map. Cost: O(1).
+void validate_raster_options(const raster_options& options, const std::string& who);
 
 /// The near distance used when raster_options::near_distance is 0: 1e-4 times the scene's
 /// bounding-box diagonal, or 1e-4 if that is 0 (empty or single-point scene).

@@ -134,13 +134,13 @@ image pass_radiance_texture(const scene& sc, const sample_points& pts, const std
 }
 
 // One pass through the cache (bake_options::use_cache).
-pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, cache_options co, bool directional,
-                        const std::function<bool(float)>& progress, bake_stats& stats) {
+pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, const cache_options& co, cache_run run,
+                        bool directional, const std::function<bool(float)>& progress, bake_stats& stats) {
   const std::size_t count = pts.texel_of.size();
-  co.directional = directional;
-  co.fill_invalid = false;  // fill_invalid_samples dilates valid texels into them instead
-  if (progress) co.progress = progress;
-  cache_result cr = cache_irradiance(pts.positions.data(), pts.normals.data(), count, sampler, co);
+  run.directional = directional;
+  run.fill_invalid = false;  // fill_invalid_samples dilates valid texels into them instead
+  if (progress) run.progress = progress;
+  cache_result cr = cache_irradiance(pts.positions.data(), pts.normals.data(), count, sampler, co, run);
   pass_values v;
   v.e = std::move(cr.irradiance);
   v.invalid.resize(count);
@@ -177,7 +177,7 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
     const std::size_t end = std::min(count, b + block);
     parallel_for(end - b, o.thread_count, 16, [&](int worker, std::size_t lo, std::size_t hi) {
       for (std::size_t i = b + lo; i < b + hi; ++i) {
-        const cache_sample smp = sampler(worker, pts.positions[i], pts.normals[i]);
+        const sampler_result smp = sampler(worker, pts.positions[i], pts.normals[i]);
         v.e[i] = smp.irradiance;
         v.invalid[i] = smp.backface_fraction > o.cache.invalid_backface_fraction ? 1 : 0;
         if (directional) {
@@ -237,18 +237,15 @@ direct_values lights_at_samples(const sample_points& pts, const scene& sc, const
   return direct;
 }
 
-// How pass `pass`'s hemicubes are rendered and integrated (the radiance texture aside).
-// Directional integration only where its result is used: the last pass, and the first when the
-// indirect part is wanted (last minus first).
-hemicube_sampler_options pass_sampler_options(const bake_options& o, bool pass_directional) {
-  hemicube_sampler_options so;
-  so.resolution = o.resolution;
-  so.roll = true;
-  so.raster.sky = o.environment;
-  so.raster.edge_coverage = o.edge_coverage;
-  so.sh_l1 = pass_directional && o.output_sh_l1;  // the cheap SH (cache.hpp), not the integrator's directional pass
-  so.hl2_cone = pass_directional && o.output_hl2;
-  return so;
+// What pass `pass`'s hemicubes compute besides irradiance (the radiance texture aside):
+// directional projections only where their result is used: the last pass, and the first when the
+// indirect part is wanted (last minus first). The cheap SH of sampler.hpp, not the integrator's
+// directional pass.
+sampler_pass pass_outputs(const bake_options& o, bool pass_directional) {
+  sampler_pass pass;
+  pass.sh_l1 = pass_directional && o.output_sh_l1;
+  pass.hl2_cone = pass_directional && o.output_hl2;
+  return pass;
 }
 
 // What the bounce passes leave: the last pass's values, the first's (with indirect_only), and
@@ -266,9 +263,8 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   const std::size_t count = pts.texel_of.size();
   const int workers = resolve_thread_count(o.thread_count);
   const bool directional = o.output_sh_l1 || o.output_hl2;
-  cache_options co = o.cache;
-  co.thread_count = o.thread_count;
-  co.progress = nullptr;
+  cache_run run;
+  run.thread_count = o.thread_count;
   bounce_values out;
   out.valid.assign(count, 1);
   std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass
@@ -278,13 +274,13 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   for (int pass = 0; pass < o.bounces; ++pass) {
     report.check(float(pass) / float(o.bounces));
     const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
-    hemicube_sampler_options so = pass_sampler_options(o, pass_directional);
+    sampler_pass pass_request = pass_outputs(o, pass_directional);
     if (pass > 0 || layout.textured_first_pass) {
       texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
       texture_view = radiance_texture(texture);
-      so.texture = &texture_view;
+      pass_request.texture = &texture_view;
     }
-    const irradiance_sampler sampler = make_hemicube_sampler(sc, so, workers);
+    const irradiance_sampler sampler = make_hemicube_sampler(sc, o.sampler, workers, pass_request);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
     std::function<bool(float)> pass_progress;
     if (report) pass_progress = [&](float f) { return report(base + span * f); };
@@ -292,9 +288,9 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
     // the same): the cache renders no hemicube for them.
     if (pass > 0) {
       for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(out.valid[i] ? 0 : 1);
-      co.known_inside = inside.data();
+      run.known_inside = inside.data();
     }
-    current = o.use_cache ? cached_pass(pts, sampler, co, pass_directional, pass_progress, stats)
+    current = o.use_cache ? cached_pass(pts, sampler, o.cache, run, pass_directional, pass_progress, stats)
                           : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, stats);
     if (direct) add_direct(*direct, current);
     fill_invalid_samples(pts, current, layout);

@@ -1,6 +1,7 @@
 // The baker's checks (checks.hpp).
 #include "checks.hpp"
 
+#include "hemilight/cubemap.hpp"
 #include "hemilight/lights.hpp"
 
 #include <cmath>
@@ -55,9 +56,10 @@ void check_input(const char* who, const bake_input& in, bool uvs_in_unit_square)
 
 void check_options(const bake_options& o, const char* who, bool size) {
   if (size) check_size(who, o.width, o.height);
-  check_hemicube_resolution(o.resolution, who);
-  if (o.bounces < 1 || o.bounces > 64)
-    throw_invalid_argument(std::string(who) + ": bounces " + std::to_string(o.bounces) + " is not in [1, 64]");
+  validate_sampler_options(o.sampler, std::string(who) + ": sampler");
+  if (o.bounces < 1 || o.bounces > max_bounces)
+    throw_invalid_argument(std::string(who) + ": bounces " + std::to_string(o.bounces) + " is not in [1, " +
+                           std::to_string(max_bounces) + "]");
   if (!(o.min_coverage >= 0.0f && o.min_coverage <= 1.0f))
     throw_invalid_argument(std::string(who) + ": min_coverage " + num(o.min_coverage) + " is not in [0, 1]");
   if (!(o.offset_texels >= 0.0f) || !std::isfinite(o.offset_texels))
@@ -82,11 +84,11 @@ void check_options(const bake_options& o, const char* who, bool size) {
 }
 
 void check_environment(const char* who, const bake_options& o) {
-  if (!o.environment) return;
+  if (!o.sampler.raster.sky) return;
   try {
-    o.environment->validate();
+    o.sampler.raster.sky->validate();
   } catch (const error& e) {
-    throw_invalid_argument(std::string(who) + ": environment: " + e.what());
+    throw_invalid_argument(std::string(who) + ": sampler.raster.sky: " + e.what());
   }
 }
 

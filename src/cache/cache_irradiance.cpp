@@ -169,12 +169,12 @@ float median_spacing(const glm::vec3* p, std::size_t count, float diagonal, cons
 class placement {
  public:
   placement(const glm::vec3* positions, const glm::vec3* normals, std::size_t count, const irradiance_sampler& sampler,
-            const cache_options& options)
-      : p_(positions), n_(normals), count_(count), sampler_(sampler), o_(options) {}
+            const cache_options& options, const cache_run& run)
+      : p_(positions), n_(normals), count_(count), sampler_(sampler), o_(options), r_(run) {}
 
   cache_result run() {
     const auto start = std::chrono::steady_clock::now();
-    threads_ = resolve_thread_count(o_.thread_count);
+    threads_ = resolve_thread_count(r_.thread_count);
     grid_of_points_.build(p_, count_);
     derive_radii();
     set_up();
@@ -194,7 +194,7 @@ class placement {
       }
       std::vector<std::size_t> seeds;
       timed(round.seed_seconds, [&] { seeds = pick_seeds(); });
-      std::vector<cache_sample> samples;
+      std::vector<sampler_result> samples;
       timed(round.render_seconds, [&] { samples = render_seeds(seeds, open); });
       round.seeds = seeds.size();
       timed(round.update_seconds, [&] {
@@ -214,7 +214,7 @@ class placement {
     const auto t_final = std::chrono::steady_clock::now();
     interpolate_all(result);
     stats_.invalid_points = count_invalid(result);
-    if (o_.fill_invalid) fill_invalid(result);
+    if (r_.fill_invalid) fill_invalid(result);
     stats_.interpolation_seconds = seconds_since(t_final);
     for (const cache_round_stats& r : stats_.round_details) stats_.render_seconds += r.render_seconds;
     stats_.records = records_.size();
@@ -243,7 +243,7 @@ class placement {
   // maximum: progress never goes backwards.
   void report(float fraction) {
     reported_ = std::max(reported_, fraction);
-    if (o_.progress && !o_.progress(reported_)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
+    if (r_.progress && !r_.progress(reported_)) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
   }
 
   // Automatic radii from the points' extent and spacing (cache_options::min_radius, max_radius).
@@ -265,7 +265,7 @@ class placement {
     o_.max_radius = std::max(o_.max_radius, o_.min_radius);
     spacing_ = a * o_.max_radius;
     finest_ = a * o_.min_radius;
-    nearby_reach_ = o_.nearby_opinion * finest_;
+    nearby_reach_ = o_.expert.lone_record_neighbour_reach * finest_;
     contact_backface_ = 0.1f * o_.invalid_backface_fraction;
   }
 
@@ -280,8 +280,8 @@ class placement {
     for (auto* v : {&covered_, &own_invalid_, &presumed_}) v->assign(count_, 0);
     // Points the caller knows to be inside geometry (cache_options::known_inside) are invalid
     // from the start, as if their own sample had been: no hemicube, no coverage test.
-    if (o_.known_inside)
-      for (std::size_t i = 0; i < count_; ++i) own_invalid_[i] = o_.known_inside[i] ? 1 : 0;
+    if (r_.known_inside)
+      for (std::size_t i = 0; i < count_; ++i) own_invalid_[i] = r_.known_inside[i] ? 1 : 0;
     dirty_.assign(count_, 1);  // the first coverage pass tests every point
     dirty_list_.resize(count_);
     std::iota(dirty_list_.begin(), dirty_list_.end(), std::uint32_t(0));
@@ -294,7 +294,7 @@ class placement {
     // both place the same records (only the final interpolation differs; cache.hpp).
     coverage_options_ = o_;
     if (coverage_options_.weight == cache_weight::ward_continuous) coverage_options_.weight = cache_weight::ward;
-    coverage_options_.progress = nullptr;
+    
     coverage_options_.second_order = false;  // the Hessians are fitted after placement
   }
 
@@ -429,20 +429,20 @@ class placement {
     const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
-    if (ok && o_.refine_disagreement && !own) ok = spread <= a * std::max(luminance(value), floor_e_);
+    if (ok && o_.expert.refine_where_records_disagree && !own) ok = spread <= a * std::max(luminance(value), floor_e_);
     // Second opinion: a point that only one record covers is not covered while that record's
     // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
     // disagree with an extrapolation that may be wrong (an edge between two rows of points, a
     // second derivative the gradient does not see).
-    if (ok && o_.second_opinion > 0.0f && !own && detail.records == 1) ok = detail.first_order <= o_.second_opinion * a;
+    if (ok && o_.expert.lone_record_change_limit > 0.0f && !own && detail.records == 1) ok = detail.first_order <= o_.expert.lone_record_change_limit * a;
     // Sole record reach: a point that one record covers must lie inside sole_record_reach of
     // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
-    if (ok && o_.sole_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
-      ok = detail.max_weight >= 1.0f / (o_.sole_record_reach * a);
+    if (ok && o_.expert.lone_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
+      ok = detail.max_weight >= 1.0f / (o_.expert.lone_record_reach * a);
     // Nearby opinion: records near a point that one record covers, which do not cover it
     // themselves, must predict the same there within a (a hard shadow edge between two rows of
     // points is invisible to the covering record's gradient, not to a record beyond it).
-    if (ok && o_.nearby_opinion > 0.0f && !own && detail.records == 1) ok = nearby_records_agree(i, detail);
+    if (ok && o_.expert.lone_record_neighbour_reach > 0.0f && !own && detail.records == 1) ok = nearby_records_agree(i, detail);
     covered_[i] = ok ? 1 : 0;
   }
 
@@ -498,8 +498,8 @@ class placement {
   }
 
   // 3. The seeds' hemicubes in parallel; results land in per-seed slots (deterministic).
-  std::vector<cache_sample> render_seeds(const std::vector<std::size_t>& seeds, std::size_t open_points) {
-    std::vector<cache_sample> samples(seeds.size());
+  std::vector<sampler_result> render_seeds(const std::vector<std::size_t>& seeds, std::size_t open_points) {
+    std::vector<sampler_result> samples(seeds.size());
     std::atomic<bool> cancel{false};
     std::atomic<std::size_t> done{0};
     const float covered_fraction = 1.0f - float(open_points) / float(count_);
@@ -508,9 +508,9 @@ class placement {
         samples[k] = sampler_(worker, p_[seeds[k]], n_[seeds[k]]);
         const std::size_t finished = ++done;
         // Worker 0 is the calling thread: the only one that calls progress.
-        if (worker == 0 && o_.progress) {
+        if (worker == 0 && r_.progress) {
           reported_ = std::max(reported_, covered_fraction + (1.0f - covered_fraction) * float(finished) / float(seeds.size()) * 0.99f);
-          if (!o_.progress(reported_)) cancel = true;
+          if (!r_.progress(reported_)) cancel = true;
         }
       }
     });
@@ -523,7 +523,7 @@ class placement {
   // clamp to [min_radius, max_radius]); invalid samples mark their point and, within their
   // exclusion ball, the points on the same side of the same surface (presumed_by). Returns
   // the index of the first new record.
-  std::size_t append_records(const std::vector<std::size_t>& seeds, const std::vector<cache_sample>& samples,
+  std::size_t append_records(const std::vector<std::size_t>& seeds, const std::vector<sampler_result>& samples,
                              cache_round_stats& round) {
     const std::size_t first_new = records_.size();
     old_radius_.resize(first_new);
@@ -541,7 +541,7 @@ class placement {
     });
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
-      const cache_sample& s = samples[k];
+      const sampler_result& s = samples[k];
       if (s.backface_fraction > o_.invalid_backface_fraction) {
         ++stats_.invalid_samples;
         ++round.invalid_samples;
@@ -559,7 +559,7 @@ class placement {
     return first_new;
   }
 
-  cache_record make_record(std::size_t i, const cache_sample& s) const {
+  cache_record make_record(std::size_t i, const sampler_result& s) const {
     cache_record r;
     r.position = p_[i];
     r.normal = n_[i];
@@ -568,12 +568,12 @@ class placement {
     r.translation_gradient = s.translation_gradient;
     r.harmonic_distance = s.harmonic_mean_distance;
     r.backface_fraction = s.backface_fraction;
-    if (o_.directional) {
+    if (r_.directional) {
       r.sh_l1 = s.sh_l1;
       r.cone = s.cone;
     }
     float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o_.max_radius;
-    if (o_.gradient_radius_limit) {
+    if (o_.expert.limit_radius_by_gradient) {
       const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
                                    0.0722f * s.translation_gradient[2]);
       const float e = luminance(s.irradiance);
@@ -611,7 +611,7 @@ class placement {
   // over pairs (new record, neighbour) (deterministic); then the records and the lists' keys take
   // the new radii.
   void limit_radii(std::size_t first_new) {
-    if (!(records_.size() > first_new && (o_.neighbour_clamp || o_.shrink_disagreeing))) return;
+    if (!(records_.size() > first_new && (o_.expert.limit_radius_by_neighbours || o_.expert.shrink_disagreeing_records))) return;
     bvh_.build(records_, o_, threads_);
     const std::vector<std::vector<neighbour_pair>> pairs = neighbour_pairs(first_new);
     clamp_radii(first_new, pairs);
@@ -636,7 +636,7 @@ class placement {
   // parallel).
   std::vector<std::vector<neighbour_pair>> neighbour_pairs(std::size_t first_new) const {
     const float a = o_.error_threshold;
-    const bool shrink = o_.shrink_disagreeing;
+    const bool shrink = o_.expert.shrink_disagreeing_records;
     std::vector<std::vector<neighbour_pair>> candidates(records_.size() - first_new);
     parallel_for(candidates.size(), threads_, 64, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
@@ -653,7 +653,7 @@ class placement {
         bvh_.query(mi.position, [&](const record_bvh::key& key) {
           if (std::size_t(key.index) == i) return;
           const float d = glm::length(mi.position - key.position);
-          const bool moot = o_.neighbour_clamp && ri + d <= 0.99f * (0.4f * d / a);
+          const bool moot = o_.expert.limit_radius_by_neighbours && ri + d <= 0.99f * (0.4f * d / a);
           near.push_back({key.index, shrink && !moot && d > 0.0f && glm::dot(mi.normal, key.normal) > 0.9f, d});
         });
         std::sort(near.begin(), near.end(), [](const neighbour_pair& x, const neighbour_pair& y) { return x.j < y.j; });
@@ -687,7 +687,7 @@ class placement {
       for (const neighbour_pair& q : candidates[i - first_new]) {
         float& rj = radius_[q.j];
         const float d = q.d;
-        if (o_.neighbour_clamp) {
+        if (o_.expert.limit_radius_by_neighbours) {
           ri = std::max(o_.min_radius, std::min(ri, rj + d));
           if (clamp_older || q.j >= first_new) rj = std::max(o_.min_radius, std::min(rj, ri + d));
         }
@@ -736,7 +736,7 @@ class placement {
         const glm::vec3 x = lists_[j].position;
         const float reach = reach_of(j), reach2 = reach * reach;
         if (j >= first_new) {
-          const float marked = o_.nearby_opinion > 0.0f ? std::max(reach, nearby_reach_ * 1.0001f) : reach;
+          const float marked = o_.expert.lone_record_neighbour_reach > 0.0f ? std::max(reach, nearby_reach_ * 1.0001f) : reach;
           std::uint32_t points = 0;
           grid_of_points_.for_each_in_sphere(x, marked, [&](std::uint32_t i) {
             mark(i);
@@ -813,7 +813,7 @@ class placement {
   void interpolate_all(cache_result& result) const {
     result.irradiance.assign(count_, glm::vec3(0.0f));
     result.valid.assign(count_, 0);
-    if (o_.directional) {
+    if (r_.directional) {
       result.sh_l1.assign(count_, std::array<glm::vec3, 4>{});
       result.cone.assign(count_, hl2_cone{});
     }
@@ -822,11 +822,11 @@ class placement {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
-        if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, o_.directional ? &sh : nullptr,
-                                      o_.directional ? &cone : nullptr) > 0.0f) {
+        if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, r_.directional ? &sh : nullptr,
+                                      r_.directional ? &cone : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
-          if (o_.directional) {
+          if (r_.directional) {
             result.sh_l1[i] = sh;
             result.cone[i] = cone;
           }
@@ -895,7 +895,7 @@ class placement {
       if (bw.first > 0.0f) {
         const cache_record& rec = records_[bw.second];
         sum += bw.first * rec.irradiance;
-        if (o_.directional) {
+        if (r_.directional) {
           for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
           const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
           for (std::size_t c = 0; c < std::size_t(hl2_cone_terms); ++c) cone.coefficients[c] += bw.first * rc.coefficients[c];
@@ -903,7 +903,7 @@ class placement {
         wsum += bw.first;
       }
     result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
-    if (o_.directional && wsum > 0.0f) {
+    if (r_.directional && wsum > 0.0f) {
       for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
       for (glm::vec3& c : cone.coefficients) c /= wsum;
       result.cone[i] = cone;
@@ -915,6 +915,7 @@ class placement {
   std::size_t count_;
   const irradiance_sampler& sampler_;
   cache_options o_;
+  const cache_run& r_;
   cache_options coverage_options_;
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
@@ -955,10 +956,12 @@ class placement {
 }  // namespace
 
 cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* normals, std::size_t count,
-                              const irradiance_sampler& sampler, const cache_options& options) {
+                              const irradiance_sampler& sampler, const cache_options& options, const cache_run& run) {
   cache_detail::validate_cache_input(positions, normals, count, options);
+  if (run.thread_count < 0)
+    throw_invalid_argument("cache_irradiance: run.thread_count is " + std::to_string(run.thread_count) + "; it must be >= 0");
   if (!sampler) throw_invalid_argument("cache_irradiance: sampler is empty");
-  return placement(positions, normals, count, sampler, options).run();
+  return placement(positions, normals, count, sampler, options, run).run();
 }
 
 }  // namespace hemilight

@@ -147,10 +147,12 @@ void fit_hessians(std::vector<cache_record>& records, const cache_options& o, in
 
 }  // namespace cache_detail
 
-void fit_record_hessians(std::vector<cache_record>& records, const cache_options& o) {
+void fit_record_hessians(std::vector<cache_record>& records, const cache_options& o, int thread_count) {
   if (!(o.error_threshold >= min_error_threshold && o.error_threshold <= 1.0f))
     throw_invalid_argument("fit_record_hessians: options.error_threshold is " + std::to_string(o.error_threshold) +
                            "; it must be in [0.001, 1]");
+  if (thread_count < 0)
+    throw_invalid_argument("fit_record_hessians: thread_count is " + std::to_string(thread_count) + "; it must be >= 0");
   for (std::size_t i = 0; i < records.size(); ++i) {
     const cache_record& r = records[i];
     const std::string which = "fit_record_hessians: record " + std::to_string(i);
@@ -161,7 +163,7 @@ void fit_record_hessians(std::vector<cache_record>& records, const cache_options
     if (!(std::fabs(glm::length(r.normal) - 1.0f) <= 1e-3f))
       throw_invalid_argument(which + " has normal " + cache_detail::vec_str(r.normal) + "; it must have length 1 (within 1e-3)");
   }
-  cache_detail::fit_hessians(records, o, resolve_thread_count(o.thread_count));
+  cache_detail::fit_hessians(records, o, resolve_thread_count(thread_count));
 }
 
 }  // namespace hemilight

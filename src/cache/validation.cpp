@@ -21,12 +21,15 @@ void validate_cache_options(const cache_options& o, const std::string& who) {
   if (o.min_radius > 0.0f && o.max_radius > 0.0f && o.min_radius > o.max_radius)
     throw_invalid_argument(fn + "min_radius " + std::to_string(o.min_radius) + " is larger than max_radius " +
                            std::to_string(o.max_radius));
-  if (!(o.second_opinion >= 0.0f) || !std::isfinite(o.second_opinion))
-    throw_invalid_argument(fn + "second_opinion is " + std::to_string(o.second_opinion) + "; it must be finite and >= 0 (0 = off)");
-  if (!(o.sole_record_reach > 0.0f && o.sole_record_reach <= 1.0f))
-    throw_invalid_argument(fn + "sole_record_reach is " + std::to_string(o.sole_record_reach) + "; it must be in (0, 1] (1 = off)");
-  if (!(o.nearby_opinion >= 0.0f && o.nearby_opinion <= 16.0f))
-    throw_invalid_argument(fn + "nearby_opinion is " + std::to_string(o.nearby_opinion) + "; it must be in [0, 16] (0 = off)");
+  const cache_expert_options& x = o.expert;
+  if (!(x.lone_record_change_limit >= 0.0f) || !std::isfinite(x.lone_record_change_limit))
+    throw_invalid_argument(fn + "expert.lone_record_change_limit is " + std::to_string(x.lone_record_change_limit) +
+                           "; it must be finite and >= 0 (0 = off)");
+  if (!(x.lone_record_reach > 0.0f && x.lone_record_reach <= 1.0f))
+    throw_invalid_argument(fn + "expert.lone_record_reach is " + std::to_string(x.lone_record_reach) + "; it must be in (0, 1] (1 = off)");
+  if (!(x.lone_record_neighbour_reach >= 0.0f && x.lone_record_neighbour_reach <= 16.0f))
+    throw_invalid_argument(fn + "expert.lone_record_neighbour_reach is " + std::to_string(x.lone_record_neighbour_reach) +
+                           "; it must be in [0, 16] (0 = off)");
   if (!(o.invalid_backface_fraction >= 0.0f && o.invalid_backface_fraction <= 1.0f))
     throw_invalid_argument(fn + "invalid_backface_fraction is " + std::to_string(o.invalid_backface_fraction) +
                            "; it must be in [0, 1]");

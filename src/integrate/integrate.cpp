@@ -211,11 +211,15 @@ std::shared_ptr<const integration_table> integration_table::get(int n) {
       });
 }
 
+void validate_integrate_options(const integrate_options& options, const std::string& who) {
+  if (!(options.min_wall_distance >= 0.0f) || !std::isfinite(options.min_wall_distance))
+    throw_invalid_argument(who + ": min_wall_distance is " + std::to_string(options.min_wall_distance) +
+                           "; it must be finite and >= 0 (0 = automatic)");
+}
+
 hemicube_integrator::hemicube_integrator(int resolution, const integrate_options& options)
     : n_(resolution), options_(options) {
-  if (!(options.min_wall_distance >= 0.0f) || !std::isfinite(options.min_wall_distance))
-    throw_invalid_argument("hemicube_integrator: min_wall_distance is " + std::to_string(options.min_wall_distance) +
-                           "; it must be finite and >= 0 (0 = automatic)");
+  validate_integrate_options(options, "hemicube_integrator");
   table_ = integration_table::get(resolution);  // validates the resolution
   const std::size_t count = hemicube_texel_count(resolution);
   // Padded by zeros, a row before and a row and a group after: the extrapolating wall pass reads

@@ -167,6 +167,7 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   if (!s) throw_invalid_argument("sample_probes: scene is null");
   if (count > 0 && !positions) throw_invalid_argument("sample_probes: positions is null but count is " + std::to_string(count));
   check_hemicube_resolution(o.resolution, "sample_probes");
+  validate_raster_options(o.raster, "sample_probes: raster");
   if (o.thread_count < 0)
     throw_invalid_argument("sample_probes: thread_count is " + std::to_string(o.thread_count) + "; it must be >= 0 (0 = all cores)");
   if (o.lights) validate_direct_options(o.direct);
@@ -192,9 +193,7 @@ probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* posi
   constexpr std::size_t grain = 8;
   const int workers = static_cast<int>(
       std::min(static_cast<std::size_t>(resolve_thread_count(o.thread_count)), (count + grain - 1) / grain));
-  raster_options ro;
-  ro.sky = o.sky;
-  ro.edge_coverage = o.edge_coverage;
+  const raster_options& ro = o.raster;
   struct context {
     std::unique_ptr<hemicube_rasterizer> raster;
     hemicube_buffer buffer;

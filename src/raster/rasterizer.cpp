@@ -254,6 +254,19 @@ const std::shared_ptr<const scene>& hemicube_rasterizer::scene_ptr() const noexc
 // rasterizer_impl: set-up
 // ---------------------------------------------------------------------------------------------
 
+void validate_raster_options(const raster_options& options, const std::string& who) {
+  if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
+    throw_invalid_argument(who + ": near_distance is " + std::to_string(options.near_distance) +
+                           "; it must be finite and >= 0 (0 = default)");
+  if (options.sky) {
+    // A cheap structural check; the values were checked when the map was built (from_image).
+    const cubemap& m = *options.sky;
+    if (m.level_count() < 1 || m.levels[0].size < 1 || (m.channels() != 3 && m.channels() != 4) ||
+        m.levels[0].pixels.size() != 6u * std::size_t(m.size()) * std::size_t(m.size()) * std::size_t(m.channels()))
+      throw_invalid_argument(who + ": the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
+  }
+}
+
 void raster_detail::rasterizer_impl::unbind() noexcept {
   scene_.reset();
   sky_.reset();
@@ -262,16 +275,7 @@ void raster_detail::rasterizer_impl::unbind() noexcept {
 void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const raster_options& options) {
   // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
   if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
-  if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
-    throw_invalid_argument("hemicube_rasterizer: near_distance is " + std::to_string(options.near_distance) +
-                           "; it must be finite and >= 0 (0 = default)");
-  if (options.sky) {
-    // A cheap structural check; the values were checked when the map was built (from_image).
-    const cubemap& m = *options.sky;
-    if (m.level_count() < 1 || m.levels[0].size < 1 || (m.channels() != 3 && m.channels() != 4) ||
-        m.levels[0].pixels.size() != 6u * std::size_t(m.size()) * std::size_t(m.size()) * std::size_t(m.channels()))
-      throw_invalid_argument("hemicube_rasterizer: the sky cube map is empty or inconsistent (build it with cubemap::from_image)");
-  }
+  validate_raster_options(options, "hemicube_rasterizer");
   // Step 2: the scene, the options, and the shades (the direction tables and scratch stay).
   scene_ = std::move(s);
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);

@@ -1,12 +1,11 @@
-// The cache's sampler factory (cache.hpp, make_hemicube_sampler): a hemicube per call, rendered
-// and integrated with one context per worker, plus the optional directional projections
-// (src/directional/).
+// make_hemicube_sampler and validate_sampler_options (sampler.hpp): a hemicube per call, rendered
+// and integrated with one context per worker, plus the optional directional projections.
 #include "../core/hash.hpp"
 
 #include "hl2_cone.hpp"
 #include "sh_l1.hpp"
 
-#include "hemilight/cache.hpp"
+#include "hemilight/sampler.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -17,22 +16,13 @@ namespace hemilight {
 
 namespace {
 
-// The options make_hemicube_sampler checks up front (the contexts are made later, by each worker).
-void check_sampler_options(const std::shared_ptr<const scene>& s, const hemicube_sampler_options& o, int workers) {
+// The arguments make_hemicube_sampler checks up front (the contexts are made later, by each worker).
+void check_sampler_arguments(const std::shared_ptr<const scene>& s, const sampler_options& o, int workers, const sampler_pass& pass) {
   if (!s) throw_invalid_argument("make_hemicube_sampler: scene is null");
   if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
-  if (o.sh_l1 && !o.integrate.rotation_gradient)
+  if (pass.sh_l1 && !o.integrate.rotation_gradient)
     throw_invalid_argument("make_hemicube_sampler: sh_l1 needs integrate.rotation_gradient (band 1 comes from it)");
-}
-
-// The options of the rasterizer and the integrator, checked now, once (the contexts are made by
-// each worker on its first call).
-void check_context_options(const std::shared_ptr<const scene>& s, const hemicube_sampler_options& o) {
-  { hemicube_rasterizer check(s, o.raster); }
-  check_hemicube_resolution(o.resolution, "make_hemicube_sampler");
-  if (!(o.integrate.min_wall_distance >= 0.0f) || !std::isfinite(o.integrate.min_wall_distance))  // as hemicube_integrator
-    throw_invalid_argument("make_hemicube_sampler: integrate.min_wall_distance is " + std::to_string(o.integrate.min_wall_distance) +
-                           "; it must be finite and >= 0 (0 = automatic)");
+  validate_sampler_options(o, "make_hemicube_sampler");
 }
 
 // The hemicube's frame at (x, n): make_frame(n), with `roll` turned about n by an angle hashed
@@ -60,16 +50,22 @@ struct sampler_context {
 
 }  // namespace
 
-irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const hemicube_sampler_options& o, int workers) {
-  check_sampler_options(s, o, workers);
-  std::shared_ptr<const hemicube_table> table = o.sh_l1 ? hemicube_table::get(o.resolution) : nullptr;
-  std::shared_ptr<const directional_detail::cone_weights> cone_table =
-      o.hl2_cone ? directional_detail::make_cone_weights(o.resolution) : nullptr;
+void validate_sampler_options(const sampler_options& o, const std::string& who) {
+  check_hemicube_resolution(o.resolution, who.c_str());
+  validate_raster_options(o.raster, who + ": raster");
+  validate_integrate_options(o.integrate, who + ": integrate");
+}
+
+irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const sampler_options& o, int workers,
+                                         const sampler_pass& pass) {
+  check_sampler_arguments(s, o, workers, pass);
+  std::shared_ptr<const hemicube_table> table = pass.sh_l1 ? hemicube_table::get(o.resolution) : nullptr;
+  std::shared_ptr<const sampler_detail::cone_weights> cone_table =
+      pass.hl2_cone ? sampler_detail::make_cone_weights(o.resolution) : nullptr;
   // One context per worker, made by the worker on its first call: a worker that never runs (a
-  // cache of a few points on many threads) costs nothing. The options are checked now, once.
-  check_context_options(s, o);
+  // cache of a few points on many threads) costs nothing.
   auto contexts = std::make_shared<std::vector<std::unique_ptr<sampler_context>>>(static_cast<std::size_t>(workers));
-  return [contexts, s, o, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> cache_sample {
+  return [contexts, s, o, pass, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> sampler_result {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
     std::unique_ptr<sampler_context>& slot = (*contexts)[std::size_t(worker)];
@@ -78,10 +74,10 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const h
           sampler_context{hemicube_rasterizer(s, o.raster), hemicube_integrator(o.resolution, o.integrate), {}});
     sampler_context& c = *slot;
     const frame f = sample_frame(x, n, o.roll);
-    c.raster.render(x, f, o.resolution, c.buffer, o.texture);
-    cache_sample out = c.integrator.integrate(c.buffer);
-    if (cone_table) out.cone = directional_detail::project_hl2_cone(c.buffer, *cone_table, f.t);
-    if (o.sh_l1) out.sh_l1 = directional_detail::project_sh_l1(c.buffer, *table, out.irradiance, out.rotation_gradient, f.n);
+    c.raster.render(x, f, o.resolution, c.buffer, pass.texture);
+    sampler_result out = c.integrator.integrate(c.buffer);
+    if (cone_table) out.cone = sampler_detail::project_hl2_cone(c.buffer, *cone_table, f.t);
+    if (pass.sh_l1) out.sh_l1 = sampler_detail::project_sh_l1(c.buffer, *table, out.irradiance, out.rotation_gradient, f.n);
     return out;
   };
 }

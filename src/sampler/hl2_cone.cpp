@@ -1,5 +1,5 @@
 // The HL2 cone: its per-texel quadrature weights, the projection of a hemicube onto them
-// (hl2_cone.hpp), and the public rotate / evaluate / hl2_from_cone (cache.hpp).
+// (hl2_cone.hpp), and the public rotate / evaluate / hl2_from_cone (sampler.hpp).
 #include "hl2_cone.hpp"
 
 #include "weighted_sums.hpp"
@@ -14,7 +14,7 @@
 
 namespace hemilight {
 
-namespace directional_detail {
+namespace sampler_detail {
 
 namespace {
 
@@ -109,7 +109,7 @@ hl2_cone project_hl2_cone(const hemicube_buffer& buffer, const cone_weights& wei
   return out;
 }
 
-}  // namespace directional_detail
+}  // namespace sampler_detail
 
 hl2_cone rotate_hl2_cone(const hl2_cone& c, const glm::vec3& normal, const glm::vec3& reference) noexcept {
   const glm::vec3 r = reference - normal * glm::dot(normal, reference);

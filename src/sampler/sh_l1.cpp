@@ -1,13 +1,13 @@
-// L1 SH: the sampler's projection (sh_l1.hpp) and their evaluation (bake.hpp).
+// L1 SH: the sampler's projection (sh_l1.hpp) and their evaluation (sampler.hpp).
 #include "sh_l1.hpp"
 
 #include "weighted_sums.hpp"
 
-#include "hemilight/bake.hpp"
+#include "hemilight/sampler.hpp"
 
 namespace hemilight {
 
-namespace directional_detail {
+namespace sampler_detail {
 
 std::array<glm::vec3, 4> project_sh_l1(const hemicube_buffer& buffer, const hemicube_table& table, const glm::vec3& irradiance,
                                        const std::array<glm::vec3, 3>& rotation_gradient, const glm::vec3& n) {
@@ -27,7 +27,7 @@ std::array<glm::vec3, 4> project_sh_l1(const hemicube_buffer& buffer, const hemi
   return sh;
 }
 
-}  // namespace directional_detail
+}  // namespace sampler_detail
 
 glm::vec3 sh_l1_irradiance(const std::array<glm::vec3, 4>& sh, const glm::vec3& d) noexcept {
   // pi Y00 = sqrt(pi) / 2 and (2 pi / 3) Y1 = sqrt(pi / 3): the clamped-cosine kernel's band 0 and

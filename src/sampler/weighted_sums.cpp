@@ -7,7 +7,7 @@
 #include <emmintrin.h>
 #endif
 
-namespace hemilight::directional_detail {
+namespace hemilight::sampler_detail {
 
 void weighted_sums(const float* r, const float* g, const float* b, const float* w, std::size_t count, double (&out)[3]) {
   for (std::size_t b0 = 0; b0 < count; b0 += 1024) {
@@ -38,4 +38,4 @@ void weighted_sums(const float* r, const float* g, const float* b, const float* 
   }
 }
 
-}  // namespace hemilight::directional_detail
+}  // namespace hemilight::sampler_detail

@@ -4,7 +4,7 @@
 
 #include <cstddef>
 
-namespace hemilight::directional_detail {
+namespace hemilight::sampler_detail {
 
 // out[c] += sum_i plane_c[i] w[i] for the three planes r, g, b of `count` texels (a multiple of
 // 4): four lanes of float partial sums per block of 1024 texels, each block's lanes summed in a
@@ -13,4 +13,4 @@ namespace hemilight::directional_detail {
 // Cost: 3 multiply-adds per texel.
 void weighted_sums(const float* r, const float* g, const float* b, const float* w, std::size_t count, double (&out)[3]);
 
-}  // namespace hemilight::directional_detail
+}  // namespace hemilight::sampler_detail
