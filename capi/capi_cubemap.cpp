@@ -5,7 +5,6 @@
 
 #include "hemilight/cubemap.hpp"
 
-#include "../src/cubemap/cubemap_internal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -251,7 +250,7 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
       return invalid(fn, "sampling " + std::to_string(sampling_value) + " is unknown");
     if (apply_fixup != 0 && apply_fixup != 1)
       return invalid(fn, "apply_fixup is " + std::to_string(apply_fixup) + "; it must be 0 or 1");
-    hemilight::cubemap_detail::raw_cube levels[32];  // sampled in place: no copy of the chain
+    hemilight::cube_level_view levels[32];  // sampled in place: no copy of the chain
     const float* src = chain;
     for (int l = 0; l < level_count; ++l) {
       const int s = std::max(1, size >> l);
@@ -262,7 +261,7 @@ hemilight_status hemilight_cubemap_sample(const float* chain, int size, int leve
     if (apply_fixup) d = hemilight::fixup_lookup(d, size, lod);
     const auto mode = sampling_value == HEMILIGHT_CUBE_SAMPLING_SEAMLESS ? hemilight::cube_sampling::seamless
                                                                    : hemilight::cube_sampling::clamp_per_face;
-    const glm::vec4 v = hemilight::cubemap_detail::sample_lod_raw(levels, level_count, d, std::max(0.0f, lod), mode);
+    const glm::vec4 v = hemilight::sample_lod(levels, level_count, d, std::max(0.0f, lod), mode);
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
       return invalid(fn, "the sample is not finite: the chain holds NaN, Inf or values near the float limit");
     rgb[0] = v.x;

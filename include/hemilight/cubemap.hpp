@@ -153,6 +153,20 @@ glm::vec4 sample_bilinear(const cube_image& level, const glm::vec3& direction, c
 /// between floor(lod) and the next level. Precondition: map.level_count() >= 1.
 glm::vec4 sample_lod(const cubemap& map, const glm::vec3& direction, float lod, cube_sampling mode) noexcept;
 
+/// One cube-map level in memory the caller owns: six faces of size x size texels of `channels`
+/// (3 or 4) floats, laid out as cube_image::pixels.
+struct cube_level_view {
+  const float* pixels = nullptr;
+  int size = 0;
+  int channels = 3;
+};
+
+/// sample_lod over a mip chain of views (levels[l] of size max(1, levels[0].size >> l)), read in
+/// place: what an engine's mapped texture memory gives without a copy. Precondition:
+/// level_count >= 1 and every view consistent. Cost: at most two bilinear lookups.
+glm::vec4 sample_lod(const cube_level_view* levels, int level_count, const glm::vec3& direction, float lod,
+                     cube_sampling mode) noexcept;
+
 /// A procedural test environment (linear radiance, strictly positive): a sky brighter towards
 /// +y, a darker ground below the horizon, a few coloured bands across the sky and a sun of
 /// radiance ~200 and angular radius ~2.9 degrees with a smooth rim. Texel values are the

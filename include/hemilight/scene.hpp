@@ -30,7 +30,7 @@
 namespace hemilight {
 
 namespace detail {
-struct ray_accel;   // rays.hpp's Embree scene, built on the first ray query (src/rays_internal.hpp)
+struct lazy_slot;   // data derived from the scene on first use: rays.hpp's Embree scene (src/scene/scene_access.hpp)
 struct ray_access;
 struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene_internal.hpp)
 }  // namespace detail
@@ -189,7 +189,7 @@ class scene {
   std::vector<bvh_node> nodes_;
   // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
   friend struct detail::ray_access;
-  std::shared_ptr<detail::ray_accel> rays_;
+  std::shared_ptr<detail::lazy_slot> rays_;
 };
 
 }  // namespace hemilight

@@ -257,6 +257,10 @@ glm::vec4 sample_lod(const cubemap& map, const glm::vec3& d, float lod, cube_sam
   return sample_lod_raw(levels, count, d, lod, mode);
 }
 
+glm::vec4 sample_lod(const cube_level_view* levels, int level_count, const glm::vec3& d, float lod, cube_sampling mode) noexcept {
+  return cubemap_detail::sample_lod_raw(levels, level_count, d, lod, mode);
+}
+
 glm::vec4 cubemap::sample(const glm::vec3& direction) const noexcept {
   assert(!levels.empty());
   return sample_bilinear(levels[0], direction, cube_sampling::seamless);

@@ -37,11 +37,7 @@ struct face_table {
 };
 
 /// A cube-map level seen through a pointer (the C ABI samples the caller's memory in place).
-struct raw_cube {
-  const float* pixels = nullptr;
-  int size = 0;
-  int channels = 3;
-};
+using raw_cube = cube_level_view;
 
 /// sample_bilinear and sample_lod on raw levels (same behaviour and preconditions).
 glm::vec4 sample_bilinear_raw(const raw_cube& level, const glm::vec3& direction, cube_sampling mode) noexcept;

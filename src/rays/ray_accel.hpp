@@ -1,8 +1,8 @@
 // Internal to hemilight (not installed): the scene's ray acceleration structure behind rays.hpp.
 //
-// scene (scene.hpp) holds a std::shared_ptr<detail::ray_accel>, made by scene::create with
-// make_ray_accel() (a few dozen bytes: a once flag and null handles). rays.cpp builds the Embree
-// scene into it on the first ray query or prepare_rays() call; ray_access reads it.
+// scene (scene.hpp) holds a detail::lazy_slot (src/scene/scene_access.hpp), empty until rays.cpp
+// builds the Embree scene into it on the first ray query or prepare_rays() call; ray_access reads
+// it.
 // The tests (tests/test_rays.cpp) and bench_rays include this header for the hooks below.
 #pragma once
 
@@ -18,13 +18,11 @@ namespace hemilight {
 namespace detail {
 
 struct ray_accel;  // defined in rays.cpp
+struct lazy_slot;  // src/scene/scene_access.hpp
 
-/// A new, unbuilt ray_accel (scene::create calls it). Throws std::bad_alloc.
-std::shared_ptr<ray_accel> make_ray_accel();
-
-/// The private member of scene that holds its ray_accel (null only for a scene not made by create).
+/// The private member of scene whose slot holds its ray_accel (null only for a scene not made by create).
 struct ray_access {
-  static ray_accel* of(const scene& s) noexcept { return s.rays_.get(); }
+  static lazy_slot* of(const scene& s) noexcept { return s.rays_.get(); }
 };
 
 /// The fallback queries over the scene's own BVH (rays_bvh.cpp): rays.hpp's contract, without Embree.

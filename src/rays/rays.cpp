@@ -2,6 +2,8 @@
 // on its first query (std::call_once), the fallback traversal of rays_bvh.cpp when that build fails.
 #include "ray_accel.hpp"
 
+#include "../scene/scene_access.hpp"
+
 #include "hemilight/error.hpp"
 
 #include <embree3/rtcore.h>
@@ -148,8 +150,6 @@ void set_ray(RTCRay& r, const glm::vec3& o, const glm::vec3& d, float t_max) noe
 }  // namespace
 
 struct ray_accel {
-  std::once_flag once;
-  std::atomic<bool> done{false};  // the fast path: acquire load instead of call_once
   RTCScene rtc = nullptr;         // null for an empty scene or a failed build
   status failure = status::ok;
   std::string message;
@@ -161,8 +161,6 @@ struct ray_accel {
     if (rtc) rtcReleaseScene(rtc);
   }
 };
-
-std::shared_ptr<ray_accel> make_ray_accel() { return std::make_shared<ray_accel>(); }
 
 namespace {
 
@@ -232,15 +230,23 @@ void build(const scene& s, ray_accel& a) noexcept {
   }
 }
 
+// The scene's ray_accel, built into its lazy slot by the first caller (the others wait, then
+// take the fast path: an acquire load). Null only for a scene not made by scene::create or when
+// even the empty structure could not be allocated (the queries then use the fallback).
 ray_accel* built(const scene& s) noexcept {
-  ray_accel* a = ray_access::of(s);
-  if (!a) return nullptr;
-  if (!a->done.load(std::memory_order_acquire))
-    std::call_once(a->once, [&] {
-      build(s, *a);
-      a->done.store(true, std::memory_order_release);
+  lazy_slot* slot = ray_access::of(s);
+  if (!slot) return nullptr;
+  if (!slot->done.load(std::memory_order_acquire))
+    std::call_once(slot->once, [&] {
+      try {
+        auto a = std::make_shared<ray_accel>();
+        build(s, *a);
+        slot->value = std::move(a);
+      } catch (const std::bad_alloc&) {  // value stays null: the fallback serves the queries
+      }
+      slot->done.store(true, std::memory_order_release);
     });
-  return a;
+  return static_cast<ray_accel*>(slot->value.get());
 }
 
 }  // namespace

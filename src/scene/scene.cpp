@@ -1,5 +1,5 @@
 #include "hemilight/scene.hpp"
-#include "../rays/ray_accel.hpp"
+#include "scene_access.hpp"
 
 #include <algorithm>
 #include <array>
@@ -152,7 +152,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
   }
   s->build_bvh();
-  s->rays_ = detail::make_ray_accel();  // built on the first ray query (rays.cpp)
+  s->rays_ = std::make_shared<detail::lazy_slot>();  // filled by the first ray query (rays.hpp)
   return s;
 }
 

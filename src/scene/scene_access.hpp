@@ -1,14 +1,28 @@
 // Internal to hemilight (not installed): the scene's per-coordinate vertex arrays, which only the
-// SIMD paths read (the rasterizer's eight-lane set-up, the ray queries' fallback traversal). The
+// SIMD paths read (the rasterizer's eight-lane set-up, the ray queries' fallback traversal), and
+// the slot that the modules above the scene fill with what they derive from it on first use. The
 // tests include this header to check the arrays against scene::triangles().
 #pragma once
 
 #include "hemilight/scene.hpp"
 
+#include <atomic>
 #include <cstddef>
+#include <memory>
+#include <mutex>
 
 namespace hemilight {
 namespace detail {
+
+/// Data derived from an immutable scene on first use by a module above it (the ray queries' Embree
+/// scene): scene::create makes an empty slot, the module fills `value` once under `once` and
+/// publishes it with `done` (release), so later readers take the fast path (acquire). The scene
+/// knows nothing of what the slot holds.
+struct lazy_slot {
+  std::once_flag once;
+  std::atomic<bool> done{false};
+  std::shared_ptr<void> value;
+};
 
 struct scene_access {
   /// The vertex coordinates of s.triangles() again, one array per coordinate:
