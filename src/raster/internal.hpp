@@ -226,6 +226,31 @@ class alignas(64) rasterizer_impl {
   };
   std::vector<edge_group> edge_groups_;
 
+  // Occlusion culling (raster_options::diagnostics.occlusion_culling; occlusion.cpp): a node is
+  // skipped on a face when its nearest possible depth is behind the least depth of every 8 x 8
+  // tile its texels lie in (a conservative hierarchical depth, kept lazily per tile).
+  struct node_rects {
+    std::int32_t x0[5], x1[5], y0[5], y1[5];  // per face, the texels whose centres the node may cover
+  };
+  void occlusion_prepare();
+  unsigned occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis,
+                          node_rects& rects);
+  void occlusion_drawn(unsigned mask, const node_rects& rects);
+  void occlusion_freeze();
+  float tile_least_depth(int face, int tx, int ty);
+  template <mode M>
+  void traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull);
+  void redraw_prepare();
+  bool occlusion_ = true;
+  std::uint32_t ties_ = 0;                     // a fragment met an equal depth in this render
+  const float* occluders_ = nullptr;           // the depths the tiles are read from (depth_, or a frozen copy)
+  std::vector<float> frozen_depth_;            // occlusion_freeze's copy
+  std::vector<float> tile_depth_;              // per tile: least 1/w of its texels (0: one is empty)
+  std::vector<std::uint8_t> tile_dirty_;       // per tile: tile_depth_ is stale
+  std::size_t tile_offset_[5] = {};            // each face's first tile
+  int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
+  std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)
+
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
   bool simd_ = true;
@@ -252,7 +277,12 @@ class alignas(64) rasterizer_impl {
   // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
   // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
   std::uint32_t key_bits_ = 0;
-  std::vector<std::uint32_t> stack_;
+  struct open_node {
+    float distance2;     // squared distance from the point to the node's box (best-first order)
+    std::uint32_t node;
+    unsigned faces;      // the faces the node may touch
+  };
+  std::vector<open_node> open_;  // the traversal's stack (reference order) or heap (front to back)
   raster_statistics stats_;
 };
 

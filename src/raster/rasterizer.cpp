@@ -100,6 +100,12 @@ inline unsigned outcode(const glm::vec3& p) noexcept {
 // function f = d . (p - x) is bounded over the box by its value at the centre +- d_abs . half;
 // the box is dropped from a face when one of the face's functions stays below -margin on it.
 // The margin absorbs the rounding difference between this test and the per-vertex outcodes.
+// Squared distance from a point to a node's box (0 inside): the front-to-back order's key.
+inline float box_distance2(const bvh_node& node, const glm::vec3& p) noexcept {
+  const glm::vec3 d = glm::max(glm::max(node.lo - p, p - node.hi), glm::vec3(0.0f));
+  return glm::dot(d, d);
+}
+
 inline unsigned node_faces(const bvh_node& node, const glm::vec3& position, const frame& f) noexcept {
   const glm::vec3 c = 0.5f * (node.lo + node.hi) - position;
   const glm::vec3 h = 0.5f * (node.hi - node.lo);
@@ -287,6 +293,13 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
 #endif
   sky_ = options.sky;
   edge_ = options.edge_coverage;
+  occlusion_ = options.diagnostics.occlusion_culling;
+  // Per node, the triangles below it (children follow their parent in the array).
+  const std::vector<bvh_node>& nodes = scene_->bvh();
+  subtree_triangles_.assign(nodes.size(), 0u);
+  for (std::size_t i = nodes.size(); i-- > 0;)
+    subtree_triangles_[i] = nodes[i].count ? nodes[i].count
+                                           : subtree_triangles_[nodes[i].first] + subtree_triangles_[nodes[i].first + 1];
   const glm::vec3 sky = scene_->sky_radiance();
   shades_.clear();
   shades_.reserve(2 + scene_->emissions().size());
@@ -363,6 +376,8 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   draws_.assign(1, draw_record{});
   draws_.front().index = no_triangle;
   stats_ = {};
+  ties_ = 0;
+  if (occlusion_ && !edge_) occlusion_prepare();
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
     if (fragment_count_.size() != count)
@@ -467,33 +482,72 @@ unsigned raster_detail::rasterizer_impl::drop_faces_between_texel_centres(const 
 
 template <rasterizer_impl::mode M>
 void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const frame& basis) {
+  if (scene_->bvh().empty()) return;
+  if (M == mode::depth && occlusion_ && !edge_) {
+    // Occlusion culling (occlusion.cpp): front to back, each node tested against the tiles of what
+    // is drawn. A texel's winner is its nearest fragment in any order, unless two fragments tie,
+    // which the reference order decides (the first drawn wins): then the render is drawn again in
+    // that order, culled against the depths found (final: a node behind them neither wins nor
+    // ties). Either way the buffer is the one the unculled reference order gives, bit for bit.
+    traverse<M>(position, basis, true, true);
+    if (ties_ == 0) return;
+    ++stats_.occlusion_redraws;
+    occlusion_freeze();
+    redraw_prepare();
+    traverse<M>(position, basis, false, true);
+    return;
+  }
+  traverse<M>(position, basis, false, false);
+}
+
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull) {
   const std::vector<bvh_node>& nodes = scene_->bvh();
-  if (nodes.empty()) return;
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
   simd_frame sf;
   if (avx2_) sf.set(position, basis, *scene_);
 #endif
-  // Stack entries: node index (low 27 bits are plenty: 2^31 triangles need < 2^29 nodes, so the
-  // face mask travels in a second word).
-  stack_.clear();
-  stack_.push_back(0);
-  stack_.push_back(31);
-  while (!stack_.empty()) {
-    const unsigned parent_mask = stack_.back();
-    stack_.pop_back();
-    const std::uint32_t ni = stack_.back();
-    stack_.pop_back();
+  // The nodes to visit with the faces they may touch. The reference order is depth first, left
+  // to right (a stack); front to back it is best first: the node whose box is nearest to the
+  // point (ties: the lower index), so that near occluders are drawn before what they hide
+  // anywhere in the tree.
+  open_.clear();
+  open_.push_back({0.0f, 0, 31});
+  const auto later = [](const open_node& a, const open_node& b) {
+    return a.distance2 > b.distance2 || (a.distance2 == b.distance2 && a.node > b.node);
+  };
+  node_rects rects;
+  while (!open_.empty()) {
+    open_node next = open_.back();
+    if (front_to_back) {
+      std::pop_heap(open_.begin(), open_.end(), later);
+      next = open_.back();
+    }
+    open_.pop_back();
+    const std::uint32_t ni = next.node;
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
-    unsigned mask = parent_mask & node_faces(node, position, basis);
+    unsigned mask = next.faces & node_faces(node, position, basis);
     if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
+    if (mask && cull) {
+      mask = occlusion_test(node, mask, position, basis, rects);
+      if (!mask) {
+        ++stats_.nodes_occluded;
+        stats_.triangles_occluded += subtree_triangles_[ni];
+      }
+    }
     if (!mask) continue;
     if (node.count == 0) {
-      stack_.push_back(node.first + 1);
-      stack_.push_back(mask);
-      stack_.push_back(node.first);
-      stack_.push_back(mask);
+      if (front_to_back) {
+        for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
+          open_.push_back({box_distance2(nodes[c], position), c, mask});
+          std::push_heap(open_.begin(), open_.end(), later);
+        }
+      } else {
+        open_.push_back({0.0f, node.first + 1, mask});  // popped after the left child's subtree
+        open_.push_back({0.0f, node.first, mask});
+      }
       continue;
     }
 #if HEMILIGHT_RASTER_AVX2
@@ -503,10 +557,10 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
           draw_leaf_avx512<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
         else
           draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
-      continue;
-    }
+    } else
 #endif
-    for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
+      for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
+    if (cull) occlusion_drawn(mask, rects);
   }
 }
 
@@ -710,6 +764,7 @@ struct face_target {
   float* depth;
   std::uint32_t* ids;
   std::uint32_t* counts;
+  std::uint32_t* ties;  // nonzero once a fragment's depth equalled the one already there
 };
 
 // Writes the texels [lo, hi] of row y (the span paths): counts them in count mode, else the
@@ -739,13 +794,14 @@ struct span_writer {
     int x = lo;
 #if HEMILIGHT_RASTER_AVX2
     if (avx2) {
-      span_avx2(drow, irow, lo, hi, zrow, dzdx, draw);
+      span_avx2(drow, irow, lo, hi, zrow, dzdx, draw, *target.ties);
       return;
     }
 #endif
 #if HEMILIGHT_RASTER_SSE2
-    if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw);
+    if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw, *target.ties);
 #endif
+    std::uint32_t ties = 0;
     // The scalar reference path (and the tail of the SIMD one).
     for (; x <= hi; ++x) {
       float z = zrow + dzdx * static_cast<float>(x);
@@ -755,9 +811,11 @@ struct span_writer {
       // Selects, not a branch: short spans would mispredict on every texel.
       const float old = drow[x];
       const bool closer = z > old;
+      ties |= static_cast<std::uint32_t>(z == old);
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
+    *target.ties |= ties;
   }
 };
 
@@ -782,7 +840,7 @@ inline void scan_box_avx2(const fixed_point (&p)[3], const texel_box& box, int n
     base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - tie_bias(dx, dy));
   }
   small_triangle_avx2_impl<count_mode>(base, sx, sy, box.x_begin, box.x_end, box.y_begin, box.y_end, n, target.depth,
-                                       target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw);
+                                       target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw, *target.ties);
 }
 #endif
 
@@ -969,7 +1027,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   fs.prepare(face, texel_step_, first_centre_, rec);
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   const face_target target{depth_.data() + face_offset, ids_.data() + face_offset,
-                           M == mode::count ? counts_->data() + face_offset : nullptr};
+                           M == mode::count ? counts_->data() + face_offset : nullptr, &ties_};
 
   // 4. Small-triangle kernels: the box scanned without spans.
 #if HEMILIGHT_RASTER_AVX2
@@ -986,7 +1044,8 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
     // additions, and the coverage mask goes straight into the depth test: no span search,
     // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
     small_triangle_sse2_impl<M == mode::count>(e.ex, e.ey, e.e0, box.x_begin, box.x_end, box.y_begin, box.y_end, n,
-                                               target.depth, target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw);
+                                               target.depth, target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw,
+                                               ties_);
     return;
   }
 #endif
@@ -1005,7 +1064,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
 #if HEMILIGHT_RASTER_AVX2
   if (M == mode::depth && avx2_) {
     walk_depth_avx2(nl, nr, left, right, y_first, y_last, box.x_begin, box.x_end, target.depth, target.ids, n, fs.z00,
-                    fs.dzdy, fs.dzdx, draw, stats_);
+                    fs.dzdy, fs.dzdx, draw, stats_, ties_);
     return;
   }
 #endif
