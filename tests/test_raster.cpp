@@ -1386,10 +1386,12 @@ namespace {
 raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vector<std::pair<glm::vec3, frame>>& points, int n,
                                            const radiance_texture* texture = nullptr) {
   const auto s = scene::create(m.desc());
-  raster_options off, scalar;
+  raster_options on, off, scalar;
+  on.diagnostics.occlusion_min_triangles = 0;  // culling in scenes of every size
   off.diagnostics.occlusion_culling = false;
   scalar.diagnostics.simd = false;
-  hemicube_rasterizer culled(s), reference(s, off), culled_scalar(s, scalar);
+  scalar.diagnostics.occlusion_min_triangles = 0;
+  hemicube_rasterizer culled(s, on), reference(s, off), culled_scalar(s, scalar);
   hemicube_buffer a, b, c;
   raster_statistics sum;
   for (const auto& [p, f] : points) {

@@ -157,6 +157,9 @@ struct raster_options {
     /// Occlusion culling: BVH nodes wholly behind what is already drawn are skipped (without edge
     /// coverage). false draws everything in view, the reference the culling is tested against.
     bool occlusion_culling = true;
+    /// Scenes with fewer drawable triangles are drawn without occlusion culling: there its tests
+    /// cost more than they save (docs/raster.md, "Occlusion culling").
+    std::size_t occlusion_min_triangles = 8192;
   };
   /// Diagnostic switches (see diagnostic_switches): for comparisons only.
   diagnostic_switches diagnostics = {};

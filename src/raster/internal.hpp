@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -117,6 +118,32 @@ struct face_setup {
 };
 
 struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (kernels_avx2.hpp)
+
+// The texels where a fragment's depth equalled the depth already there (a tie, which the drawing
+// order decides), with that depth: occlusion culling's front-to-back pass checks after drawing
+// whether a tie still holds a texel's final depth. Ties are rare (coplanar overlapping triangles);
+// past `limit` entries only `overflow` is kept.
+struct tie_log {
+  static constexpr std::size_t limit = 4096;
+  std::vector<std::pair<const float*, float>> at;
+  bool overflow = false;
+  void clear() noexcept {
+    at.clear();
+    overflow = false;
+  }
+  // Lanes `bits` of the group of texels at `depth` with depths `z` (a cold path).
+  __attribute__((noinline, cold)) void add(const float* depth, const float* z, unsigned bits) {
+    for (; bits; bits &= bits - 1) {
+      const unsigned lane = static_cast<unsigned>(__builtin_ctz(bits));
+      if (at.size() == limit) {
+        overflow = true;
+        return;
+      }
+      at.emplace_back(depth + lane, z[lane]);
+    }
+  }
+  bool any() const noexcept { return overflow || !at.empty(); }
+};
 
 // The state and drawing code of a hemicube_rasterizer (raster.hpp): the public class holds one
 // of these and forwards to it. The hot code is member functions of this class, so nothing in
@@ -237,16 +264,18 @@ class alignas(64) rasterizer_impl {
                           node_rects& rects);
   void occlusion_drawn(unsigned mask, const node_rects& rects);
   void occlusion_freeze();
-  float tile_least_depth(int face, int tx, int ty);
+  bool hidden_in_tile(int face, int tx, int ty, const node_rects& rects, float nearest);
   template <mode M>
   void traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull);
   void redraw_prepare();
+  bool ties_decide_order() const;  // a logged tie holds its texel's final depth (or the log overflowed)
   bool occlusion_ = true;
-  std::uint32_t ties_ = 0;                     // a fragment met an equal depth in this render
+  tie_log ties_;                               // the depth ties of this render's front-to-back pass
+  tie_log* tie_sink_ = nullptr;                // &ties_ while that pass draws, else null (no logging)
   const float* occluders_ = nullptr;           // the depths the tiles are read from (depth_, or a frozen copy)
   std::vector<float> frozen_depth_;            // occlusion_freeze's copy
   std::vector<float> tile_depth_;              // per tile: least 1/w of its texels (0: one is empty)
-  std::vector<std::uint8_t> tile_dirty_;       // per tile: tile_depth_ is stale
+  std::vector<std::uint8_t> tile_dirty_;       // per tile: tile_depth_ is stale (or never read whole)
   std::size_t tile_offset_[5] = {};            // each face's first tile
   int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
   std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)

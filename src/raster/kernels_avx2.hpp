@@ -52,23 +52,32 @@ HEMILIGHT_TARGET_AVX2 inline __m256 depth_test8(float* depth, std::uint32_t* ids
 // Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
 // The depth test of span_avx2 with its constants given (zr: the row's depth, dz: its step per
 // texel, zmin = FLT_MIN, id: the record in every lane), shared with the span walk's functor.
-// `ties` gets a nonzero bit when a texel's depth equalled the one already there.
+// Logs the tie lanes `tie` of the eight texels at depth (depths z), if any and if `ties` is not
+// null (renders without occlusion culling log nothing).
+HEMILIGHT_TARGET_AVX2 inline void log_ties8(tie_log* ties, const float* depth, __m256 z, __m256 tie) {
+  if (!ties) return;
+  if (const int bits = _mm256_movemask_ps(tie)) {
+    alignas(32) float zl[8];
+    _mm256_store_ps(zl, z);
+    ties->add(depth, zl, static_cast<unsigned>(bits));
+  }
+}
+
+// Ties go to `ties` (tie_log; may be null).
 HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(float* drow, std::uint32_t* irow,
                                                                                int lo, int hi, __m256 zr, __m256 dz,
                                                                                __m256 zmin, __m256 id,
-                                                                               std::uint32_t& ties) noexcept {
+                                                                               tie_log* ties) noexcept {
   const __m256i end = _mm256_set1_epi32(hi + 1), eight = _mm256_set1_epi32(8);
   __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  __m256 tie = _mm256_setzero_ps();
   for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
     const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-    tie = _mm256_or_ps(tie, depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id));
+    log_ties8(ties, drow + x, z, depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id));
   }
-  ties |= static_cast<std::uint32_t>(_mm256_movemask_ps(tie));
 }
 
 HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
-                                     std::uint32_t draw, std::uint32_t& ties) noexcept {
+                                     std::uint32_t draw, tie_log* ties) noexcept {
   span_body_avx2(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN),
                  _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw))), ties);
 }
@@ -83,7 +92,7 @@ struct depth_spans_avx2 {
   double z00, dzdy;
   __m256 dz, zmin, id;
   std::size_t spans = 0, fragments = 0;
-  std::uint32_t ties = 0;
+  tie_log* ties = nullptr;
 
   HEMILIGHT_TARGET_AVX2 depth_spans_avx2(float* depth_, std::uint32_t* ids_, int n_, double z00_, double dzdy_,
                                          float dzdx, std::uint32_t draw) noexcept
@@ -105,12 +114,12 @@ struct depth_spans_avx2 {
 HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(
     int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
     std::int64_t x_begin, std::int64_t x_end, float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
-    float dzdx, std::uint32_t draw, raster_statistics& stats, std::uint32_t& ties) noexcept {
+    float dzdx, std::uint32_t draw, raster_statistics& stats, tie_log* ties) noexcept {
   depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
+  span.ties = ties;
   walk_rows_of(nl, nr, left, right, y0, y1, x_begin, x_end, span);
   stats.spans += span.spans;
   stats.fragments += span.fragments;
-  ties |= span.ties;
 }
 
 // The small-triangle path of small_triangle_sse2_impl, eight texels per step.
@@ -120,9 +129,8 @@ template <bool count_mode>
 HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_avx2_body(
     const std::int32_t* base, const std::int32_t* sx, const std::int32_t* sy, std::size_t stride, std::int64_t x_begin,
     std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n, float* depth, std::uint32_t* ids,
-    std::uint32_t* counts, double z00, double dzdy, float dzdx, std::uint32_t draw, std::uint32_t& ties) noexcept {
+    std::uint32_t* counts, double z00, double dzdy, float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  __m256 tie = _mm256_setzero_ps();
   __m256i step[3], row[3], dy[3];
   for (std::size_t k = 0; k < 3; ++k) {
     // Values at (x_begin + lane, y_begin); edge k's values are at [k * stride].
@@ -153,9 +161,9 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       const __m256 mask = _mm256_castsi256_ps(_mm256_srai_epi32(in, 31));
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
       const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
-      tie = _mm256_or_ps(tie, depth_test8(depth + i, ids + i, _mm256_max_ps(_mm256_add_ps(zr, zx), zmin), mask, id));
+      const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
+      log_ties8(ties, depth + i, z, depth_test8(depth + i, ids + i, z, mask, id));
     }
-    ties |= static_cast<std::uint32_t>(_mm256_movemask_ps(tie));
     return;
   }
   for (std::int64_t y = y_begin; y <= y_end; ++y) {
@@ -178,13 +186,12 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
         continue;
       }
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-      tie = _mm256_or_ps(tie, depth_test8(depth + i, ids + i, z, mask, id));
+      log_ties8(ties, depth + i, z, depth_test8(depth + i, ids + i, z, mask, id));
     }
     row[0] = _mm256_add_epi32(row[0], dy[0]);
     row[1] = _mm256_add_epi32(row[1], dy[1]);
     row[2] = _mm256_add_epi32(row[2], dy[2]);
   }
-  ties |= static_cast<std::uint32_t>(_mm256_movemask_ps(tie));
 }
 
 // small_triangle_avx2_body as a function (for draw_fixed, outside the AVX2 set-up).
@@ -193,7 +200,7 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
                                                     const std::int32_t* sy, std::int64_t x_begin, std::int64_t x_end,
                                                     std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
                                                     std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
-                                                    float dzdx, std::uint32_t draw, std::uint32_t& ties) noexcept {
+                                                    float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
   small_triangle_avx2_body<count_mode>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
                                        dzdy, dzdx, draw, ties);
 }

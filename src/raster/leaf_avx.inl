@@ -336,7 +336,7 @@ HEMILIGHT_LEAF_TARGET void raster_detail::rasterizer_impl::HEMILIGHT_LEAF_NAME(c
       if ((empty | flat) & bit) continue;
       if (draw[j] == 0) draw[j] = commit_record(plane_of[j], tri, textured_ ? &record(j) : nullptr, basis);
       small_triangle_avx2_body<M == mode::count>(&base[0][j], &sx[0][j], &sy[0][j], 8, xb[j], xe[j], yb[j], ye[j], n,
-                                                 depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j], ties_);
+                                                 depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j], tie_sink_);
     }
   }
 }

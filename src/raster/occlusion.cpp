@@ -58,55 +58,75 @@ void raster_detail::rasterizer_impl::redraw_prepare() {
   draw_triangles_.assign(1, no_triangle);
   draws_.assign(1, draw_record{});
   draws_.front().index = no_triangle;
-  ties_ = 0;
+  ties_.clear();
 }
 
-float raster_detail::rasterizer_impl::tile_least_depth(int face, int tx, int ty) {
+bool raster_detail::rasterizer_impl::ties_decide_order() const {
+  if (ties_.overflow) return true;
+  for (const auto& [depth, z] : ties_.at)
+    if (*depth == z) return true;  // the tie holds the texel's final depth: the order chose its winner
+  return false;
+}
+
+bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, const node_rects& r, float nearest) {
   const std::size_t t = tile_offset_[face] + static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) +
                         static_cast<std::size_t>(tx);
-  if (!tile_dirty_[t]) return tile_depth_[t];
+  if (!tile_dirty_[t] && nearest < tile_depth_[t]) return true;
+  // The texels of the rectangle in the tile, until one is as near as the node may be (or empty).
   const int rows = face == 0 ? n_ : n_ / 2;
-  const int x0 = tx * tile_size, x1 = std::min(x0 + tile_size, n_);
-  const int y0 = ty * tile_size, y1 = std::min(y0 + tile_size, rows);
+  const int tile_x0 = tx << tile_bits, tile_y0 = ty << tile_bits;
+  const int tile_x1 = std::min(tile_x0 + tile_size, n_) - 1, tile_y1 = std::min(tile_y0 + tile_size, rows) - 1;
+  const int x0 = std::max(r.x0[face], tile_x0), x1 = std::min(r.x1[face], tile_x1);
+  const int y0 = std::max(r.y0[face], tile_y0), y1 = std::min(r.y1[face], tile_y1);
   const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(face));
-  float least = d[static_cast<std::size_t>(y0) * static_cast<std::size_t>(n_) + static_cast<std::size_t>(x0)];
-  for (int y = y0; y < y1 && least > 0.0f; ++y) {
+  float least = INFINITY;
+  for (int y = y0; y <= y1; ++y) {
     const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_);
-    for (int x = x0; x < x1; ++x) least = std::min(least, row[x]);
+    for (int x = x0; x <= x1; ++x) {
+      if (!(nearest < row[x])) return false;
+      least = std::min(least, row[x]);
+    }
   }
-  tile_depth_[t] = least;
-  tile_dirty_[t] = 0;
-  return least;
+  // Every texel read: when that was the whole tile, its least depth is known again.
+  if (tile_dirty_[t] && x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) {
+    tile_depth_[t] = least;
+    tile_dirty_[t] = 0;
+  }
+  return true;
 }
 
 unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position,
                                                         const frame& basis, node_rects& rects) {
   // The box's corners in the local frame, grown by the float error of moving points there (the
-  // triangles' vertices carry the same kind of error).
+  // triangles' vertices carry the same kind of error), as eight lanes per coordinate (corner k
+  // takes x from hi if k & 1, y if k & 2, z if k & 4): plain loops the compiler vectorises.
   const glm::vec3 scale = glm::max(glm::max(glm::abs(node.lo), glm::abs(node.hi)), glm::abs(position));
   const glm::vec3 grow(1e-6f * (scale.x + scale.y + scale.z));
-  const glm::vec3 lo = node.lo - grow, hi = node.hi + grow;
-  glm::vec3 corner[8];
-  for (int k = 0; k < 8; ++k)
-    corner[k] = basis.to_local(glm::vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - position);
+  const glm::vec3 lo = node.lo - grow - position, hi = node.hi + grow - position;
+  float lx[8], ly[8], lz[8];
+  for (int k = 0; k < 8; ++k) {
+    const float x = k & 1 ? hi.x : lo.x, y = k & 2 ? hi.y : lo.y, z = k & 4 ? hi.z : lo.z;
+    lx[k] = basis.t.x * x + basis.t.y * y + basis.t.z * z;
+    ly[k] = basis.b.x * x + basis.b.y * y + basis.b.z * z;
+    lz[k] = basis.n.x * x + basis.n.y * y + basis.n.z * z;
+  }
   const float n = static_cast<float>(n_), half = 0.5f * n;
   for (int f = 0; f < 5; ++f) {
     if (!(mask >> f & 1u)) continue;
     const int rows = f == 0 ? n_ : n_ / 2;
     // The face's texels a point of the box may project to: all of them when the box reaches the
     // near plane (its projection is unbounded), else the bounds of its corners' projections (a
-    // ratio over a box with positive denominators takes its extremes at the corners).
-    float w_min = INFINITY, u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
-    for (const glm::vec3& c : corner) {
-      const clip_vertex cv = to_clip(f, c);
-      w_min = std::min(w_min, cv.w);
-      if (cv.w > 0.0f) {
-        const float inv = 1.0f / cv.w;
-        u0 = std::min(u0, cv.u * inv);
-        u1 = std::max(u1, cv.u * inv);
-        v0 = std::min(v0, cv.v * inv);
-        v1 = std::max(v1, cv.v * inv);
-      }
+    // ratio over a box with positive denominators takes its extremes at the corners). to_clip's
+    // (u, v, w) per face: (x, y, z), (y, z, x), (-y, z, -x), (-x, z, y), (x, z, -y).
+    const float* cu = f == 0 ? lx : f == 1 ? ly : f == 2 ? ly : lx;
+    const float* cv = f == 0 ? ly : lz;
+    const float* cw = f == 0 ? lz : f <= 2 ? lx : ly;
+    const float su = f == 2 || f == 3 ? -1.0f : 1.0f, sw = f == 2 || f == 4 ? -1.0f : 1.0f;
+    float w[8], pu[8], pv[8];
+    float w_min = INFINITY;
+    for (int k = 0; k < 8; ++k) {
+      w[k] = sw * cw[k];
+      w_min = std::min(w_min, w[k]);
     }
     if (!(w_min > near_)) {
       rects.x0[f] = 0;
@@ -114,6 +134,18 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
       rects.y0[f] = 0;
       rects.y1[f] = rows - 1;
       continue;  // its nearest depth is 1/near: nothing drawn can hide it
+    }
+    for (int k = 0; k < 8; ++k) {
+      const float inv = 1.0f / w[k];
+      pu[k] = su * cu[k] * inv;
+      pv[k] = cv[k] * inv;
+    }
+    float u0 = pu[0], u1 = pu[0], v0 = pv[0], v1 = pv[0];
+    for (int k = 1; k < 8; ++k) {
+      u0 = std::min(u0, pu[k]);
+      u1 = std::max(u1, pu[k]);
+      v0 = std::min(v0, pv[k]);
+      v1 = std::max(v1, pv[k]);
     }
     // Texel centres at (x + 1/2) for x = (u + 1) N / 2; side faces' rows start at v = 0.
     const float v_offset = f == 0 ? 1.0f : 0.0f;
@@ -137,25 +169,11 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     rects.y0[f] = y0;
     rects.y1[f] = y1;
     // Hidden when its nearest depth, with the margin, is below the depth of every texel of its
-    // rectangle: read per tile from the tile's least depth, and texel by texel where a tile
-    // (partly outside the rectangle) holds a nearer or empty texel.
+    // rectangle, read per tile from the tile's least depth where it is known and high enough.
     const float nearest = depth_margin / w_min;
-    const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(f));
     bool hidden = true;
     for (int ty = y0 >> tile_bits; hidden && ty <= (y1 >> tile_bits); ++ty)
-      for (int tx = x0 >> tile_bits; hidden && tx <= (x1 >> tile_bits); ++tx) {
-        if (nearest < tile_least_depth(f, tx, ty)) continue;
-        const int cx0 = std::max(x0, tx << tile_bits), cx1 = std::min(x1, (tx << tile_bits) + tile_size - 1);
-        const int cy0 = std::max(y0, ty << tile_bits), cy1 = std::min(y1, (ty << tile_bits) + tile_size - 1);
-        for (int y = cy0; hidden && y <= cy1; ++y) {
-          const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_);
-          for (int x = cx0; x <= cx1; ++x)
-            if (!(nearest < row[x])) {
-              hidden = false;
-              break;
-            }
-        }
-      }
+      for (int tx = x0 >> tile_bits; hidden && tx <= (x1 >> tile_bits); ++tx) hidden = hidden_in_tile(f, tx, ty, rects, nearest);
     if (hidden) mask &= ~(1u << f);
   }
   return mask;

@@ -293,7 +293,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
 #endif
   sky_ = options.sky;
   edge_ = options.edge_coverage;
-  occlusion_ = options.diagnostics.occlusion_culling;
+  occlusion_ = options.diagnostics.occlusion_culling &&
+               scene_->drawable_triangle_count() >= options.diagnostics.occlusion_min_triangles;
   // Per node, the triangles below it (children follow their parent in the array).
   const std::vector<bvh_node>& nodes = scene_->bvh();
   subtree_triangles_.assign(nodes.size(), 0u);
@@ -376,8 +377,8 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   draws_.assign(1, draw_record{});
   draws_.front().index = no_triangle;
   stats_ = {};
-  ties_ = 0;
-  if (occlusion_ && !edge_) occlusion_prepare();
+  ties_.clear();
+  tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
     if (fragment_count_.size() != count)
@@ -489,8 +490,11 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     // which the reference order decides (the first drawn wins): then the render is drawn again in
     // that order, culled against the depths found (final: a node behind them neither wins nor
     // ties). Either way the buffer is the one the unculled reference order gives, bit for bit.
+    occlusion_prepare();
+    tie_sink_ = &ties_;
     traverse<M>(position, basis, true, true);
-    if (ties_ == 0) return;
+    tie_sink_ = nullptr;
+    if (!ties_decide_order()) return;
     ++stats_.occlusion_redraws;
     occlusion_freeze();
     redraw_prepare();
@@ -764,7 +768,7 @@ struct face_target {
   float* depth;
   std::uint32_t* ids;
   std::uint32_t* counts;
-  std::uint32_t* ties;  // nonzero once a fragment's depth equalled the one already there
+  tie_log* ties;  // where a fragment's depth equalled the one already there
 };
 
 // Writes the texels [lo, hi] of row y (the span paths): counts them in count mode, else the
@@ -794,14 +798,13 @@ struct span_writer {
     int x = lo;
 #if HEMILIGHT_RASTER_AVX2
     if (avx2) {
-      span_avx2(drow, irow, lo, hi, zrow, dzdx, draw, *target.ties);
+      span_avx2(drow, irow, lo, hi, zrow, dzdx, draw, target.ties);
       return;
     }
 #endif
 #if HEMILIGHT_RASTER_SSE2
-    if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw, *target.ties);
+    if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw, target.ties);
 #endif
-    std::uint32_t ties = 0;
     // The scalar reference path (and the tail of the SIMD one).
     for (; x <= hi; ++x) {
       float z = zrow + dzdx * static_cast<float>(x);
@@ -811,11 +814,10 @@ struct span_writer {
       // Selects, not a branch: short spans would mispredict on every texel.
       const float old = drow[x];
       const bool closer = z > old;
-      ties |= static_cast<std::uint32_t>(z == old);
+      if (target.ties && z == old) target.ties->add(drow + x, &z, 1u);
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
-    *target.ties |= ties;
   }
 };
 
@@ -840,7 +842,7 @@ inline void scan_box_avx2(const fixed_point (&p)[3], const texel_box& box, int n
     base[k] = static_cast<std::int32_t>(dx * (oy - a.y) - dy * (ox - a.x) - tie_bias(dx, dy));
   }
   small_triangle_avx2_impl<count_mode>(base, sx, sy, box.x_begin, box.x_end, box.y_begin, box.y_end, n, target.depth,
-                                       target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw, *target.ties);
+                                       target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw, target.ties);
 }
 #endif
 
@@ -1027,7 +1029,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   fs.prepare(face, texel_step_, first_centre_, rec);
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   const face_target target{depth_.data() + face_offset, ids_.data() + face_offset,
-                           M == mode::count ? counts_->data() + face_offset : nullptr, &ties_};
+                           M == mode::count ? counts_->data() + face_offset : nullptr, tie_sink_};
 
   // 4. Small-triangle kernels: the box scanned without spans.
 #if HEMILIGHT_RASTER_AVX2
@@ -1045,7 +1047,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
     // no branch per texel. Same coverage (exact integers) and depths as the scalar path.
     small_triangle_sse2_impl<M == mode::count>(e.ex, e.ey, e.e0, box.x_begin, box.x_end, box.y_begin, box.y_end, n,
                                                target.depth, target.ids, target.counts, fs.z00, fs.dzdy, fs.dzdx, draw,
-                                               ties_);
+                                               tie_sink_);
     return;
   }
 #endif
@@ -1064,7 +1066,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
 #if HEMILIGHT_RASTER_AVX2
   if (M == mode::depth && avx2_) {
     walk_depth_avx2(nl, nr, left, right, y_first, y_last, box.x_begin, box.x_end, target.depth, target.ids, n, fs.z00,
-                    fs.dzdy, fs.dzdx, draw, stats_, ties_);
+                    fs.dzdy, fs.dzdx, draw, stats_, tie_sink_);
     return;
   }
 #endif
