@@ -1,62 +1,6 @@
 // hemilight/bake.hpp — the lightmap baker: from triangles with lightmap UVs to an irradiance
-// lightmap, through the irradiance cache, with bounces.
-//
-// Pipeline (docs/bake.md):
-//   1. Samples. Every triangle is rasterized in UV space over the W x H texel grid with exact
-//      coverage: the triangle (in texel units) is clipped against each texel square
-//      (Sutherland-Hodgman), giving the covered area and its centroid. Per texel:
-//        - coverage = the summed covered fraction of all triangles, clamped to 1;
-//        - owner = the triangle with the largest covered area (ties: lower triangle index)
-//          — the overlap rule: where triangles overlap in UV space the owner's material is the
-//          texel's material and the owner is preferred for the sample;
-//        - sample point = the area-weighted centroid of all covered parts; it is mapped to 3D
-//          through the owner if it lies inside the owner's UV triangle, else through another
-//          covering triangle that contains it (largest area first), else the owner's own centroid
-//          is used. (So a texel on the diagonal of a quad gets its centre, a texel on a chart
-//          border the centroid of the covered part: never a point outside the surface.)
-//        - normal = the triangle's interpolated vertex normal there (normalised), or its face
-//          normal when no vertex normals are given (or they interpolate to ~0).
-//      Texels with coverage < min_coverage get no sample.
-//   2. Offset. Each sample moves along its normal by
-//          max(2 x default_near_distance(scene), offset_texels x texel world size),
-//      texel world size = sqrt(3D area / UV area in texels) of the sample's triangle: the point
-//      leaves its own surface by a fraction of a texel, and always by more than the near plane.
-//   3. Irradiance. cache_irradiance() with make_hemicube_sampler() (cache.hpp), each hemicube
-//      rolled about its normal by an angle hashed from the sample position (deterministic per
-//      texel): hemicube aliasing shows as fine noise, not bands. Samples inside geometry (their own
-//      hemicube sees back faces, or the cache presumes them inside from an invalid sample on the
-//      same side of the same surface: cache.hpp) are filled by dilating the valid texels around
-//      them in the lightmap (the same chart: never light from across a wall), in both modes.
-//   3b. Lights (bake_options::lights, lights.hpp). Their direct irradiance E_L is computed at
-//      every sample once, with shadow rays (never interpolated: the cache sees only what the
-//      hemicubes gather), and every pass's irradiance is E_hemicube + E_L. So pass 1's radiance
-//      texture holds emission + albedo (E_hemicube + E_L) / pi and the bounces carry the lights'
-//      light; indirect_only (E_bounces - E_1) drops E_L with the emitters' first bounce. The SH
-//      and HL2 maps get each light's part along its direction (below), and an optional shadow
-//      mask holds the visibility of up to four lights per texel.
-//   4. Bounces. Pass 1 sees emission and sky. Pass k > 1 renders with a radiance texture (same
-//      size as the lightmap) holding, per texel, emission + albedo E_{k-1} / pi of the texel's
-//      owner, dilated like the lightmap. The result of pass `bounces` is the lightmap; with
-//      indirect_only it is E_bounces - E_1, clamped at 0 (everything but the first bounce).
-//   5. Dilation. Every chart grows into the empty texels around it, one ring per step (each
-//      empty texel with a filled 8-neighbour gets the mean of its filled 8-neighbours), so
-//      bilinear lookups at chart borders do not pull in black.
-//
-//   6. Directional lightmaps (optional, bake_options::output_sh_l1 / output_hl2). In the last pass
-//      (and, with indirect_only, the first) the hemicube sampler also computes the world-space L1
-//      SH of the incoming radiance and/or the irradiance on the cone of HL2 directions (54.74
-//      degrees from the normal) as a Fourier series in azimuth (cache.hpp, hl2_cone); cache
-//      records carry both and each texel gets their Ward-weighted average (cones rotated to a
-//      common reference tangent first). SH maps are those coefficients. HL2 maps are the cone
-//      series read at the azimuths of the three basis vectors of the texel's lightmap tangent
-//      frame (lightmap_tangent_frame, hl2_from_cone): frame-correct for any tangent, exact for
-//      light within 35.26 degrees of the normal, otherwise cut at azimuthal order 3 (measured 1.7%
-//      RMS for a grazing side light, where going through L1 SH would give 25%; docs/bake.md).
-//      All of them are dilated like the irradiance. A light adds to them what radiance from one
-//      direction w (light_sample::direction) would: with F = E_L / (n . w), SH coefficient
-//      F Y(w) and HL2 value F max(0, b_k . w). Exact for hard lights; for soft ones w is the
-//      direction of the visible part's vector irradiance (the spread of a small disc or sphere
-//      is lost: L1 and the clamped cosine change by O(a^2) for a light of angular radius a).
+// lightmap (optionally directional maps and a shadow mask), through the irradiance cache, with
+// bounces and analytic lights. The pipeline, its steps and its figures: docs/bake.md.
 //
 // UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
 // its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
@@ -81,12 +25,9 @@
 
 namespace hemilight {
 
-/// Largest lightmap width or height bake_lightmap accepts. The per-sample state is kept for
-/// covered texels only: peak memory is about 32 bytes per texel (the result's images and masks)
-/// plus, per sampled texel, about 124 bytes on a flat quad at N = 8 and up to about 210 bytes on
-/// a heightfield at N = 64 with more cache records (docs/bake.md, "Scaling" and "Memory"), so a
-/// fully sampled 8192^2 needs up to about 14 GiB; larger maps are refused with
-/// error(invalid_argument).
+/// Largest lightmap width or height bake_lightmap accepts: peak memory is O(texels) plus
+/// O(sampled texels) (docs/bake.md, "Memory per texel"), up to about 14 GiB for a fully sampled
+/// 8192^2. Larger maps are refused with error(invalid_argument).
 inline constexpr int max_lightmap_size = 8192;
 
 /// Largest number of light bounces a bake takes (bake_options::bounces).
@@ -113,11 +54,12 @@ struct bake_options {
   /// Texels whose covered fraction is below this get no sample (they are filled by dilation).
   /// In [0, 1]; 0 samples every texel touched by a triangle.
   float min_coverage = 0.01f;
-  /// Sample offset along the normal in texel world sizes (the top of this header), finite, >= 0.
+  /// Sample offset along the normal in texel world sizes (docs/bake.md, step 2), finite, >= 0.
   float offset_texels = 0.05f;
   /// Rings of dilation around every chart, >= 0; -1 fills every empty texel of the lightmap.
   int dilation = 16;
-  /// Output the L1 SH lightmaps (bake_result::sh_l1). Cost: a few percent of the bake.
+  /// Output the L1 SH lightmaps (bake_result::sh_l1). Cost: 3 multiply-adds per hemicube texel in
+  /// the directional passes.
   bool output_sh_l1 = false;
   /// Output the Half-Life 2 basis lightmaps (bake_result::hl2). Cost: 21 multiply-adds per
   /// hemicube texel in the directional passes, 96 bytes per record, a table per resolution.
@@ -140,14 +82,14 @@ struct bake_stats {
   std::size_t texels = 0;             ///< W x H
   std::size_t covered_texels = 0;     ///< texels with coverage > 0
   std::size_t sampled_texels = 0;     ///< texels with coverage >= min_coverage (one sample each)
-  std::size_t invalid_texels = 0;     ///< sampled texels filled by the cache (inside geometry), any pass
+  std::size_t invalid_texels = 0;     ///< sampled texels inside geometry in any pass (filled by dilation)
   std::size_t overlapping_texels = 0; ///< texels whose covering triangles sum to more than 1.001 texel (UV overlap)
   std::size_t dilated_texels = 0;     ///< empty texels filled by dilation
   std::size_t hemicubes = 0;          ///< hemicubes rendered, all passes
   std::size_t records = 0;            ///< cache records, all passes
   std::vector<cache_stats> passes;    ///< the cache's statistics per pass
-  double coverage_seconds = 0.0;      ///< step 1
-  double direct_seconds = 0.0;        ///< step 3b: the lights' direct irradiance (0 without lights)
+  double coverage_seconds = 0.0;      ///< exact UV coverage and samples (compute_lightmap_samples)
+  double direct_seconds = 0.0;        ///< the lights' direct irradiance (0 without lights)
   double seconds = 0.0;               ///< the whole bake (wall time)
 };
 
@@ -168,8 +110,8 @@ struct bake_result {
   std::array<image, 4> sh_l1;
   /// With output_hl2 (else three empty images): irradiance through the Half-Life 2 basis vectors
   /// hl2_basis[k] of each texel's lightmap tangent frame (lightmap_tangent_frame), >= 0, from the
-  /// interpolated HL2 cone series (top of this header). A uniform sky L gives pi L (1 + 1/sqrt 3) / 2
-  /// in all three. With indirect_only: last pass minus first pass. Dilated.
+  /// interpolated HL2 cone series (docs/bake.md, "Directional lightmaps"). A uniform sky L gives
+  /// pi L (1 + 1/sqrt 3) / 2 in all three. With indirect_only: last pass minus first pass. Dilated.
   std::array<image, 3> hl2;
   /// With shadow_mask_lights (else empty): W x H RGBA, channel c = the visibility of light
   /// shadow_mask_lights[c] (lights.hpp's light_sample::visibility: 1 for a light that casts no
@@ -188,15 +130,15 @@ struct bake_input {
 /// Bakes the irradiance lightmap of a scene (all meshes share one lightmap UV space).
 ///
 /// Errors (hemilight::error naming the problem; nothing returned):
-///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces < 1 or > 64,
-///     bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN, dilation < -1, cache
-///     options out of range); no lightmap UVs; a UV outside [0, 1] ("lightmap_uvs[7].u = 1.2 is
-///     outside [0, 1]"); a triangle with nonzero 3D area but zero UV area; a non-finite normal; an
-///     albedo outside [0, 1];
-///     everything scene::create rejects; no texel sampled (nothing to bake);
+///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces not in
+///     [1, max_bounces], bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN,
+///     dilation < -1, cache options out of range); no lightmap UVs; a UV outside [0, 1]
+///     ("lightmap_uvs[7].u = 1.2 is outside [0, 1]"); a triangle with nonzero 3D area but zero UV
+///     area; a non-finite normal; an albedo outside [0, 1]; everything scene::create rejects; no
+///     texel sampled (nothing to bake);
 ///   cancelled: the progress callback returned false.
-/// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): about
-/// hemicubes x (20-100 us at N = 64) / threads.
+/// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): one
+/// render and integration per hemicube, spread over the threads, plus O(sampled texels).
 bake_result bake_lightmap(const bake_input& input, const bake_options& options);
 
 // ---- scenes: many meshes, several lightmap pages ---------------------------------------------
@@ -291,17 +233,21 @@ struct scene_bake_result {
 /// Cost: as bake_lightmap over the sum of the pages' texels, plus copies of the vertices.
 scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& options);
 
-/// The samples of a lightmap (step 1 of the pipeline, before the offset), per texel, row-major.
+/// The samples of a lightmap (before the offset: docs/bake.md, step 1), per texel, row-major.
 struct lightmap_samples {
   int width = 0, height = 0;
-  std::vector<float> coverage;              ///< covered fraction, clamped to [0, 1]
-  /// Owner triangle (scene_desc numbering) by the overlap rule, or no_triangle if nothing covers the texel.
+  std::vector<float> coverage;              ///< summed covered fraction, clamped to [0, 1]
+  /// Owner triangle (scene_desc numbering): the largest covered area (ties: the lower index); its
+  /// material is the texel's. no_triangle if nothing covers the texel.
   std::vector<std::uint32_t> owner;
-  /// Triangle the sample lies on (the owner or another covering triangle), or no_triangle.
+  /// Triangle the sample lies on: the owner if it contains the combined centroid, else the
+  /// covering triangle of largest area that does, else the owner; or no_triangle.
   std::vector<std::uint32_t> sample_triangle;
-  std::vector<glm::vec2> centroid;          ///< sample point in UV (not texel) units
+  /// Sample point in UV (not texel) units: the area-weighted centroid of all covered parts, or
+  /// the owner's own covered part's centroid where that lies on no covering triangle.
+  std::vector<glm::vec2> centroid;
   std::vector<glm::vec3> position;          ///< sample point in 3D, on sample_triangle
-  std::vector<glm::vec3> normal;            ///< unit normal at the sample
+  std::vector<glm::vec3> normal;            ///< unit interpolated vertex normal, or the face normal
   std::vector<float> texel_world_size;      ///< sqrt(3D area / UV area in texels) of sample_triangle
   /// Lightmap tangent frame at the sample (lightmap_tangent_frame of sample_triangle with the
   /// sample's normal): unit tangent along +u and bitangent along +v, both orthogonal to `normal`.
@@ -312,7 +258,7 @@ struct lightmap_samples {
   static constexpr std::uint32_t no_triangle = 0xffffffffu;
 };
 
-/// Exact coverage and sample points of every texel (step 1). Validates like bake_lightmap
+/// Exact coverage and sample points of every texel. Validates like bake_lightmap
 /// (size, UVs, normals, zero-area UV triangles); positions and indices must be valid (as
 /// scene::create checks). Cost: O(sum over triangles of the texels in their UV bounding box).
 lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height);

@@ -1,19 +1,19 @@
 // hemilight/cache.hpp — irradiance caching: render hemicubes at few of the points where
 // irradiance is needed, interpolate the rest with gradients (Ward 1988, Ward & Heckbert 1992).
+// Placement, radii and their figures: docs/cache.md.
 //
 // Records: position x_i, normal n_i, irradiance E_i, gradients g_r,i and g_t,i (integrate.hpp's
-// convention), validity radius R_i (the split-sphere distance, clamped and limited: docs/cache.md).
-// Interpolation at (x, n), over the records with w_i > 1/a that x is not behind:
+// convention), validity radius R_i. Interpolation at (x, n), over the records with w_i > 1/a that
+// x is not behind:
 //
 //     E(x, n) = sum_i w_i (E_i + (n_i x n) . g_r,i + (x - x_i) . g_t,i) / sum_i w_i,  clamped >= 0
 //
 // with Ward's w_i = 1 / (|x - x_i| / R_i + sqrt(1 - n . n_i)) (cache_weight lists the others) and,
 // with second_order, + 1/2 (x - x_i)^T H_i (x - x_i) in each record's prediction.
 //
-// Placement runs in rounds of halving seed spacing, in a fixed pseudo-random order: the same input
-// gives bitwise the same output for any thread count. Points whose own hemicube sees back faces
-// (inside geometry) are reported invalid and filled from records on their side of the surface.
-// The rules and their measured effect: docs/cache.md.
+// Determinism: the same input gives bitwise the same output for any thread count. Points inside
+// geometry (their own hemicube, or a nearby invalid sample's, sees back faces) are reported invalid
+// and filled from records on their side of the surface.
 #pragma once
 
 #include "hemilight/sampler.hpp"
@@ -41,9 +41,9 @@ struct cache_record {
   float backface_fraction = 0.0f;
   /// L1 spherical harmonics of the incoming radiance, world space, the sample's
   /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
-  /// channel c: sh_l1[k][c]). Zero unless cache_options::directional.
+  /// channel c: sh_l1[k][c]). Zero unless cache_run::directional.
   std::array<glm::vec3, 4> sh_l1{};
-  /// Irradiance on the HL2 cone (hl2_cone), the sample's cone. Zero unless directional.
+  /// Irradiance on the HL2 cone (hl2_cone), the sample's cone. Zero unless cache_run::directional.
   hl2_cone cone;
   /// Second-order term per channel c (world space, symmetric, acting in the record's tangent
   /// plane; units: irradiance per scene unit squared): the interpolation adds
@@ -62,7 +62,7 @@ enum class cache_weight {
   /// as with `ward` (placement and statistics are identical), but a record's weight falls to 0 at
   /// the edge of its reach instead of jumping from 1/a to 0 there, so the interpolated irradiance
   /// is continuous where a record's reach ends. Ward's own weight (and its jump) remains inside
-  /// the coverage tests. docs/cache.md gives its measured effect on the error.
+  /// the coverage tests.
   ward_continuous,  // last, so the earlier values stay as they were (and match the C ABI's numbering)
 };
 
@@ -71,8 +71,7 @@ enum class cache_weight {
 inline constexpr float min_error_threshold = 0.001f;
 
 /// Expert settings of the cache's placement: each default is the measured best (docs/cache.md,
-/// "Placement", measures each one against its cost). Change them to study the cache, not to tune
-/// a bake.
+/// "Placement"). Change them to study the cache, not to tune a bake.
 struct cache_expert_options {
   bool limit_radius_by_gradient = true;    ///< R_i <= E_i / |g_t,i| (on luminance)
   bool limit_radius_by_neighbours = true;  ///< R_i <= R_j + |x_i - x_j|
@@ -156,7 +155,7 @@ struct cache_stats {
   std::size_t records = 0;          ///< records kept
   std::size_t invalid_samples = 0;  ///< samples rejected for seeing back faces (their own point is inside geometry)
   /// Points not interpolated (cache_result::valid = 0): invalid samples' own points and points
-  /// presumed inside geometry near them (cache.hpp, top), filled from records on their side.
+  /// presumed inside geometry near them, filled from records on their side (or left at 0).
   std::size_t invalid_points = 0;
   std::size_t rounds = 0;           ///< placement rounds that rendered hemicubes
   double seconds = 0.0;             ///< wall time
@@ -185,11 +184,11 @@ struct cache_stats {
 struct cache_result {
   std::vector<glm::vec3> irradiance;  ///< per point, RGB, >= 0
   std::vector<std::uint8_t> valid;    ///< per point: 1 = interpolated from covering records, 0 = filled (inside geometry or uncovered)
-  /// Per point with options.directional (else empty): the Ward-weighted average of the covering
+  /// Per point with run.directional (else empty): the Ward-weighted average of the covering
   /// records' world-space L1 SH (filled points: of the same nearest records as their E). Not
   /// clamped: band-1 coefficients are signed.
   std::vector<std::array<glm::vec3, 4>> sh_l1;
-  /// Per point with options.directional (else empty): the records' cones rotated to the
+  /// Per point with run.directional (else empty): the records' cones rotated to the
   /// reference make_frame(normal).t of the point (rotate_hl2_cone) and averaged with the weights of E.
   std::vector<hl2_cone> cone;
   std::vector<cache_record> records;
@@ -228,22 +227,14 @@ glm::vec3 interpolate_records(const std::vector<cache_record>& records, const gl
                               const glm::vec3& normal, const cache_options& options, float* weight_sum = nullptr);
 
 /// Fits each record's `hessian` (per channel) from the records around it, as cache_irradiance
-/// does with cache_options::second_order:
-///  - neighbours: records j != i with |x_j - x_i| <= 2 a R_i (a = options.error_threshold) and
-///    n_i . n_j > 0.95;
-///  - the 2 x 2 symmetric Hessian in the record's tangent plane is the least-squares solution of
-///    P (g_t,j - g_t,i) = H P (x_j - x_i) over the neighbours (P: projection on the tangent plane),
-///    with a ridge of 1e-6 of the normal matrix's trace (neighbours on one line leave the direction
-///    across it at 0);
-///  - then it is scaled by s in [0, 1], the least-squares factor by which the quadratic term best
-///    predicts the neighbours' irradiance beyond the first-order prediction, E_j - (E_i +
-///    (n_i x n_j).g_r,i + (x_j - x_i).g_t,i). The values are data the fit did not use: where the
-///    gradients' differences are not a smooth quadratic (a shadow edge, a ceiling line), s goes
-///    to 0 and the record stays first-order.
-/// Records with fewer than 2 neighbours get 0. Deterministic for any thread_count (>= 0; 0 = all
-/// cores). Throws error(invalid_argument), naming the first bad
-/// record, when error_threshold is not in [0.001, 1], a record's radius is negative or not finite, its
-/// position is not finite or its normal's length is not 1 within 1e-3; records are then unchanged.
+/// does with cache_options::second_order (docs/cache.md, "The second-order term"): the 2 x 2
+/// symmetric Hessian in the record's tangent plane that best maps the offsets of its neighbours
+/// (|x_j - x_i| <= 2 a R_i, n_i . n_j > 0.95) to their gradient differences, scaled by s in [0, 1]
+/// by how well it predicts their irradiance beyond first order. Records with fewer than 2
+/// neighbours get 0. Deterministic for any thread_count (>= 0; 0 = all cores).
+/// Throws error(invalid_argument), naming the first bad record, when error_threshold is not in
+/// [min_error_threshold, 1], a record's radius is negative or not finite, its position is not
+/// finite or its normal's length is not 1 within 1e-3; records are then unchanged.
 /// Irradiance and gradients are not checked: NaN in them gives that record a zero Hessian.
 /// Cost: O(records x neighbours).
 void fit_record_hessians(std::vector<cache_record>& records, const cache_options& options, int thread_count = 0);

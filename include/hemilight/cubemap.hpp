@@ -15,10 +15,9 @@
 //   centre   u = (x + 0.5) * 2/n - 1                  what GPUs sample
 //   stretch  u = 2x / (n - 1) - 1                     edge texels of adjacent faces coincide
 //   warp     u = c + a c^3, c = the centre u, a = n^2 / (n - 1)^3   edge texels coincide too
-// Size 1: every mapping gives u = 0 (the face centre): one texel cannot be both edges, the
-// stretch formula would divide by zero and the warp constant a is infinite. The edge texels
-// (x = 0 and x = n - 1) get exactly -1 and +1 under stretch and warp, and u(n-1-x) = -u(x)
-// exactly, so adjacent faces' edge texels have bitwise identical directions (tested).
+// Size 1: every mapping gives u = 0 (the face centre). Under stretch and warp the edge texels
+// (x = 0 and x = n - 1) get exactly -1 and +1 and u(n-1-x) = -u(x) exactly, so adjacent faces'
+// edge texels have bitwise identical directions.
 //
 // Thread safety: everything here is a pure function or reads immutable objects; cubemap::sample
 // may be called from any number of threads at once.
@@ -127,7 +126,7 @@ struct cubemap {
   /// The sky lookup for the rasterizer: radiance seen along `direction` (need not be unit),
   /// seamless bilinear at the top level; RGB in .xyz, alpha (1 for RGB maps) in .w. A zero or
   /// non-finite direction gives the +X face centre's value (never NaN). Thread-safe on an
-  /// immutable cubemap. Precondition: level_count() >= 1. Cost: ~30-50 ns.
+  /// immutable cubemap. Precondition: level_count() >= 1. Cost: O(1), one bilinear lookup.
   glm::vec4 sample(const glm::vec3& direction) const noexcept;
 };
 
@@ -182,36 +181,29 @@ cube_image procedural_environment(int size, int channels = 3);
 struct filter_options {
   edge_fixup fixup = edge_fixup::none;  ///< mapping of the output texel directions
   int thread_count = 0;                 ///< 0: all cores (parallel.hpp)
-  /// Lobe cutoff: input texels whose weight dot^p is below this are skipped; the lobe's angular
-  /// extent is acos(cutoff^(1/p)). NVTT uses 1e-3, cmft 1e-5; 1e-4 keeps the error of cutting a
-  /// bright sun's lobe tail near 0.1% (docs/cubemap.md).
+  /// Lobe cutoff, in (0, 1): input texels whose weight dot^p is below this are skipped; the lobe's
+  /// angular extent is acos(cutoff^(1/p)) (docs/cubemap.md compares cutoffs).
   float cutoff = 1e-4f;
   /// Accuracy/speed knob: the filter reads the coarsest input mip whose texels (2/size rad at a
   /// face centre) are at most sigma / texels_per_sigma, sigma = 1/sqrt(p) the lobe's width.
-  /// Larger is slower and closer to brute force (docs/cubemap.md has the measured curve): on the
-  /// 256^2 test sky with a sun, 2.5 gives a max relative error of ~0.3% against brute force,
-  /// 1.5 is ~1.2x faster at up to ~1.5% (levels whose lobe is not much wider than the sun).
+  /// Larger is slower and closer to brute force (docs/cubemap.md, "Speed against accuracy").
   float texels_per_sigma = 2.5f;
-  /// Smallest input mip size the cosine-power filter reads (wide lobes are cheap to filter, and
-  /// a bright compact source such as a sun needs several texels per lobe width: with 16 the
-  /// 256-chain's coarse levels were off by up to 1.1%, with 64 by <= 0.25%).
+  /// Smallest input mip size the cosine-power filter reads: a bright compact source such as a sun
+  /// needs several texels per lobe width (docs/cubemap.md, "Filtering").
   int min_input_size = 64;
-  /// Input mip size the irradiance (cosine-lobe) filter reads (clamped to the input's size):
-  /// 16 keeps irradiance under 0.4% from brute force on the test sky at ~10 ms for 32^2 out.
+  /// Input mip size the irradiance (cosine-lobe) filter reads (clamped to the input's size); the
+  /// error falls as O(size^-2) (docs/cubemap.md, "Irradiance methods against brute force").
   int irradiance_input_size = 16;
   /// true (default): the lobe weights are computed once per call, in double, for the output
-  /// texels of one eighth of one face, and applied to all 48 symmetric images of them (the cube's
-  /// symmetries map both texel grids onto themselves), so each tap is a multiply-add. false: the
-  /// lobe is evaluated per tap (a 1024-step table for p >= 8), the previous method, kept for
-  /// comparison. Both read the same input mip and cut the lobe at the same extent.
+  /// texels of one eighth of one face, and applied to all 48 symmetric images of them, so each tap
+  /// is a multiply-add. false: the lobe is evaluated per tap (a 1024-step table for p >= 8), kept
+  /// for comparison. Both read the same input mip and cut the lobe at the same extent.
   bool precomputed_weights = true;
   /// Mip chains only (filter_mip_chain, filter_mip_chain_powers), texel-centre outputs only
   /// (fixup none; ignored otherwise): a level whose lobe is wider than the previous level's is
-  /// filtered from that previous output level with the differential lobe 1/q = 1/p_k - 1/p_(k-1)
-  /// (cos^p composes like a Gaussian for large p), so it reads a narrower lobe; only for levels
-  /// with p >= 256 (below, the composition is measurably not a cos^p lobe) whose previous level
-  /// has at least 2 texels_per_sigma sqrt(q) texels (it must resolve the lobe). Off by default;
-  /// docs/cubemap.md has the measured speed and error against brute force.
+  /// filtered from that previous output level with the differential lobe 1/q = 1/p_k - 1/p_(k-1),
+  /// so it reads a narrower lobe; only for levels with p >= 256 whose previous level has at least
+  /// 2 texels_per_sigma sqrt(q) texels. Off by default (docs/cubemap.md, "Cascade").
   bool cascade = false;
 };
 
@@ -227,11 +219,10 @@ struct filter_options {
 /// > 0, output_size outside [1, cubemap_max_size], or bad options. Cost: about
 /// 6 out^2 * 6 (4.3 r)^2 taps for narrow lobes, r the lobe's width in texels of the input mip
 /// read (texels_per_sigma to twice that, or less when the input's top level is coarser), the
-/// whole input mip for wide lobes; with precomputed_weights a tap is a multiply-add (~1 ns on
-/// one core) and 1/48 of them also cost a weight evaluation. Extra memory with precomputed
-/// weights: the weights and runs of at most ~2M taps at a time (~16 MB), 4 bytes per output
-/// texel, and for RGB input a four-float copy of the input mip read (16 bytes per texel).
-/// Per-tap weights: ~5-7 ns per tap. 256^2 chain (gloss mapping): ~0.2 s on two cores.
+/// whole input mip for wide lobes; with precomputed_weights a tap is a multiply-add and 1/48 of
+/// them also cost a weight evaluation. Extra memory with precomputed weights: the weights and
+/// runs of at most ~2M taps at a time (~16 MB), 4 bytes per output texel, and for RGB input a
+/// four-float copy of the input mip read (16 bytes per texel).
 cube_image filter_cosine_power(const cubemap& input, float power, int output_size, const filter_options& options = {});
 
 /// Irradiance E(n) = integral of L(w) max(0, n.w) dw (W/m^2 for L in W/m^2/sr; a uniform sky L
@@ -287,13 +278,13 @@ std::array<double, 9> sh9_basis(const glm::dvec3& w) noexcept;
 
 /// Projects a cube-map level on SH bands 0-2 with exact texel solid angles (directions at
 /// texel centres). Deterministic for any thread count. Errors: error(invalid_argument) for an
-/// inconsistent or non-finite image. Cost: 6 n^2 * ~30 flops (256: ~2 ms on two cores).
+/// inconsistent or non-finite image. Cost: 6 n^2 * ~30 flops.
 sh9 project_sh9(const cube_image& level, int thread_count = 0);
 
 /// Irradiance at unit normal n from SH radiance: sum A_l L_lm Y_lm(n) with the clamped-cosine
 /// band factors A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4 (Ramamoorthi and Hanrahan 2001).
-/// Exact for radiance in bands 0-2; otherwise the known SH truncation error (<= ~3% for typical
-/// skies, larger for a small bright sun). Cost: ~40 flops.
+/// Exact for radiance in bands 0-2; otherwise the SH truncation error, large for a small bright
+/// sun (docs/cubemap.md). Cost: ~40 flops.
 glm::dvec4 sh9_irradiance(const sh9& radiance, const glm::dvec3& n) noexcept;
 
 /// A cube map of size `size` whose texels (directions from `mapping`) hold sh9_irradiance.
@@ -318,14 +309,14 @@ std::array<double, 25> sh25_basis(const glm::dvec3& w) noexcept;
 
 /// Projects a cube-map level on SH bands 0-4 with exact texel solid angles (directions at texel
 /// centres). Deterministic for any thread count. Errors: error(invalid_argument) for an
-/// inconsistent or non-finite image. Cost: 6 n^2 * ~100 flops (256: ~5 ms on one core).
+/// inconsistent or non-finite image. Cost: 6 n^2 * ~100 flops.
 sh25 project_sh25(const cube_image& level, int thread_count = 0);
 
 /// Irradiance at unit normal n from SH radiance of bands 0-4: sum A_l L_lm Y_lm(n), A_0 = pi,
 /// A_1 = 2 pi / 3, A_2 = pi / 4, A_3 = 0, A_4 = -pi / 24 (the clamped cosine's band factors;
-/// Ramamoorthi and Hanrahan 2001). What cmft's "bands 0-4" irradiance computes. The truncation
-/// error is smaller than sh9's but still large for a small bright source: for a point source the
-/// result near the terminator rings (docs/cubemap.md has the measured error on the test sky).
+/// Ramamoorthi and Hanrahan 2001), as cmft's "bands 0-4" irradiance. The truncation error is
+/// smaller than sh9's but still large for a small bright source, which rings near the terminator
+/// (docs/cubemap.md).
 /// Cost: ~100 flops.
 glm::dvec4 sh25_irradiance(const sh25& radiance, const glm::dvec3& n) noexcept;
 

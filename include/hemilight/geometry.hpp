@@ -189,8 +189,8 @@ double hemicube_texel_projected_solid_angle(int n, std::size_t index) noexcept;
 /// dropped beyond its byte budget; a table in use lives while held).
 class hemicube_table {
  public:
-  /// The shared table of resolution N, built on first use (cost: about 100 ns per texel, split
-  /// over all cores; N = 256 takes a few ms). Thread-safe.
+  /// The shared table of resolution N, built on first use (cost: O(N^2), split over all cores).
+  /// Thread-safe.
   /// Throws error(invalid_argument) if N is odd or outside [2, 4096].
   static std::shared_ptr<const hemicube_table> get(int n);
 

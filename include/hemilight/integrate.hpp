@@ -1,10 +1,8 @@
 // hemilight/integrate.hpp — from one hemicube buffer to irradiance, gradients and distances.
-//
-// One pass over the texels and one over the walls between them. All weights are exact and
-// precomputed once per resolution (integration_table): per texel the vector solid angle
-// V_i = integral of w dw over the texel (Lambert's formula), whose z component is the projected
-// solid angle; per wall between two neighbouring texels the coefficient of each translation-
-// gradient estimator. Derivations: docs/integration.md.
+// Weights are exact and precomputed once per resolution (integration_table): per texel the vector
+// solid angle V_i = integral of w dw over the texel, whose z component is the projected solid
+// angle; per wall between two neighbouring texels each estimator's coefficient. Derivations and
+// measured accuracy: docs/integration.md.
 //
 // Gradient convention (per colour channel c), world space, both vectors in the tangent plane:
 //
@@ -13,17 +11,10 @@
 // Rotation gradient: g_r = n x sum_i L_i V_i (exact for the radiance the hemicube sees: the
 // irradiance of a fixed radiance field is linear in n while no texel crosses the horizon).
 // Translation gradient, three estimators (translation_estimator):
-//   simple       sum_i L_i 3 P_i w_t,i / r_i: each texel's projected solid angle differentiated
-//                as if it saw a small patch facing the point; no parallax, no occlusion.
-//   classified   Ward & Heckbert's stratified gradient adapted to hemicube walls: each wall
-//                moves with the nearer of its two texels, classified as constant latitude (rate
-//                cos(theta)/r) or constant longitude (rate 1/(r sin(theta))), length = arc length,
-//                direction = normalize((d0 x d1)_t).
-//   great_arc    (default) a hemicube wall is a great arc with constant normal m = normalize(d0 x d1);
-//                a translation u moves it at the rate (u.m)/r_min, so its coefficient is
-//                m_t * (integral of cos(theta) along the arc) / r_min.
-// All three weight a wall (or texel) by the cosine where the radiance changes, not by the texels'
-// own cosines (the latter biases the gradient wherever lit surfaces are near: docs/integration.md).
+//   simple       sum_i L_i 3 P_i w_t,i / r_i: no parallax, no occlusion (for comparison).
+//   classified   Ward & Heckbert's stratified gradient adapted to hemicube walls (for comparison).
+//   great_arc    (default) each wall, a great arc with normal m = normalize(d0 x d1), moves at the
+//                rate (u.m)/r_min: coefficient m_t * (integral of cos(theta) along the arc) / r_min.
 //
 // Robustness: misses (distance +inf) contribute to E but a wall uses the finite side's distance
 // (a wall between two misses contributes nothing). A wall's distance is clamped from below by
@@ -57,12 +48,8 @@ struct integrate_options {
   /// centre distance (Ward and Heckbert); true extrapolates the nearer texel's inverse distance
   /// half a texel to the wall, from its neighbour on the far side (when that neighbour's depth is
   /// closer to it than the other texel's, i.e. the wall is the discontinuity), clamped to [1/2, 2]
-  /// x the centre's. The centre's distance is biased where the depth changes fast across a texel:
-  /// a plane seen at a grazing angle, an emitter seen edge-on (docs/integration.md: g_t of an
-  /// emitter 2 mm above the point's plane, N = 256, 23% -> 0.97% error; of a wall beside the
-  /// point, 3.8% -> 0.13%). Cost: ~1.0-1.1x the integration time with the AVX2 kernels, one more
-  /// pass over the walls without them. Off by default: the cache's error curves with it are mixed
-  /// (docs/cache.md, "Measured"; docs/design/cache.md).
+  /// x the centre's: for planes seen at a grazing angle (docs/integration.md, section 6). Cost:
+  /// one more pass over the walls without the AVX2 kernels.
   bool extrapolate_wall_depth = false;
   bool directional = false;  ///< also compute L1 spherical harmonics and the Half-Life 2 basis irradiance
   bool double_precision = false;  ///< accumulate in double instead of float (slower; for checks)
@@ -102,8 +89,7 @@ struct irradiance_sample {
 class integration_table {
  public:
   /// The shared table of resolution N (cached like hemicube_table: in the table cache of
-  /// memory.hpp, within its budget; a table in use lives while held). Cost of a build: ~1 us
-  /// per texel.
+  /// memory.hpp, within its budget; a table in use lives while held). Cost of a build: O(N^2).
   /// Throws error(invalid_argument) for an invalid N.
   static std::shared_ptr<const integration_table> get(int n);
   explicit integration_table(int n);  ///< builds a private table; prefer get()
@@ -146,10 +132,9 @@ class hemicube_integrator {
 
   /// Integrates one buffer. Precondition: buffer.resolution == resolution() and the buffer's
   /// arrays have 3 N^2 entries (throws error(invalid_argument) otherwise); radiance finite and
-  /// >= 0, distances > 0 or +inf (asserted in debug builds). Cost at N = 64: ~12k texels and
-  /// ~25k walls, tens of microseconds; less for mostly black (emission-only) hemicubes, whose
-  /// black texel groups the AVX2 kernels skip. Whether they look for them depends on the last
-  /// hemicubes this integrator saw, which changes the speed only, never a bit of the result.
+  /// >= 0, distances > 0 or +inf (asserted in debug builds). Cost: O(N^2) (3 N^2 texels, about
+  /// 6 N^2 walls); less for mostly black hemicubes, whose black texel groups the AVX2 kernels
+  /// skip. The result does not depend on the hemicubes this integrator saw before.
   irradiance_sample integrate(const hemicube_buffer& buffer);
 
   int resolution() const noexcept { return n_; }

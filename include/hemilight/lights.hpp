@@ -26,48 +26,24 @@
 //                normalised); width and height (> 0, m) along t and b = n x t; color = radiance
 //                (W/m^2/sr). Its corners are centre +- width/2 t +- height/2 b.
 //
-// Unoccluded irradiance at a point p with unit normal n (unoccluded_irradiance):
-//   hard point, spot: I cos(theta) / d^2 (times the spot factor); 0 for d = 0.
-//   hard sun: E cos(theta).
-//   sphere or sun disc (a cone of directions of half-angle a, sin a = r / d or the angular
-//     radius, of uniform radiance L): fully above the horizon (theta <= pi/2 - a)
-//     E = pi L sin^2(a) cos(theta) (= the hard light's value); straddling the horizon the exact
-//     irradiance of a cone cut by the horizon (Snyder 1996, "Area light sources for real-time
-//     graphics"; the form of Lagarde and de Rousiers 2014, "Moving Frostbite to PBR"):
-//       x = cot a, y = -x cot(theta),
-//       E = L [ (cos(theta) acos(y) - x sin(theta) sqrt(1 - y^2)) sin^2(a)
-//               + atan(sin(theta) sqrt(1 - y^2) / x) ]
-//     A point inside the sphere (d <= r) gets the limit a = pi/2: E = pi L (1 + cos(theta)) / 2.
+// Unoccluded irradiance at a point p with unit normal n (unoccluded_irradiance; the formulas:
+// docs/lights.md, "Unoccluded irradiance"):
+//   hard point, spot: I cos(theta) / d^2 (times the spot factor); 0 for d = 0. Hard sun: E cos(theta).
+//   sphere or sun disc (a cone of half-angle a, sin a = r / d or the angular radius, of uniform
+//     radiance L): fully above the horizon pi L sin^2(a) cos(theta), the hard light's value;
+//     straddling it, the exact irradiance of the cone cut by the horizon (Snyder 1996); inside
+//     the sphere (d <= r) pi L (1 + cos(theta)) / 2.
 //   rect: 0 if p is not in front of the emitting side; otherwise Lambert's formula on the
-//     rectangle clipped to the half-space in front of p's tangent plane (Sutherland-Hodgman),
-//       E = (L / 2) | sum_i angle(v_i, v_i+1) n . normalize(v_i x v_i+1) |,  v_i = q_i - p,
-//     in double (angles by atan2(|v_i x v_i+1|, v_i . v_i+1)). Exact where the light is visible.
+//     rectangle clipped to p's upper half-space, in double. Exact where the light is visible.
 //
-// Shadows (direct_irradiance): E = unoccluded E x visibility, visibility in [0, 1] from shadow
-// rays (occluded(), rays.hpp; every triangle, either side) from p + offset n (see direct_options)
-// towards the light, stopping `offset` before the light's surface (so a light lying on a wall or
-// ceiling is not shadowed by it). Hard lights: one ray, visibility 0 or 1. Soft lights (radius > 0;
-// rect always): samples over the light's extent, stratified, from a (0, 2)-sequence in base 2 (the
-// first two Sobol dimensions) with a random digital shift seeded by a hash of the point's and the
-// normal's float bits and the light's index: each prefix of 2^k samples is a (0, k, 2)-net (one
-// sample in each of 2^k equal strata of any elementary shape), and the pattern at a point never
-// depends on threads or call order. Sun and spheres: uniform over the cone of directions the
-// light fills seen from p (equal-area map of the unit square to the cap); rect: uniform over its
-// area. Samples below p's horizon are not traced. Visibility is the weighted fraction
-// sum(V_i w_i) / sum(w_i) with w_i the sample's share of the irradiance (cone: cos(theta_i);
-// rect: cos(theta_i) cos(theta'_i) / d_i^2), so it is exact for a fully visible or fully blocked
-// light and a consistent ratio estimate in between. Adaptive: probes first, 8 points on the
-// light's outline (a rect's corners and edge midpoints; eight points on a cone's rim) plus the
-// sequence's first probe_samples samples. If every probe above the horizon agrees (all visible
-// or all blocked) the visibility is 1 or 0; otherwise the sequence continues to
-// penumbra_samples samples (its probes kept; the outline probes only decide, they would bias the
-// estimate towards the edges). A straight occluder edge across a rect always leaves corners on
-// both sides, so half-plane penumbrae are never missed; on a disc the eight rim points miss at
-// most a segment of 1.3% of its area. An occluder that blocks only the light's interior
-// (a thin pole) is found only where an interior probe sees it. If no sample is above the horizon
-// though the closed form is not 0 (a sliver of the light), one ray decides (rect: to the centroid
-// of the clipped polygon; cone: to its rim point nearest p's normal). Measured errors:
-// docs/lights.md.
+// Shadows (direct_light): E = unoccluded E x visibility, visibility in [0, 1] from shadow rays
+// (occluded(), rays.hpp; every triangle, either side) from p + offset n (direct_options) towards
+// the light, stopping `offset` before the light's surface. Hard lights: one ray, visibility 0 or
+// 1. Soft lights (radius > 0; rect always): the irradiance-weighted fraction of stratified
+// samples over the light's extent, exact for a fully visible or fully blocked light; 8 outline
+// probes and probe_samples samples first, continued to penumbra_samples where they disagree
+// (docs/lights.md, "Visibility"). The samples depend only on the point, the normal and the
+// light's index, never on threads or call order.
 //
 // Thread safety: light_set is immutable after construction; the functions below keep no state
 // and allocate nothing, so any number of threads may evaluate the same lights at once.
@@ -121,10 +97,8 @@ struct direct_options {
   /// is fully visible or fully blocked.
   int probe_samples = 4;
   /// Samples in a penumbra, the interior probes included (<= 65536), so a penumbra point costs
-  /// 8 + penumbra_samples rays. Powers of two keep the set a (0, k, 2)-net. RMS error in the
-  /// penumbrae of three scenes against 4096 samples, as a fraction of the unoccluded irradiance:
-  /// 0.4-0.6% with 256 (the default), 0.8-1.2% with 128, 1.4-1.5% with 64 (docs/lights.md).
-  /// Penumbrae are a few percent of a scene's points, so the default costs little.
+  /// 8 + penumbra_samples rays. Powers of two keep the set a (0, k, 2)-net. The penumbra error
+  /// against the count: docs/lights.md.
   int penumbra_samples = 256;
   /// Ray origin offset along the normal: offset_scale x scene.size() + 2^-18 x max |p_i| (the
   /// second term keeps the offset above float rounding far from the origin). 1e-4 is the
@@ -186,7 +160,7 @@ struct light_sample {
 
 /// Unoccluded irradiance of light i at p with unit normal n (the closed forms at the top of this
 /// header), RGB W/m^2. Preconditions: i < lights.size(), p finite, |n| = 1 (asserted to 1e-3).
-/// Cost: a few dozen flops (rect: clipping and Lambert's formula in double, ~0.1 us).
+/// Cost: O(1) (rect: clipping and Lambert's formula in double).
 glm::vec3 unoccluded_irradiance(const light_set& lights, std::size_t i, const glm::vec3& p, const glm::vec3& n) noexcept;
 
 /// Direct irradiance of light i at p with unit normal n, with shadows against `s`.
@@ -206,9 +180,7 @@ glm::vec3 direct_irradiance(const scene& s, const light_set& lights, const glm::
                             const direct_options& options = {}, light_sample* per_light = nullptr);
 
 /// Emissive rectangles as RECT lights, so that their direct light is computed exactly at every
-/// point (closed form, shadow rays) instead of seen by hemicubes (which alias small emitters and
-/// make the cache place records along their light's edges).
-/// Finds pairs of one-sided emissive triangles of `mesh` that share an edge (the same two vertex
+/// point (closed form, shadow rays) instead of seen by hemicubes. Finds pairs of one-sided emissive triangles of `mesh` that share an edge (the same two vertex
 /// positions, bit for bit, whatever the indices), have the same emission (bit for bit), face the
 /// same way and together form a rectangle: the shared edge is its diagonal, the two other corners
 /// see it at right angles and the fourth corner is where a rectangle puts it, each within 1e-4 of

@@ -22,9 +22,8 @@
 namespace hemilight {
 
 /// The default budget of the table cache: 256 MiB. It retains every table of two resolutions up
-/// to N = 512 at once (one sampler, cache and probe set at N = 512 needs about 106 MiB of tables),
-/// so common use never rebuilds a table, while a process that used many resolutions keeps at
-/// most this much (the tables of N = 402..512 alone add up to 2.45 GB).
+/// to N = 512 at once (about 106 MiB per resolution), so common use never rebuilds a table, while
+/// a process that used many resolutions keeps at most this much.
 inline constexpr std::size_t default_table_budget = std::size_t(256) << 20;
 
 /// Sets the table cache's byte budget (0: retain nothing; tables then live only while held) and

@@ -19,7 +19,7 @@ int resolve_thread_count(int thread_count) noexcept;
 /// when all are done. With one worker, or count <= grain, everything runs on the calling thread
 /// as worker 0 (no thread is started). The first exception thrown by a body stops the handing
 /// out of new chunks and is rethrown here after all workers have finished.
-/// Cost: one std::thread start per extra worker per call (~20 us); use grains of >= 50 us work.
+/// Cost: one std::thread start per extra worker per call; give each grain far more work than that.
 void parallel_for(std::size_t count, int thread_count, std::size_t grain,
                   const std::function<void(int worker, std::size_t begin, std::size_t end)>& body);
 

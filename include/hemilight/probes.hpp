@@ -15,17 +15,11 @@
 // Coefficient k of a probe = integral over the whole sphere of L(w) Y_k(w) d omega (radiance in
 // W m^-2 sr^-1, so a uniform sky of radiance L gives c_0 = 2 sqrt(pi) L and the rest 0).
 //
-// How a probe is made: two hemicubes of the same resolution N at the point, one looking up the
-// world +z axis (frame t = +x, b = +y) and one down -z (t = +x, b = -y): together the six faces
-// of a cube, every direction once. Each texel's radiance is taken as constant over the texel, and
-// each basis function is integrated exactly over each texel (4 x 4 Gauss-Legendre points per
-// texel on the face plane, per eighth of a face for N < 16, in double; the tests check the
-// basis' integrals over the sphere), so the only error is the texel's constant radiance (edges
-// inside texels). Lights (lights.hpp) add their direct part at the point: each
-// light as a point source from the direction of its visible vector irradiance, with the
-// irradiance a surface facing that direction would get, shadows included (exact for hard point,
-// spot and directional lights; for soft lights and rects the error is second order in the
-// light's angular size).
+// A probe is two hemicubes of resolution N at the point, up +z (t = +x, b = +y) and down -z
+// (t = +x, b = -y), with each basis function integrated exactly over each texel: the only error
+// is the texel's constant radiance. Lights (lights.hpp) add their direct part as point sources
+// along their visible vector irradiance, shadows included: exact for hard lights, second order
+// in the angular size for soft ones and rects. Method and figures: docs/probes.md.
 //
 // A probe inside closed geometry sees the back faces of one-sided triangles: probe_result's
 // backface_fraction (the solid-angle fraction of the sphere that sees back faces) is near 1 for
@@ -56,21 +50,15 @@ std::array<float, 9> sh9_basis(const glm::vec3& w) noexcept;
 /// clamped-cosine convolution, E(n) = sum_k A_l c_k Y_k(n) with A_0 = pi, A_1 = 2 pi / 3,
 /// A_2 = pi / 4 (Ramamoorthi and Hanrahan 2001). `normal` need not be unit length (it is
 /// normalised); a zero or non-finite normal gives 0. Negative results (ringing of a small bright
-/// source) are returned as they are. Error of the band limit for a small bright source (a cap of
-/// half-angle 5 deg whose exact irradiance facing it is 1; exact E = cos(theta) up to 85 deg):
-///   theta  0       30      60      90      120      180
-///   SH9    1.062   0.878   0.462   0.095   -0.038   0.062   (exact: 1, 0.866, 0.5, ~0, 0, 0)
-/// i.e. up to +6% of the facing value where the light is, ringing of -4% .. +10% of it elsewhere
-/// (a delta source: 1.0625 facing it). Smooth lighting (sky, bounces) loses far less.
-/// Cost: ~30 flops.
+/// source) are returned as they are (docs/probes.md, "What SH9 can and cannot hold"; a delta
+/// source gives 1.0625 x its irradiance facing it). Cost: ~30 flops.
 glm::vec3 sh9_irradiance(const sh9_rgb& coefficients, const glm::vec3& normal) noexcept;
 
 /// Options of sample_probes.
 struct probe_options {
   int resolution = 64;  ///< hemicube N of each of the two hemicubes: even, in [hemicube_min_resolution, hemicube_max_resolution]
   /// How the hemicubes are drawn: near plane, environment sky (`raster.sky`; null: the scene's
-  /// constant sky), exact edge coverage (removes the edge aliasing of emitters, docs/probes.md; the
-  /// covered share is measured in projected solid angle, not per basis function).
+  /// constant sky), exact edge coverage (docs/probes.md).
   raster_options raster;
   int thread_count = 0;                    ///< >= 0; 0 = all cores. Results do not depend on it.
   std::shared_ptr<const light_set> lights; ///< lights (null: none)
@@ -93,9 +81,8 @@ struct probe_result {
 /// Errors (error(invalid_argument), naming what): a null scene or positions with count > 0, a
 /// non-finite position ("positions[7].y is nan"), an invalid resolution, a negative
 /// thread_count, bad direct options, an invalid texture or one on a scene without lightmap UVs.
-/// Cost: 2 hemicubes and their projections per point (Cornell box, N = 64: ~140 us on one core,
-/// 7k probes/s; docs/probes.md) plus the lights' shadow rays; tables of 36 N^2 floats per N
-/// (kept in the table cache of memory.hpp, within its budget).
+/// Cost: 2 hemicubes and their projections per point, O(N^2), plus the lights' shadow rays;
+/// tables of 36 N^2 floats per N (kept in the table cache of memory.hpp, within its budget).
 probe_result sample_probes(std::shared_ptr<const scene> s, const glm::vec3* positions, std::size_t count,
                            const probe_options& options = {});
 

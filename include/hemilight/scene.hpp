@@ -32,7 +32,7 @@ namespace hemilight {
 namespace detail {
 struct lazy_slot;   // data derived from the scene on first use: rays.hpp's Embree scene (src/scene/scene_access.hpp)
 struct ray_access;
-struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene_internal.hpp)
+struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene/scene_access.hpp)
 }  // namespace detail
 
 /// Per-triangle material: what the hemicube sees of a triangle and what a bounce needs.
@@ -127,9 +127,9 @@ class scene {
   ///     12 vertices"); a negative or non-finite emission, albedo or sky radiance.
   ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
   /// Zero-area triangles (repeated indices, collinear or coincident positions) are accepted and
-  /// never drawn. Cost: O(T log^2 T) for T triangles (1M triangles: about a second on one core);
-  /// memory about 140 bytes per triangle. The ray queries' Embree scene (rays.hpp) is not built
-  /// here but on the first ray query or prepare_rays() call.
+  /// never drawn. Cost: O(T log^2 T) for T triangles; memory about 140 bytes per triangle. The
+  /// ray queries' Embree scene (rays.hpp) is not built here but on the first ray query or
+  /// prepare_rays() call.
   static std::shared_ptr<const scene> create(const scene_desc& desc);
 
   std::size_t vertex_count() const noexcept { return positions_.size(); }
@@ -144,8 +144,7 @@ class scene {
   const material& triangle_material(std::size_t i) const noexcept { return materials_[i]; }
   /// The distinct emissions of the scene's materials (compared bit for bit), in order of first
   /// appearance; emission_index(i) is triangle i's entry (scene_desc numbering; precondition:
-  /// i < triangle_count()). The rasterizer labels what each texel sees with this small number
-  /// instead of comparing radiances, so its resolve finds runs of equal radiance cheaply.
+  /// i < triangle_count()). The rasterizer labels what each texel sees with this number.
   const std::vector<glm::vec3>& emissions() const noexcept { return emissions_; }
   std::uint32_t emission_index(std::size_t i) const noexcept { return emission_index_[i]; }
   bool has_lightmap_uvs() const noexcept { return !uvs_.empty(); }
