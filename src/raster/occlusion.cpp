@@ -10,6 +10,7 @@
 // stale as the buffer fills (their least depth only grows, so a stale value is conservative) and
 // are refreshed when a test reads them after a leaf was drawn over them.
 #include "internal.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -68,31 +69,77 @@ bool raster_detail::rasterizer_impl::ties_decide_order() const {
   return false;
 }
 
-bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, const node_rects& r, float nearest) {
+namespace {
+
+// The least of the texels [x0, x1] (within one tile: x1 - x0 < 8) of rows y0..y1 of a face's
+// depths d (rows of `width` texels; reading eight texels from x0 stays inside the buffer, which is
+// padded by eight).
+float least_in_rows(const float* d, int width, int x0, int x1, int y0, int y1) noexcept {
+#if HEMILIGHT_RASTER_SSE2
+  // Lanes outside [x0, x1] read +inf.
+  const __m128 inf = _mm_set1_ps(INFINITY);
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3), count = _mm_set1_epi32(x1 - x0 + 1);
+  const __m128 keep_lo = _mm_castsi128_ps(_mm_cmpgt_epi32(count, lane));
+  const __m128 keep_hi = _mm_castsi128_ps(_mm_cmpgt_epi32(count, _mm_add_epi32(lane, _mm_set1_epi32(4))));
+  __m128 least = inf;
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x0;
+    const __m128 a = _mm_or_ps(_mm_and_ps(keep_lo, _mm_loadu_ps(row)), _mm_andnot_ps(keep_lo, inf));
+    const __m128 b = _mm_or_ps(_mm_and_ps(keep_hi, _mm_loadu_ps(row + 4)), _mm_andnot_ps(keep_hi, inf));
+    least = _mm_min_ps(least, _mm_min_ps(a, b));
+  }
+  least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(1, 0, 3, 2)));
+  least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(least);
+#else
+  float least = INFINITY;
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+    for (int x = x0; x <= x1; ++x) least = std::min(least, row[x]);
+  }
+  return least;
+#endif
+}
+
+}  // namespace
+
+bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, int rx0, int rx1, int ry0, int ry1,
+                                                    float nearest) {
   const std::size_t t = tile_offset_[face] + static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) +
                         static_cast<std::size_t>(tx);
-  if (!tile_dirty_[t] && nearest < tile_depth_[t]) return true;
-  // The texels of the rectangle in the tile, until one is as near as the node may be (or empty).
   const int rows = face == 0 ? n_ : n_ / 2;
   const int tile_x0 = tx << tile_bits, tile_y0 = ty << tile_bits;
   const int tile_x1 = std::min(tile_x0 + tile_size, n_) - 1, tile_y1 = std::min(tile_y0 + tile_size, rows) - 1;
-  const int x0 = std::max(r.x0[face], tile_x0), x1 = std::min(r.x1[face], tile_x1);
-  const int y0 = std::max(r.y0[face], tile_y0), y1 = std::min(r.y1[face], tile_y1);
   const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(face));
-  float least = INFINITY;
-  for (int y = y0; y <= y1; ++y) {
-    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_);
-    for (int x = x0; x <= x1; ++x) {
-      if (!(nearest < row[x])) return false;
-      least = std::min(least, row[x]);
-    }
-  }
-  // Every texel read: when that was the whole tile, its least depth is known again.
-  if (tile_dirty_[t] && x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) {
-    tile_depth_[t] = least;
+  if (tile_dirty_[t]) {
+    tile_depth_[t] = least_in_rows(d, n_, tile_x0, tile_x1, tile_y0, tile_y1);
     tile_dirty_[t] = 0;
   }
+  if (nearest < tile_depth_[t]) return true;
+  // The tile holds a texel as near as `nearest` (or an empty one): is it in the rectangle?
+  const int x0 = std::max(rx0, tile_x0), x1 = std::min(rx1, tile_x1);
+  const int y0 = std::max(ry0, tile_y0), y1 = std::min(ry1, tile_y1);
+  if (x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) return false;
+  return nearest < least_in_rows(d, n_, x0, x1, y0, y1);
+}
+
+bool raster_detail::rasterizer_impl::rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest) {
+  // Hidden when `nearest` is below the depth of every texel of the rectangle, read per tile from
+  // the tile's least depth where it is known and high enough.
+  for (int ty = y0 >> tile_bits; ty <= (y1 >> tile_bits); ++ty)
+    for (int tx = x0 >> tile_bits; tx <= (x1 >> tile_bits); ++tx)
+      if (!hidden_in_tile(face, tx, ty, x0, x1, y0, y1, nearest)) return false;
   return true;
+}
+
+bool raster_detail::rasterizer_impl::plane_hidden(int face, const texel_box& box, const face_setup& fs) {
+  // The plane's depth is affine in the texel indices: its largest over the box is at a corner.
+  const double xs[2] = {static_cast<double>(box.x_begin), static_cast<double>(box.x_end)};
+  double nearest = 0.0;
+  for (const std::int64_t y : {box.y_begin, box.y_end})
+    for (const double x : xs) nearest = std::max(nearest, fs.z00 + fs.dzdy * static_cast<double>(y) + double(fs.dzdx) * x);
+  return rect_hidden(face, static_cast<int>(box.x_begin), static_cast<int>(box.x_end), static_cast<int>(box.y_begin),
+                     static_cast<int>(box.y_end), static_cast<float>(nearest * depth_margin));
 }
 
 unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position,
@@ -170,11 +217,7 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     rects.y1[f] = y1;
     // Hidden when its nearest depth, with the margin, is below the depth of every texel of its
     // rectangle, read per tile from the tile's least depth where it is known and high enough.
-    const float nearest = depth_margin / w_min;
-    bool hidden = true;
-    for (int ty = y0 >> tile_bits; hidden && ty <= (y1 >> tile_bits); ++ty)
-      for (int tx = x0 >> tile_bits; hidden && tx <= (x1 >> tile_bits); ++tx) hidden = hidden_in_tile(f, tx, ty, rects, nearest);
-    if (hidden) mask &= ~(1u << f);
+    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_min)) mask &= ~(1u << f);
   }
   return mask;
 }
