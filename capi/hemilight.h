@@ -113,7 +113,9 @@ HEMILIGHT_API hemilight_status hemilight_exr_info(const char* path, int* width, 
 
 /* Reads an EXR image as float RGB into rgb (capacity in floats, at least width x height x 3).
  * width and height (may be NULL) receive the size. Errors: as hemilight_exr_info, and
- * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). */
+ * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). The size
+ * in the header is compared with capacity before any pixel is decoded: a refusal costs about a
+ * millisecond, whatever size the file claims. */
 HEMILIGHT_API hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t capacity, int* width,
                                                       int* height);
 
@@ -127,7 +129,8 @@ HEMILIGHT_API hemilight_status hemilight_exr_save_rgb(const char* path, const fl
 /* Reads an ENVMAP_CUBE EXR (size x 6 size) as six GL-ordered faces of float RGB into faces
  * (capacity in floats, at least 6 x size x size x 3); size receives the face size (may be NULL).
  * Errors: as hemilight_exr_load_rgb, and UNSUPPORTED when the image is not 6x as tall as wide or
- * is a latlong map. */
+ * is a latlong map. The shape and the capacity are checked from the header, before any pixel is
+ * decoded. */
 HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, float* faces, size_t capacity,
                                                               int* size);
 

@@ -101,7 +101,9 @@ void check_header_sizes(const std::string& path, const char* function) {
   }
 }
 
-raw_read read_raw(const std::string& path, int channels, const char* function, bool pixels = true) {
+// cube: the image must be a cube map (w x 6w, no latlong envmap attribute), checked from the
+// header before any pixel is decoded.
+raw_read read_raw(const std::string& path, int channels, const char* function, bool pixels = true, bool cube = false) {
   check_channels_arg(channels, function, true);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(status::io, function, path, "no such file");
@@ -139,6 +141,11 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
       out.has_envmap = true;
       out.envmap = Imf::envmap(header);
     }
+    if (cube && out.has_envmap && out.envmap != Imf::ENVMAP_CUBE)
+      fail(status::unsupported, function, path, "envmap attribute is latlong, not cube");
+    if (cube && h != 6 * w)
+      fail(status::unsupported, function, path,
+           "a cube map must be w x 6w pixels; this file is " + std::to_string(w) + " x " + std::to_string(h));
     if (!pixels) return out;
     out.pixels.assign(count * static_cast<std::size_t>(out.channels), 0.0f);
     Imf::FrameBuffer fb;
@@ -303,13 +310,9 @@ void write_exr(const std::string& path, const image& img, exr_pixel_type type) {
 }
 
 cube_image read_exr_cubemap(const std::string& path, int channels) {
-  raw_read raw = read_raw(path, channels, "read_exr_cubemap");
-  if (raw.has_envmap && raw.envmap != Imf::ENVMAP_CUBE)
-    fail(status::unsupported, "read_exr_cubemap", path, "envmap attribute is latlong, not cube");
-  if (static_cast<long long>(raw.height) != 6LL * raw.width)
-    fail(status::unsupported, "read_exr_cubemap", path,
-         "a cube map must be w x 6w pixels; this file is " + std::to_string(raw.width) + " x " +
-             std::to_string(raw.height));
+  // The shape is checked from the header (read_raw's cube): a file that is no cube map fails
+  // before its pixels are decoded.
+  raw_read raw = read_raw(path, channels, "read_exr_cubemap", true, true);
   cube_image cube;
   cube.size = raw.width;
   cube.channels = raw.channels;

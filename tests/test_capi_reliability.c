@@ -1,9 +1,11 @@
 /* C99 regression tests of the C ABI's reliability fixes, one per reproducer of a fuzzing run:
  * tiny and huge normals and directions (their squares under- or overflow float), points spanning
  * more than float can square, radiance near FLT_MAX and lights whose irradiance overflows (refused,
- * never +inf on OK), the EXR writers' and cube maps' size limits, and bake errors in the caller's
- * terms (the mesh and the index within it). References: closed forms (a uniform sky gives pi L)
- * and the same call with the unit vector. Prints failing checks and "N passed, N failed". */
+ * never +inf on OK), the EXR writers' and cube maps' size limits, bake errors in the caller's
+ * terms (the mesh and the index within it), and crafted EXR files refused within 64 MiB (peak
+ * resident set of a child process). References: closed forms (a uniform sky gives pi L) and the
+ * same call with the unit vector. Prints failing checks and "N passed, N failed". */
+#define _POSIX_C_SOURCE 200809L /* fork, pipe, getrusage */
 #include "capi_check.h"
 
 #include <float.h>
@@ -11,6 +13,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#if defined(__unix__) || defined(__APPLE__)
+#define HAVE_FORK 1
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#endif
 
 static const double pi = 3.14159265358979323846;
 
@@ -216,6 +226,106 @@ static void test_crafted_exr(const char* data) {
   CHECK(w == -7 && h == -7 && cube == -7 && px[0] == -7.0f);
 }
 
+#if HAVE_FORK
+/* What a child process reports of one EXR load: the call's status and message, whether the
+ * 48-float buffer stayed untouched, and the child's peak resident set (getrusage). */
+struct load_report {
+  int status, untouched;
+  long peak_kib;
+  char message[400];
+};
+
+/* Runs entry 0 (hemilight_exr_info), 1 (hemilight_exr_load_rgb) or 2 (hemilight_exr_load_cubemap_rgb)
+ * on `path` in a child process, with a buffer of 48 floats. Returns 0 and fills *r, or -1 if the
+ * child could not run. */
+static int load_in_child(const char* path, int entry, struct load_report* r) {
+  int fd[2], child_status = 0;
+  pid_t pid;
+  ssize_t got;
+  if (pipe(fd) != 0) return -1;
+  fflush(stdout);
+  pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    struct load_report c;
+    struct rusage u;
+    float px[48];
+    int i, w = -7, h = -7, cube = -7;
+    close(fd[0]);
+    memset(&c, 0, sizeof c);
+    for (i = 0; i < 48; ++i) px[i] = -7.0f;
+    c.status = entry == 0   ? (int)hemilight_exr_info(path, &w, &h, &cube)
+               : entry == 1 ? (int)hemilight_exr_load_rgb(path, px, 48, &w, &h)
+                            : (int)hemilight_exr_load_cubemap_rgb(path, px, 48, &w);
+    getrusage(RUSAGE_SELF, &u);
+#if defined(__APPLE__)
+    c.peak_kib = (long)(u.ru_maxrss / 1024); /* bytes there */
+#else
+    c.peak_kib = (long)u.ru_maxrss; /* KiB on Linux */
+#endif
+    c.untouched = 1;
+    for (i = 0; i < 48; ++i) c.untouched = c.untouched && px[i] == -7.0f;
+    if (c.status != HEMILIGHT_OK) c.untouched = c.untouched && w == -7 && h == -7 && cube == -7;
+    strncpy(c.message, hemilight_last_error(), sizeof c.message - 1);
+    got = write(fd[1], &c, sizeof c);
+    _exit(got == (ssize_t)sizeof c ? 0 : 1);
+  }
+  close(fd[1]);
+  got = read(fd[0], r, sizeof *r);
+  close(fd[0]);
+  if (waitpid(pid, &child_status, 0) != pid || got != (ssize_t)sizeof *r) return -1;
+  return WIFEXITED(child_status) && WEXITSTATUS(child_status) == 0 ? 0 : -1;
+}
+
+/* Every entry that reads EXR refuses each crafted file with a peak resident set under 64 MiB
+ * (measured in a child process: getrusage's ru_maxrss, the whole process, about 8 MiB before the
+ * call; 30 MiB under ASan, whose shadow memory counts too). Before the loaders compared the header's
+ * size with the capacity, exr_load_capacity_checked_after_decode.exr (377 bytes, RLE, a 16,514,819 x 2
+ * data window that hemilight_exr_info accepts) was decoded into a temporary first: 480 MiB peak in
+ * both loaders; exr_cube_768_constant.exr (a valid 768 x 4608 cube map of 0.25, written by
+ * hemilight_exr_save_cubemap_rgb with half_float = 1) cost the cube-map loader 89 MiB. */
+static void test_crafted_exr_peak(const char* data) {
+  struct case_ {
+    const char* file;
+    int entry;
+    hemilight_status status;
+    const char* why;
+  };
+  static const struct case_ cases[] = {
+      {"exr_load_capacity_checked_after_decode.exr", 0, HEMILIGHT_OK, ""},
+      {"exr_load_capacity_checked_after_decode.exr", 1, HEMILIGHT_ERROR_INVALID_ARGUMENT,
+       "hemilight_exr_load_rgb: capacity 48 floats is too small"},
+      {"exr_load_capacity_checked_after_decode.exr", 2, HEMILIGHT_ERROR_UNSUPPORTED, "a cube map must be w x 6w pixels"},
+      {"exr_cube_768_constant.exr", 1, HEMILIGHT_ERROR_INVALID_ARGUMENT, "capacity 48 floats is too small"},
+      {"exr_cube_768_constant.exr", 2, HEMILIGHT_ERROR_INVALID_ARGUMENT,
+       "hemilight_exr_load_cubemap_rgb: capacity 48 floats is too small"},
+      {"exr_header_16384x16384_incomplete.exr", 0, HEMILIGHT_ERROR_IO, "truncated"},
+      {"exr_header_16384x16384_incomplete.exr", 1, HEMILIGHT_ERROR_IO, "truncated"},
+      {"exr_header_16384x16384_incomplete.exr", 2, HEMILIGHT_ERROR_IO, "truncated"},
+      {"exr_header_16384x16385_incomplete.exr", 0, HEMILIGHT_ERROR_OUT_OF_MEMORY, "2^28 pixels"},
+      {"exr_header_16384x16385_incomplete.exr", 1, HEMILIGHT_ERROR_OUT_OF_MEMORY, "2^28 pixels"},
+      {"exr_header_16384x16385_incomplete.exr", 2, HEMILIGHT_ERROR_OUT_OF_MEMORY, "2^28 pixels"},
+      {"exr_opaque_attr_1.6GB_alloc.exr", 0, HEMILIGHT_ERROR_IO, "claims 1634231040 bytes"},
+      {"exr_opaque_attr_1.6GB_alloc.exr", 1, HEMILIGHT_ERROR_IO, "claims 1634231040 bytes"},
+      {"exr_opaque_attr_1.6GB_alloc.exr", 2, HEMILIGHT_ERROR_IO, "claims 1634231040 bytes"}};
+  const long limit_kib = 64 * 1024;
+  char path[1024];
+  size_t i;
+  for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    struct load_report r;
+    snprintf(path, sizeof path, "%s/%s", data, cases[i].file);
+    CHECK(load_in_child(path, cases[i].entry, &r) == 0);
+    CHECK(r.status == (int)cases[i].status);
+    CHECK(strstr(r.message, cases[i].why) != NULL);
+    CHECK(r.untouched);
+    CHECK(r.peak_kib > 0 && r.peak_kib < limit_kib);
+    if (r.status != (int)cases[i].status || !strstr(r.message, cases[i].why) || !(r.peak_kib > 0 && r.peak_kib < limit_kib))
+      printf("  %s, entry %d: status %d, peak %ld KiB, message: %s\n", cases[i].file, cases[i].entry, r.status, r.peak_kib,
+             r.message);
+  }
+}
+#endif
+
 int main(int argc, char** argv) {
   test_normals_and_radiance();
   test_light_overflow();
@@ -224,6 +334,9 @@ int main(int argc, char** argv) {
   test_sizes_and_messages(argc > 1 ? argv[1] : ".");
   test_bake_messages();
   if (argc > 2) test_crafted_exr(argv[2]);
+#if HAVE_FORK
+  if (argc > 2) test_crafted_exr_peak(argv[2]);
+#endif
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }
