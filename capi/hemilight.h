@@ -21,6 +21,13 @@
  *     x along the GL s coordinate and y along t.
  *   - Thread safety: every function may be called from any thread; objects are immutable after
  *     creation unless a function says otherwise.
+ *   - Arrays and counts (every entry that takes an array with a count): every argument is checked
+ *     whatever the counts, so a count of 0 never hides a bad one (a NULL scene, an invalid N or
+ *     thread_count fails with count 0 as with count 1000). An array may be NULL only when its
+ *     count is 0. With valid arguments, count 0 succeeds and writes nothing (the batch, the
+ *     probes) or makes an empty set (hemilight_scene_create, hemilight_scene_with_lights, a bake
+ *     mesh without vertices, options->light_count); an entry that needs elements says so in its
+ *     Errors (hemilight_cache_irradiance: count 0; the bakes: mesh_count 0, page_count 0).
  *
  * Structs that grow (what stays compatible)
  *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
@@ -308,7 +315,8 @@ HEMILIGHT_API void hemilight_sampler_release(hemilight_sampler* sampler);
 
 /* hemilight_sample_irradiance at `count` points on `thread_count` threads (0 = all cores):
  * positions and normals are 3 * count floats, out receives count results, each bitwise what
- * hemilight_sample_irradiance gives for that point, for any thread count. count = 0 does nothing.
+ * hemilight_sample_irradiance gives for that point, for any thread count. count = 0 checks the other
+ * arguments and does nothing (the arrays may then be NULL: "Arrays and counts" at the top).
  * Errors (nothing written to out): INVALID_ARGUMENT for a NULL scene, or NULL arrays with count > 0,
  * count over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0, and any bad point, named by
  * its index ("point 17: normal (0, 0, 0) has no direction"); OUT_OF_MEMORY. Cost: count hemicubes
@@ -336,7 +344,8 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight
  * Errors (nothing written): INVALID_ARGUMENT for a NULL scene, NULL arrays with count > 0, count
  * over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0 and a non-finite position, named by
  * its index ("point 7: position (0, nan, 1) is not finite"); OUT_OF_MEMORY.
- * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
+ * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 checks the other
+ * arguments and does nothing (the arrays may then be NULL: "Arrays and counts" at the top).
  * Cost: 2 hemicubes and their projections per probe plus the lights' shadow rays (Cornell box,
  * N = 64: ~7k probes/s per core, 14k on two; docs/probes.md); tables of 36 N^2 floats per N,
  * kept between calls within the table budget (hemilight_set_table_budget). */

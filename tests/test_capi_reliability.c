@@ -204,6 +204,128 @@ static void test_bake_messages(void) {
   CHECK(memcmp(out, untouched, sizeof out) == 0);
 }
 
+/* The rule for arrays and counts (hemilight.h, "Conventions"), for every entry that takes an array
+ * with a count: a count of 0 never skips the check of another argument; an array may be NULL only
+ * when its count is 0; count 0 with valid arguments succeeds and writes nothing (or makes an empty
+ * set), except in the entries whose Errors refuse it (the cache, the bakes). Found by fuzzing: the
+ * batch and the probes with count 0 accepted N = 3 and thread_count = -1. */
+static void test_count_zero(void) {
+  static const float pa[] = {0, 0, 0, 0, 0, -1, 1, 0, -1, 1, 0, 0}, ua[] = {0, 0, 0, 1, 1, 1, 1, 0};
+  static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+  const float sky[3] = {1, 1, 1}, nan_sky[3] = {NAN, 1, 1}, nan_pos[3] = {NAN, 0, 0};
+  const float p[3] = {0, 0, 1}, up[3] = {0, 0, 1};
+  hemilight_scene *s = NULL, *lit = NULL, *sentinel = (hemilight_scene*)&passed, *t = sentinel;
+  hemilight_irradiance r[1], r_untouched[1];
+  float sh[27], sh_untouched[27], bf[1] = {-7.0f}, e[3] = {-7.0f, -7.0f, -7.0f};
+  hemilight_cache_options co;
+  hemilight_bake_mesh m[2];
+  hemilight_bake_options o;
+  hemilight_bake_scene_desc sd;
+  hemilight_bake_page page;
+  hemilight_bake_placement placement = {0, {1, 1}, {0, 0}};
+  float one[3 * 16], two[3 * 16], untouched[3 * 16];
+
+  /* hemilight_scene_create: no vertices, no triangles (the arrays NULL) is the empty scene; the
+   * other arguments are checked all the same, and triangle_count 0 does not skip the vertices. */
+  CHECK(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, &s) == HEMILIGHT_OK);
+  CHECK_FAILS(hemilight_scene_create(NULL, 0, NULL, 0, NULL, NULL, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT, "sky_radiance is NULL");
+  CHECK_FAILS(hemilight_scene_create(NULL, 0, NULL, 0, NULL, nan_sky, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT, "sky_radiance (nan");
+  CHECK_FAILS(hemilight_scene_create(NULL, 0, NULL, 0, NULL, sky, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "out is NULL");
+  CHECK_FAILS(hemilight_scene_create(nan_pos, 1, NULL, 0, NULL, sky, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT, "positions[0] (vertex 0)");
+  CHECK_FAILS(hemilight_scene_create(NULL, 1, NULL, 0, NULL, sky, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "positions is NULL but vertex_count is 1");
+  CHECK(t == sentinel);
+
+  /* hemilight_scene_with_lights: count 0 (lights NULL) is a scene without lights. */
+  CHECK(hemilight_scene_with_lights(s, NULL, 0, &lit) == HEMILIGHT_OK);
+  hemilight_scene_release(lit);
+  CHECK_FAILS(hemilight_scene_with_lights(NULL, NULL, 0, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_scene_with_lights(s, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "out is NULL");
+  CHECK_FAILS(hemilight_scene_with_lights(s, NULL, 1, &t), HEMILIGHT_ERROR_INVALID_ARGUMENT, "lights is NULL but the count is 1");
+  CHECK(t == sentinel);
+
+  /* hemilight_sample_irradiance_batch: count 0 writes nothing; every other argument is checked. */
+  memset(r_untouched, 0x5a, sizeof r_untouched);
+  memcpy(r, r_untouched, sizeof r);
+  CHECK(hemilight_sample_irradiance_batch(s, NULL, NULL, 0, 16, 0, NULL) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_irradiance_batch(s, p, up, 0, 16, 1, r) == HEMILIGHT_OK);
+  CHECK_FAILS(hemilight_sample_irradiance_batch(NULL, p, up, 0, 16, 1, r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_sample_irradiance_batch(s, p, up, 0, 3, 1, r), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_sample_irradiance_batch: resolution 3 is invalid");
+  CHECK_FAILS(hemilight_sample_irradiance_batch(s, p, up, 0, 16, -1, r), HEMILIGHT_ERROR_INVALID_ARGUMENT, "thread_count is -1");
+  CHECK_FAILS(hemilight_sample_irradiance_batch(s, NULL, up, 1, 16, 1, r), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "positions is NULL but count is 1");
+  CHECK_FAILS(hemilight_sample_irradiance_batch(s, p, NULL, 1, 16, 1, r), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "normals is NULL but count is 1");
+  CHECK_FAILS(hemilight_sample_irradiance_batch(s, p, up, 1, 16, 1, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "out is NULL but count is 1");
+  CHECK(memcmp(r, r_untouched, sizeof r) == 0);
+
+  /* hemilight_sample_probes and _with_backfaces: the same. */
+  memset(sh_untouched, 0x5a, sizeof sh_untouched);
+  memcpy(sh, sh_untouched, sizeof sh);
+  CHECK(hemilight_sample_probes(s, NULL, 0, 16, 0, NULL) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_probes(s, p, 0, 16, 1, sh) == HEMILIGHT_OK);
+  CHECK(hemilight_sample_probes_with_backfaces(s, NULL, 0, 16, 0, NULL, NULL) == HEMILIGHT_OK);
+  CHECK_FAILS(hemilight_sample_probes(NULL, p, 0, 16, 1, sh), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK_FAILS(hemilight_sample_probes(s, p, 0, 3, 1, sh), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_sample_probes: resolution 3 is invalid");
+  CHECK_FAILS(hemilight_sample_probes(s, p, 0, 16, -1, sh), HEMILIGHT_ERROR_INVALID_ARGUMENT, "thread_count is -1");
+  CHECK_FAILS(hemilight_sample_probes_with_backfaces(NULL, NULL, 0, 16, 0, NULL, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_sample_probes_with_backfaces: scene is NULL");
+  CHECK_FAILS(hemilight_sample_probes_with_backfaces(s, NULL, 0, 3, 0, NULL, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "resolution 3 is invalid");
+  CHECK_FAILS(hemilight_sample_probes_with_backfaces(s, NULL, 0, 16, -1, NULL, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "thread_count is -1");
+  CHECK_FAILS(hemilight_sample_probes(s, NULL, 1, 16, 1, sh), HEMILIGHT_ERROR_INVALID_ARGUMENT, "positions is NULL but count is 1");
+  CHECK_FAILS(hemilight_sample_probes(s, p, 1, 16, 1, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "sh9_rgb is NULL but count is 1");
+  CHECK_FAILS(hemilight_sample_probes_with_backfaces(s, p, 1, 16, 1, sh, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "backface_fraction is NULL but count is 1");
+  CHECK(memcmp(sh, sh_untouched, sizeof sh) == 0 && bf[0] == -7.0f);
+
+  /* hemilight_cache_irradiance needs points: count 0 is refused (its Errors), with valid arguments
+   * as with a NULL scene. */
+  hemilight_cache_options_init(&co);
+  CHECK_FAILS(hemilight_cache_irradiance(s, p, up, 0, &co, e, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "count is 0");
+  CHECK_FAILS(hemilight_cache_irradiance(NULL, p, up, 0, &co, e, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene is NULL");
+  CHECK(e[0] == -7.0f);
+
+  /* The bakes: mesh_count 0 and page_count 0 are refused (their Errors); a mesh without vertices or
+   * triangles may have NULL arrays and adds nothing (bitwise the same bake without it), but its
+   * material is checked; options->light_count 0 takes NULL lights, 1 does not. */
+  memset(m, 0, sizeof m);
+  m[0].positions = pa, m[0].lightmap_uvs = ua, m[0].vertex_count = 4, m[0].indices = idx, m[0].triangle_count = 2;
+  hemilight_bake_options_init(&o);
+  o.width = o.height = 4, o.resolution = 8;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+  memset(untouched, 0x5a, sizeof untouched);
+  memcpy(two, untouched, sizeof two);
+  CHECK(hemilight_bake_lightmap(m, 1, &o, one, 48, NULL, 0, NULL) == HEMILIGHT_OK);
+  CHECK(hemilight_bake_lightmap(m, 2, &o, two, 48, NULL, 0, NULL) == HEMILIGHT_OK);
+  CHECK(memcmp(one, two, sizeof one) == 0 && fabs(one[0] / pi - 1.0) < 1e-5);
+  memcpy(two, untouched, sizeof two);
+  m[1].material.albedo[0] = 2.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, two, 48, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "meshes[1].material.albedo[0] = 2");
+  m[1].material.albedo[0] = 0.0f;
+  o.light_count = 1;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 1, &o, two, 48, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->lights is NULL but the count is 1");
+  o.light_count = 0;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 0, &o, two, 48, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "mesh_count is 0");
+  CHECK_FAILS(hemilight_bake_lightmap_directional(m, 0, &o, two, 48, NULL, 0, NULL, 0, NULL, 0, NULL),
+              HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_bake_lightmap_directional: mesh_count is 0");
+  memset(&page, 0, sizeof page);
+  page.width = page.height = 4, page.irradiance_rgb = two, page.irradiance_capacity = 48;
+  hemilight_bake_scene_desc_init(&sd);
+  sd.meshes = m, sd.mesh_count = 0, sd.placements = &placement, sd.pages = &page, sd.page_count = 1;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene->mesh_count is 0");
+  sd.mesh_count = 1, sd.page_count = 0;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene->page_count is 0");
+  CHECK(memcmp(two, untouched, sizeof two) == 0);
+  hemilight_scene_release(s);
+}
+
 /* Crafted EXR files (tests/data/): headers claiming 16384^2 pixels in an 8.5 KB file, and an
  * attribute whose size field claims 1.6 GB in a 599-byte file. They fail (IO) from the header
  * alone, before any pixel is allocated, with the C function's name; nothing is written. */
@@ -333,6 +455,7 @@ int main(int argc, char** argv) {
   test_cache_extent();
   test_sizes_and_messages(argc > 1 ? argv[1] : ".");
   test_bake_messages();
+  test_count_zero();
   if (argc > 2) test_crafted_exr(argv[2]);
 #if HAVE_FORK
   if (argc > 2) test_crafted_exr_peak(argv[2]);
