@@ -123,8 +123,8 @@ HEMILIGHT_API hemilight_status hemilight_exr_info(const char* path, int* width, 
 /* Reads an EXR image as float RGB into rgb (capacity in floats, at least width x height x 3).
  * width and height (may be NULL) receive the size. Errors: as hemilight_exr_info, and
  * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). The size
- * in the header is compared with capacity before any pixel is decoded: a refusal costs about a
- * millisecond, whatever size the file claims. */
+ * in the header is compared with capacity before any pixel is decoded: a refusal costs the
+ * header's reading alone, whatever size the file claims. */
 HEMILIGHT_API hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t capacity, int* width,
                                                       int* height);
 

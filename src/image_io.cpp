@@ -9,7 +9,9 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfMultiPartInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfPartType.h>
 #include <ImfStandardAttributes.h>
 #include <Imath/half.h>
 
@@ -19,6 +21,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <system_error>
 
 namespace hemilight {
@@ -110,8 +113,14 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
   if (std::filesystem::is_directory(path, ec)) fail(status::io, function, path, "is a directory, not an EXR file");
   check_header_sizes(path, function);
   try {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& header = file.header();
+    // The header and the offset table through MultiPartInputFile, which allocates no line buffers:
+    // InputFile's decompressors take up to 2.5 scanlines up front (248 MB of address space for a
+    // 377-byte RLE file claiming 16,514,819 x 2 pixels). InputFile is opened to decode, once every
+    // check passed, and for deep data (which it flattens) as before.
+    Imf::MultiPartInputFile parts(path.c_str());
+    const Imf::Header& header = parts.header(0);
+    std::unique_ptr<Imf::InputFile> file;
+    if (header.hasType() && Imf::isDeepData(header.type())) file = std::make_unique<Imf::InputFile>(path.c_str());
     const Imath::Box2i dw = header.dataWindow();
     const long long w = static_cast<long long>(dw.max.x) - dw.min.x + 1;
     const long long h = static_cast<long long>(dw.max.y) - dw.min.y + 1;
@@ -136,7 +145,8 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
     out.height = static_cast<int>(h);
     const std::size_t count = checked_pixel_count(w, h, 1, function);
     // Before anything is allocated: a header claiming a huge image in a short file stops here.
-    if (!file.isComplete()) fail(status::io, function, path, "file is truncated (not all scanlines are present)");
+    if (!(file ? file->isComplete() : parts.partComplete(0)))
+      fail(status::io, function, path, "file is truncated (not all scanlines are present)");
     if (Imf::hasEnvmap(header)) {
       out.has_envmap = true;
       out.envmap = Imf::envmap(header);
@@ -147,6 +157,8 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
       fail(status::unsupported, function, path,
            "a cube map must be w x 6w pixels; this file is " + std::to_string(w) + " x " + std::to_string(h));
     if (!pixels) return out;
+    if (!file) file = std::make_unique<Imf::InputFile>(path.c_str());
+    if (file->header().dataWindow() != dw) fail(status::io, function, path, "the file changed while it was read");
     out.pixels.assign(count * static_cast<std::size_t>(out.channels), 0.0f);
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * static_cast<std::size_t>(out.channels);
@@ -154,8 +166,8 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
     const char* names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < out.channels; ++c)
       fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, out.pixels.data() + c, dw, xs, ys, 1, 1, c == 3 ? 1.0 : 0.0));
-    file.setFrameBuffer(fb);
-    file.readPixels(dw.min.y, dw.max.y);
+    file->setFrameBuffer(fb);
+    file->readPixels(dw.min.y, dw.max.y);
     return out;
   } catch (const error&) {
     throw;
