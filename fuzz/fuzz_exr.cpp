@@ -3,7 +3,7 @@
 // writes: fuzz/corpus/exr). Checks the contract: finite outputs on OK (a file may hold NaN or
 // Inf pixels: those are passed on as stored, so only sizes are checked here), untouched ones on
 // failure, and no allocation beyond what the file can hold (ASan's allocation limit; run.sh --ci
-// gives this harness -malloc_limit_mb=256). Images over 2^16 pixels are loaded into a buffer of 48
+// gives this harness -malloc_limit_mb=64). Images over 2^16 pixels are loaded into a buffer of 48
 // floats: the loaders must refuse them from the header, before decoding anything.
 #include "fuzz_input.hpp"
 
