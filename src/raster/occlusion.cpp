@@ -169,31 +169,50 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     const float* cv = f == 0 ? ly : lz;
     const float* cw = f == 0 ? lz : f <= 2 ? lx : ly;
     const float su = f == 2 || f == 3 ? -1.0f : 1.0f, sw = f == 2 || f == 4 ? -1.0f : 1.0f;
-    float w[8], pu[8], pv[8];
-    float w_min = INFINITY;
+    float u[8], v[8], w[8];
+    float u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY, w_min = INFINITY;
     for (int k = 0; k < 8; ++k) {
+      u[k] = su * cu[k];
+      v[k] = cv[k];
       w[k] = sw * cw[k];
+      u_lo = std::min(u_lo, u[k]);
+      u_hi = std::max(u_hi, u[k]);
+      v_lo = std::min(v_lo, v[k]);
+      v_hi = std::max(v_hi, v[k]);
       w_min = std::min(w_min, w[k]);
     }
-    if (!(w_min > near_)) {
+    // What the face sees of the box lies in its pyramid |u|, |v| <= w (v >= 0 on the side faces):
+    // there w >= |u| and w >= |v|, so w_near below bounds w over that part even when the box
+    // reaches behind the face (a box beside the point, or across its tangent plane).
+    const auto from_zero = [](float a, float b) { return a > 0.0f ? a : b < 0.0f ? -b : 0.0f; };
+    const float v_from_zero = f == 0 ? from_zero(v_lo, v_hi) : std::max(v_lo, 0.0f);
+    const float w_near = std::max(std::max(w_min, from_zero(u_lo, u_hi)), v_from_zero) * (1.0f - 1e-6f);
+    if (!(w_near > near_)) {
       rects.x0[f] = 0;
       rects.x1[f] = n_ - 1;
       rects.y0[f] = 0;
       rects.y1[f] = rows - 1;
       continue;  // its nearest depth is 1/near: nothing drawn can hide it
     }
-    for (int k = 0; k < 8; ++k) {
-      const float inv = 1.0f / w[k];
-      pu[k] = su * cu[k] * inv;
-      pv[k] = cv[k] * inv;
-    }
-    float u0 = pu[0], u1 = pu[0], v0 = pv[0], v1 = pv[0];
-    for (int k = 1; k < 8; ++k) {
-      u0 = std::min(u0, pu[k]);
-      u1 = std::max(u1, pu[k]);
-      v0 = std::min(v0, pv[k]);
-      v1 = std::max(v1, pv[k]);
-    }
+    // The projection of the box's part at w >= w_near: its corners there and the points where its
+    // edges cross w = w_near (the vertices of a convex polytope; u/w takes its extremes at them).
+    float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    const auto extend = [&](float pu, float pv) {
+      u0 = std::min(u0, pu);
+      u1 = std::max(u1, pu);
+      v0 = std::min(v0, pv);
+      v1 = std::max(v1, pv);
+    };
+    for (int k = 0; k < 8; ++k)
+      if (w[k] >= w_near) extend(u[k] / w[k], v[k] / w[k]);
+    if (w_min < w_near)
+      for (int k = 0; k < 8; ++k)
+        for (int bit = 1; bit < 8; bit <<= 1) {
+          const int j = k | bit;
+          if (j == k || (w[k] >= w_near) == (w[j] >= w_near)) continue;
+          const float t = (w_near - w[k]) / (w[j] - w[k]);
+          extend((u[k] + t * (u[j] - u[k])) / w_near, (v[k] + t * (v[j] - v[k])) / w_near);
+        }
     // Texel centres at (x + 1/2) for x = (u + 1) N / 2; side faces' rows start at v = 0.
     const float v_offset = f == 0 ? 1.0f : 0.0f;
     const float fx0 = (u0 + 1.0f) * half - 0.5f, fx1 = (u1 + 1.0f) * half - 0.5f;
@@ -217,7 +236,7 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     rects.y1[f] = y1;
     // Hidden when its nearest depth, with the margin, is below the depth of every texel of its
     // rectangle, read per tile from the tile's least depth where it is known and high enough.
-    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_min)) mask &= ~(1u << f);
+    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_near)) mask &= ~(1u << f);
   }
   return mask;
 }
