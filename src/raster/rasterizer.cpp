@@ -1031,7 +1031,10 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   if (box.x_begin > box.x_end || box.y_begin > box.y_end) return;
   fs.prepare(face, texel_step_, first_centre_, rec);
   // 3b. With occlusion culling, a big or clipped triangle hidden over its whole box is dropped.
-  if (M == mode::depth && culling_ && plane_hidden(face, box, fs)) return;
+  if (M == mode::depth && culling_ && plane_hidden(face, box, fs)) {
+    ++stats_.face_triangles_occluded;
+    return;
+  }
   if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   const face_target target{depth_.data() + face_offset, ids_.data() + face_offset,
