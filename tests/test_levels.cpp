@@ -208,7 +208,7 @@ void check_level(const level& l, std::size_t target) {
   }
   CHECK(crowded == 0);
   // The packer wastes little: the charts' boxes grown by the padding (the least room each
-  // needs) cover at least 75% of the atlas (82-97% at the default sizes).
+  // needs) cover at least 75% of the atlas (81-91% at the default sizes).
   double needed = 0.0;
   for (const glm::dvec4& b : box) needed += (b.z - b.x + l.padding) * (b.w - b.y + l.padding);
   INFO("padded chart boxes cover " << needed / (S * S) << " of the atlas");
