@@ -260,16 +260,23 @@ class alignas(64) rasterizer_impl {
     std::int32_t x0[5], x1[5], y0[5], y1[5];  // per face, the texels whose centres the node may cover
   };
   void occlusion_prepare();
+  // The faces of `mask` on which the node may cover a texel centre not hidden by the occluders
+  // (counted in stats_ when hidden on all of them); their texel rectangles go to `rects`.
   unsigned occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis,
-                          node_rects& rects);
+                          node_rects& rects, std::uint32_t node_index);
   void occlusion_drawn(unsigned mask, const node_rects& rects);
   void occlusion_freeze();
   bool hidden_in_tile(int face, int tx, int ty, int x0, int x1, int y0, int y1, float nearest);
   bool rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest);
   bool plane_hidden(int face, const texel_box& box, const face_setup& fs);  // a triangle's box, its plane
+  bool triangle_hidden(int face, const clip_vertex (&c)[3]);  // a triangle before clipping
+  bool texel_rect(int face, float u0, float u1, float v0, float v1, int& x0, int& x1, int& y0, int& y1) const;
   bool culling_ = false;  // a traversal with occlusion tests is drawing (draw_fixed tests big triangles too)
   template <mode M>
-  void traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull);
+  void traverse(const glm::vec3& position, const frame& basis, bool cull);
+  void traverse_front_to_back(const glm::vec3& position, const frame& basis);
+  template <mode M>
+  void draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis, const simd_frame& sf);
   void redraw_prepare();
   bool ties_decide_order() const;  // a logged tie holds its texel's final depth (or the log overflowed)
   bool occlusion_ = true;
@@ -309,12 +316,7 @@ class alignas(64) rasterizer_impl {
   // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
   // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
   std::uint32_t key_bits_ = 0;
-  struct open_node {
-    float distance2;     // squared distance from the point to the node's box (best-first order)
-    std::uint32_t node;
-    unsigned faces;      // the faces the node may touch
-  };
-  std::vector<open_node> open_;  // the traversal's stack (reference order) or heap (front to back)
+  std::vector<std::uint64_t> stack_;  // the traversal's stack (reference order) or heap (front to back)
   raster_statistics stats_;
 };
 

@@ -337,4 +337,9 @@ HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
 
 }  // namespace hemilight
 
+#else
+namespace hemilight {
+// Without the AVX2 kernels the set-up's broadcast frame is never used: an empty stand-in.
+struct raster_detail::simd_frame {};
+}  // namespace hemilight
 #endif  // HEMILIGHT_RASTER_AVX2

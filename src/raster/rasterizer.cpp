@@ -494,81 +494,112 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     occlusion_prepare();
     tie_sink_ = &ties_;
     culling_ = true;
-    traverse<M>(position, basis, true, true);
+    traverse_front_to_back(position, basis);
     tie_sink_ = nullptr;
     if (ties_decide_order()) {
       ++stats_.occlusion_redraws;
       occlusion_freeze();
       redraw_prepare();
-      traverse<M>(position, basis, false, true);
+      traverse<M>(position, basis, true);
     }
     culling_ = false;
     return;
   }
-  traverse<M>(position, basis, false, false);
+  traverse<M>(position, basis, false);
 }
 
 template <rasterizer_impl::mode M>
-void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull) {
-  const std::vector<bvh_node>& nodes = scene_->bvh();
+void raster_detail::rasterizer_impl::draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position,
+                                               const frame& basis, const simd_frame& sf) {
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
+  if (avx2_) {
+    for (std::uint32_t k = 0; k < node.count; k += 8)
+      if (avx512_)
+        draw_leaf_avx512<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
+      else
+        draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
+    return;
+  }
+#else
+  (void)sf;
+#endif
+  for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
+}
+
+// The reference order: depth first, left to right. With `cull`, nodes are tested against the
+// occluders too (the redraw after a tie, against the frozen depths of the front-to-back pass).
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const frame& basis, bool cull) {
+  const std::vector<bvh_node>& nodes = scene_->bvh();
   simd_frame sf;
+#if HEMILIGHT_RASTER_AVX2
   if (avx2_) sf.set(position, basis, *scene_);
 #endif
-  // The nodes to visit with the faces they may touch. The reference order is depth first, left
-  // to right (a stack); front to back it is best first: the node whose box is nearest to the
-  // point (ties: the lower index), so that near occluders are drawn before what they hide
-  // anywhere in the tree.
-  open_.clear();
-  open_.push_back({0.0f, 0, 31});
-  const auto later = [](const open_node& a, const open_node& b) {
-    return a.distance2 > b.distance2 || (a.distance2 == b.distance2 && a.node > b.node);
-  };
+  // Stack entries: node index << 5 | the faces it may touch.
+  stack_.clear();
+  stack_.push_back(31);
   node_rects rects;
-  while (!open_.empty()) {
-    open_node next = open_.back();
-    if (front_to_back) {
-      std::pop_heap(open_.begin(), open_.end(), later);
-      next = open_.back();
-    }
-    open_.pop_back();
-    const std::uint32_t ni = next.node;
+  while (!stack_.empty()) {
+    const std::uint64_t entry = stack_.back();
+    stack_.pop_back();
+    const auto ni = static_cast<std::uint32_t>(entry >> 5);
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
-    unsigned mask = next.faces & node_faces(node, position, basis);
+    unsigned mask = static_cast<unsigned>(entry & 31u) & node_faces(node, position, basis);
     if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
-    if (mask && cull) {
-      mask = occlusion_test(node, mask, position, basis, rects);
-      if (!mask) {
-        ++stats_.nodes_occluded;
-        stats_.triangles_occluded += subtree_triangles_[ni];
-      }
-    }
+    if (mask && cull) mask = occlusion_test(node, mask, position, basis, rects, ni);
     if (!mask) continue;
     if (node.count == 0) {
-      if (front_to_back) {
-        for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
-          open_.push_back({box_distance2(nodes[c], position), c, mask});
-          std::push_heap(open_.begin(), open_.end(), later);
-        }
-      } else {
-        open_.push_back({0.0f, node.first + 1, mask});  // popped after the left child's subtree
-        open_.push_back({0.0f, node.first, mask});
+      stack_.push_back(std::uint64_t(node.first + 1) << 5 | mask);  // popped after the left child's subtree
+      stack_.push_back(std::uint64_t(node.first) << 5 | mask);
+      continue;
+    }
+    draw_leaf<M>(node, mask, position, basis, sf);
+  }
+}
+
+// Front to back, best first: the node whose box is nearest to the point (ties: the lower index),
+// so that near occluders are drawn before what they hide anywhere in the tree. Each node is tested
+// against the faces' frusta and texel centres and against the occluders by occlusion_test alone
+// (a conservative test of its own: the reference order's node_faces and between-centres tests
+// would only repeat it).
+void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& position, const frame& basis) {
+  const std::vector<bvh_node>& nodes = scene_->bvh();
+  simd_frame sf;
+#if HEMILIGHT_RASTER_AVX2
+  if (avx2_) sf.set(position, basis, *scene_);
+#endif
+  // Heap keys: the squared distance's bits (non-negative floats order as their bits), the node
+  // index, the faces: the least key is the nearest node.
+  const auto key = [&](std::uint32_t ni, unsigned mask) {
+    std::uint32_t bits;
+    const float d2 = box_distance2(nodes[ni], position);
+    std::memcpy(&bits, &d2, sizeof bits);
+    return std::uint64_t(bits) << 32 | std::uint64_t(ni) << 5 | mask;
+  };
+  stack_.clear();
+  stack_.push_back(31);
+  const std::greater<std::uint64_t> later;
+  node_rects rects;
+  while (!stack_.empty()) {
+    std::pop_heap(stack_.begin(), stack_.end(), later);
+    const std::uint64_t entry = stack_.back();
+    stack_.pop_back();
+    const auto ni = static_cast<std::uint32_t>(entry >> 5 & 0x7ffffffu);
+    const bvh_node& node = nodes[ni];
+    ++stats_.nodes_visited;
+    const unsigned mask = occlusion_test(node, static_cast<unsigned>(entry & 31u), position, basis, rects, ni);
+    if (!mask) continue;
+    if (node.count == 0) {
+      for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
+        stack_.push_back(key(c, mask));
+        std::push_heap(stack_.begin(), stack_.end(), later);
       }
       continue;
     }
-#if HEMILIGHT_RASTER_AVX2
-    if (avx2_) {
-      for (std::uint32_t k = 0; k < node.count; k += 8)
-        if (avx512_)
-          draw_leaf_avx512<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
-        else
-          draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
-    } else
-#endif
-      for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
-    if (cull) occlusion_drawn(mask, rects);
+    draw_leaf<mode::depth>(node, mask, position, basis, sf);
+    occlusion_drawn(mask, rects);
   }
 }
 
@@ -676,6 +707,14 @@ void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&loc
     any_out |= code;
   }
   if (all_out) return;
+  // With occlusion culling, a triangle hidden over what the face sees of it is not clipped.
+  if (M == mode::depth && culling_ && any_out) {
+    const clip_vertex c3[3] = {poly[0], poly[1], poly[2]};
+    if (triangle_hidden(face, c3)) {
+      ++stats_.face_triangles_occluded;
+      return;
+    }
+  }
   if (any_out) ++stats_.clipped;
   for (int k = 0; k < 5 && count >= 3; ++k) {
     if (!(any_out >> k & 1u)) continue;
