@@ -509,7 +509,7 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
 }
 
 template <rasterizer_impl::mode M>
-void raster_detail::rasterizer_impl::draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position,
+inline void raster_detail::rasterizer_impl::draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position,
                                                const frame& basis, const simd_frame& sf) {
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
@@ -849,6 +849,7 @@ struct span_writer {
     if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw, target.ties);
 #endif
     // The scalar reference path (and the tail of the SIMD one).
+    tie_log* const ties = target.ties;
     for (; x <= hi; ++x) {
       float z = zrow + dzdx * static_cast<float>(x);
       // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and a
@@ -857,7 +858,7 @@ struct span_writer {
       // Selects, not a branch: short spans would mispredict on every texel.
       const float old = drow[x];
       const bool closer = z > old;
-      if (target.ties && z == old) target.ties->add(drow + x, &z, 1u);
+      if (ties && z == old) ties->add(drow + x, &z, 1u);
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
