@@ -4,6 +4,7 @@
 // here whose every direction from an inside point crosses exactly one triangle, and closed forms.
 #include "hemilight/raster.hpp"
 #include "hemilight/integrate.hpp"
+#include "hemilight/levels.hpp"
 #include "hemilight/reference_scenes.hpp"
 #include "hemilight/parallel.hpp"
 
@@ -1384,7 +1385,7 @@ namespace {
 // scalar path with culling) and checks the buffers and the seen triangles bit for bit. Returns the
 // culled renders' statistics summed.
 raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vector<std::pair<glm::vec3, frame>>& points, int n,
-                                           const radiance_texture* texture = nullptr) {
+                                           const radiance_texture* texture = nullptr, bool same_triangles = true) {
   const auto s = scene::create(m.desc());
   raster_options on, off, scalar;
   on.diagnostics.occlusion_min_triangles = 0;  // culling in scenes of every size
@@ -1405,7 +1406,8 @@ raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vecto
     CHECK(std::memcmp(c.radiance.data(), b.radiance.data(), c.radiance.size() * sizeof(float)) == 0);
     std::size_t same = 0;
     for (std::size_t i = 0; i < a.texel_count(); ++i) same += culled.seen_triangle(i) == reference.seen_triangle(i) ? 1u : 0u;
-    CHECK(same == a.texel_count());
+    // (Where two triangles of one shade meet at exactly the same depth, either may be named.)
+    if (same_triangles) CHECK(same == a.texel_count());
     CHECK(reference.statistics().nodes_occluded == 0);
     const raster_statistics& st = culled.statistics();
     sum.nodes_visited += st.nodes_visited;
@@ -1457,6 +1459,20 @@ TEST_CASE("raster: occlusion culling leaves every buffer bitwise what the uncull
   CHECK(occluded > 0);  // and the culling did cull
 }
 
+TEST_CASE("raster: occlusion culling leaves the stand-in levels' buffers bitwise the unculled ones", "[raster]") {
+  // The closed and open stand-in levels at their smallest sizes, points on their surfaces (some
+  // inside the solids that overlap where parts meet, where coplanar faces tie), N = 64.
+  std::mt19937 rng(43);
+  for (const char* name : {"arena", "keep", "city_block", "terrain_town"}) {
+    level_options o;
+    o.target_triangles = std::string(name) == "arena" || std::string(name) == "keep" ? 10000 : 50000;
+    const scene_mesh m = make_level(name, o).mesh;
+    INFO(name);
+    const raster_statistics st = check_occlusion_is_exact(m, surface_points(m, 16, rng), 64, nullptr, false);
+    CHECK(st.triangles_occluded > 0);
+  }
+}
+
 TEST_CASE("raster: occlusion culling skips what lies behind a wall and counts it", "[raster]") {
   // A point in front of a closed wall, behind which stand 2,000 boxes: from the point's side the
   // wall hides every box. The wall's leaves are the nearest nodes and drawn first (best-first
@@ -1498,4 +1514,22 @@ TEST_CASE("raster: occlusion culling keeps the reference order's choice between 
   m.add_quad({-0.5f, -0.5f, 0.6f}, {-0.5f, 0.5f, 0.6f}, {0.5f, 0.5f, 0.6f}, {0.5f, -0.5f, 0.6f}, green);
   const raster_statistics st = check_occlusion_is_exact(m, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64);
   CHECK(st.occlusion_redraws == 1);
+
+  // The same with one material for both layers: whichever wins, the texel gets the same shade and
+  // the distance of the tied depth, so no redraw is needed (only seen_triangle may differ). With
+  // a radiance texture over lightmap UVs that differ between the layers, the winner matters again.
+  scene_mesh same = m;
+  for (material& mat : same.materials)
+    if (mat.emission.z == 1.0f) mat = red;
+  const raster_statistics st_same =
+      check_occlusion_is_exact(same, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64, nullptr, false);
+  CHECK(st_same.occlusion_redraws == 0);
+  same.lightmap_uvs.resize(same.positions.size());
+  for (std::size_t v = 0; v < same.positions.size(); ++v)
+    same.lightmap_uvs[v] = {v < same.positions.size() / 2 ? 0.1f : 0.9f, 0.5f};
+  std::vector<float> pixels = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};  // 2 x 1: red left, blue right
+  const radiance_texture texture(pixels.data(), 2, 1);
+  const raster_statistics st_textured =
+      check_occlusion_is_exact(same, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64, &texture);
+  CHECK(st_textured.occlusion_redraws == 1);
 }

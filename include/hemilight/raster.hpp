@@ -197,8 +197,10 @@ class hemicube_rasterizer {
                        std::vector<std::uint32_t>& counts);
 
   /// After render(): the scene triangle (scene_desc numbering) seen through a texel, or
-  /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). A debugging and
-  /// testing aid; the buffer itself does not carry triangle numbers.
+  /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). Where triangles of
+  /// one shade meet at exactly the same depth (coplanar overlaps) and occlusion culling drew the
+  /// render, it may name another of them than the reference order's first (the buffer is the same
+  /// either way). A debugging and testing aid; the buffer itself does not carry triangle numbers.
   /// Precondition: texel < 3 N^2 of the last render, and not moved from since (asserted).
   std::uint32_t seen_triangle(std::size_t texel) const noexcept;
 

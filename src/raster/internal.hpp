@@ -122,27 +122,31 @@ struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (ker
 // The texels where a fragment's depth equalled the depth already there (a tie, which the drawing
 // order decides), with that depth: occlusion culling's front-to-back pass checks after drawing
 // whether a tie still holds a texel's final depth. Ties are rare (coplanar overlapping triangles);
-// past `limit` entries only `overflow` is kept.
+// past `limit` entries (twice the hemicube's texels: set by the render) only `overflow` is kept.
 struct tie_log {
-  static constexpr std::size_t limit = 4096;
-  std::vector<std::pair<const float*, float>> at;
+  std::size_t limit = 0;
+  struct entry {
+    const float* depth;  // the texel's depth (in the rasterizer's depth buffer)
+    float z;             // the tied depth
+    std::uint32_t id;    // the texel id of the fragment that tied (and lost to the earlier one)
+  };
+  std::vector<entry> at;
   bool overflow = false;
   void clear() noexcept {
     at.clear();
     overflow = false;
   }
-  // Lanes `bits` of the group of texels at `depth` with depths `z` (a cold path).
-  __attribute__((noinline, cold)) void add(const float* depth, const float* z, unsigned bits) {
+  // Lanes `bits` of the group of texels at `depth` with depths `z`, all of draw `id` (a cold path).
+  __attribute__((noinline, cold)) void add(const float* depth, const float* z, std::uint32_t id, unsigned bits) {
     for (; bits; bits &= bits - 1) {
       const unsigned lane = static_cast<unsigned>(__builtin_ctz(bits));
       if (at.size() == limit) {
         overflow = true;
         return;
       }
-      at.emplace_back(depth + lane, z[lane]);
+      at.push_back({depth + lane, z[lane], id});
     }
   }
-  bool any() const noexcept { return overflow || !at.empty(); }
 };
 
 // The state and drawing code of a hemicube_rasterizer (raster.hpp): the public class holds one
@@ -278,7 +282,9 @@ class alignas(64) rasterizer_impl {
   template <mode M>
   void draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis, const simd_frame& sf);
   void redraw_prepare();
-  bool ties_decide_order() const;  // a logged tie holds its texel's final depth (or the log overflowed)
+  // A logged tie holds its texel's final depth between fragments the buffer can tell apart (other
+  // shades, or a textured render), or the log overflowed.
+  bool ties_decide_order() const;
   bool occlusion_ = true;
   tie_log ties_;                               // the depth ties of this render's front-to-back pass
   tie_log* tie_sink_ = nullptr;                // &ties_ while that pass draws, else null (no logging)

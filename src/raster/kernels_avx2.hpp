@@ -53,11 +53,11 @@ HEMILIGHT_TARGET_AVX2 inline __m256 depth_test8(float* depth, std::uint32_t* ids
 // The depth test of span_avx2 with its constants given (zr: the row's depth, dz: its step per
 // texel, zmin = FLT_MIN, id: the record in every lane), shared with the span walk's functor.
 // Logs the tie lanes `tie` of the eight texels at depth (depths z), if any.
-HEMILIGHT_TARGET_AVX2 inline void log_ties8(tie_log* ties, const float* depth, __m256 z, __m256 tie) {
+HEMILIGHT_TARGET_AVX2 inline void log_ties8(tie_log* ties, const float* depth, __m256 z, __m256 tie, __m256 id) {
   if (const int bits = _mm256_movemask_ps(tie)) {
     alignas(32) float zl[8];
     _mm256_store_ps(zl, z);
-    ties->add(depth, zl, static_cast<unsigned>(bits));
+    ties->add(depth, zl, static_cast<std::uint32_t>(_mm256_cvtsi256_si32(_mm256_castps_si256(id))), static_cast<unsigned>(bits));
   }
 }
 
@@ -72,7 +72,7 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(
   for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
     const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
     const __m256 tie = depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
-    if (log) log_ties8(ties, drow + x, z, tie);
+    if (log) log_ties8(ties, drow + x, z, tie, id);
   }
 }
 
@@ -175,7 +175,7 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
       const __m256 tie = depth_test8(depth + i, ids + i, z, mask, id);
-      if (log) log_ties8(ties, depth + i, z, tie);
+      if (log) log_ties8(ties, depth + i, z, tie, id);
     }
     return;
   }
@@ -200,7 +200,7 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       }
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
       const __m256 tie = depth_test8(depth + i, ids + i, z, mask, id);
-      if (log) log_ties8(ties, depth + i, z, tie);
+      if (log) log_ties8(ties, depth + i, z, tie, id);
     }
     row[0] = _mm256_add_epi32(row[0], dy[0]);
     row[1] = _mm256_add_epi32(row[1], dy[1]);

@@ -20,11 +20,11 @@ using namespace raster_detail;
 namespace {
 
 // Logs the tie lanes `tie` of the four texels at depth (depths z), if any.
-inline void log_ties4(tie_log* ties, const float* depth, __m128 z, __m128 tie) {
+inline void log_ties4(tie_log* ties, const float* depth, __m128 z, __m128 tie, std::uint32_t id) {
   if (const int bits = _mm_movemask_ps(tie)) {
     alignas(16) float zl[4];
     _mm_store_ps(zl, z);
-    ties->add(depth, zl, static_cast<unsigned>(bits));
+    ties->add(depth, zl, id, static_cast<unsigned>(bits));
   }
 }
 
@@ -77,7 +77,7 @@ void small_triangle_sse2_body(const std::int64_t (&ex)[3], const std::int64_t (&
           }
           float z = _mm_cvtss_f32(zr) + dzdx * static_cast<float>(x + k);
           z = z > FLT_MIN ? z : FLT_MIN;
-          if (log && z == depth[i]) ties->add(depth + i, &z, 1u);
+          if (log && z == depth[i]) ties->add(depth + i, &z, draw, 1u);
           if (z > depth[i]) {
             depth[i] = z;
             ids[i] = draw;
@@ -95,7 +95,7 @@ void small_triangle_sse2_body(const std::int64_t (&ex)[3], const std::int64_t (&
       const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
       const __m128 old = _mm_loadu_ps(depth + i);
       const __m128 closer = _mm_and_ps(_mm_cmpgt_ps(z, old), _mm_castsi128_ps(in));
-      if (log) log_ties4(ties, depth + i, z, _mm_and_ps(_mm_cmpeq_ps(z, old), _mm_castsi128_ps(in)));
+      if (log) log_ties4(ties, depth + i, z, _mm_and_ps(_mm_cmpeq_ps(z, old), _mm_castsi128_ps(in)), draw);
       _mm_storeu_ps(depth + i, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
       __m128i* ip = reinterpret_cast<__m128i*>(ids + i);
       const __m128i mask = _mm_castps_si128(closer);
@@ -157,7 +157,7 @@ inline int span_sse2_body(float* drow, std::uint32_t* irow, int x, int hi, float
     const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
     const __m128 old = _mm_loadu_ps(drow + x);
     const __m128 closer = _mm_cmpgt_ps(z, old);
-    if (log) log_ties4(ties, drow + x, z, _mm_cmpeq_ps(z, old));
+    if (log) log_ties4(ties, drow + x, z, _mm_cmpeq_ps(z, old), draw);
     _mm_storeu_ps(drow + x, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
     __m128i* ip = reinterpret_cast<__m128i*>(irow + x);
     const __m128i mask = _mm_castps_si128(closer);

@@ -64,8 +64,17 @@ void raster_detail::rasterizer_impl::redraw_prepare() {
 
 bool raster_detail::rasterizer_impl::ties_decide_order() const {
   if (ties_.overflow) return true;
-  for (const auto& [depth, z] : ties_.at)
-    if (*depth == z) return true;  // the tie holds the texel's final depth: the order chose its winner
+  // A tie decides nothing when the depth it tied at was beaten later, or when both fragments give
+  // the texel the same bits: the same shade (radiance and flags) and, without a texture, the
+  // distance comes from the texel's depth, which is the tied depth either way. (seen_triangle()
+  // may then name either triangle.)
+  const auto key = [&](std::uint32_t id) { return key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]; };
+  for (const tie_log::entry& e : ties_.at) {
+    if (*e.depth != e.z) continue;
+    if (textured_) return true;
+    const std::size_t texel = static_cast<std::size_t>(e.depth - depth_.data());
+    if (key(ids_[texel]) != key(e.id)) return true;
+  }
   return false;
 }
 

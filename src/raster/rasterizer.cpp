@@ -379,6 +379,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   draws_.front().index = no_triangle;
   stats_ = {};
   ties_.clear();
+  ties_.limit = 2 * count;
   tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
@@ -858,7 +859,7 @@ struct span_writer {
       // Selects, not a branch: short spans would mispredict on every texel.
       const float old = drow[x];
       const bool closer = z > old;
-      if (ties && z == old) ties->add(drow + x, &z, 1u);
+      if (ties && z == old) ties->add(drow + x, &z, draw, 1u);
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
