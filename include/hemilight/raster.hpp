@@ -86,6 +86,13 @@ struct raster_options {
   /// every path. Cost: several times a render (docs/raster.md); bind() sorts the scene's edges
   /// (O(E log E)). Off by default.
   bool edge_coverage = false;
+  /// Level of detail: a BVH node whose box spans under lod_texels hemicube texels (seen from
+  /// more than twice its half diagonal) is drawn from a simplified proxy of its triangles
+  /// (meshoptimizer, built once per scene on the first bind that asks for it) instead of its
+  /// triangles: far clusters cost a few triangles. It changes the buffers (docs/raster.md, "Level
+  /// of detail", measures the error against N and the threshold); 0 = exact, the default. Range
+  /// [0, 16]; ignored with edge_coverage.
+  float lod_texels = 0.0f;
 
   /// Diagnostic switches, for comparisons and tests only (not for tuning): every setting gives
   /// bit-identical buffers (tested), only the speed differs. The defaults pick the fastest kernels
@@ -136,6 +143,7 @@ struct raster_statistics {
   std::size_t triangles_occluded = 0;  ///< occlusion culling: the triangles below those nodes
   std::size_t face_triangles_occluded = 0;  ///< occlusion culling: big (triangle, face) pairs found hidden before their spans
   std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
+  std::size_t lod_nodes = 0;           ///< level of detail: nodes drawn from their proxies
 };
 
 namespace raster_detail {

@@ -76,6 +76,7 @@ struct draw_record {
   glm::vec3 grad_b1;     ///< barycentric b1 = grad_b1 . (q - v0)  (only with a texture)
   glm::vec3 grad_b2;     ///< barycentric b2 = grad_b2 . (q - v0)
   bool textured;         ///< UVs + texture: radiance comes from the texture
+  const std::uint32_t* vertices = nullptr;  ///< a LOD proxy's scene vertices (UVs); null: those of `index`
 };
 /// What the resolve pass copies to the texels of a draw: the sky, a back face, or the front of
 /// a triangle with one of the scene's emissions.
@@ -178,7 +179,8 @@ class alignas(64) rasterizer_impl {
   template <mode M>
   void draw_all(const glm::vec3& position, const frame& basis);
   template <mode M>
-  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis);
+  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis,
+                     const std::uint32_t* vertices = nullptr);
   template <mode M>
   void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
                    const scene::triangle& tri);
@@ -285,6 +287,11 @@ class alignas(64) rasterizer_impl {
   // A logged tie holds its texel's final depth between fragments the buffer can tell apart (other
   // shades, or a textured render), or the log overflowed.
   bool ties_decide_order() const;
+  // Level of detail (raster_options::lod_texels; lod.cpp): a node spanning under lod_texels_
+  // texels is drawn from its proxy.
+  bool lod_draw(const bvh_node& node, std::uint32_t node_index, unsigned mask, const glm::vec3& position, const frame& basis);
+  const struct lod_proxies* lod_ = nullptr;
+  float lod_texels_ = 0.0f;
   bool occlusion_ = true;
   tie_log ties_;                               // the depth ties of this render's front-to-back pass
   tie_log* tie_sink_ = nullptr;                // &ties_ while that pass draws, else null (no logging)

@@ -4,6 +4,7 @@
 // so the kernels inline where their target allows); exact edge coverage is in edge.cpp.
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
+#include "lod.hpp"
 
 #include "hemilight/cubemap.hpp"
 
@@ -264,6 +265,8 @@ void validate_raster_options(const raster_options& options, const std::string& w
   if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
     throw_invalid_argument(who + ": near_distance is " + std::to_string(options.near_distance) +
                            "; it must be finite and >= 0 (0 = default)");
+  if (!(options.lod_texels >= 0.0f && options.lod_texels <= 16.0f))
+    throw_invalid_argument(who + ": lod_texels is " + std::to_string(options.lod_texels) + "; it must be in [0, 16] (0 = off)");
   if (options.sky) {
     // A cheap structural check; the values were checked when the map was built (from_image).
     const cubemap& m = *options.sky;
@@ -293,6 +296,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
 #endif
   sky_ = options.sky;
   edge_ = options.edge_coverage;
+  lod_texels_ = edge_ ? 0.0f : options.lod_texels;
+  lod_ = lod_texels_ > 0.0f ? &lod_proxies_of(*scene_) : nullptr;
   occlusion_ = options.diagnostics.occlusion_culling &&
                scene_->drawable_triangle_count() >= options.diagnostics.occlusion_min_triangles;
   // Per node, the triangles below it (children follow their parent in the array).
@@ -551,6 +556,7 @@ void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const f
     if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
     if (mask && cull) mask = occlusion_test(node, mask, position, basis, rects, ni);
     if (!mask) continue;
+    if (M == mode::depth && lod_ && lod_draw(node, ni, mask, position, basis)) continue;
     if (node.count == 0) {
       stack_.push_back(std::uint64_t(node.first + 1) << 5 | mask);  // popped after the left child's subtree
       stack_.push_back(std::uint64_t(node.first) << 5 | mask);
@@ -558,6 +564,23 @@ void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const f
     }
     draw_leaf<M>(node, mask, position, basis, sf);
   }
+}
+
+// Level of detail: a node whose box spans under lod_texels_ texels (its half diagonal R seen from
+// distance d > 2 R: R N / d texels, the angle of 2R over the 2/N of a texel at a face's centre) is
+// drawn from its proxy (lod.hpp), when it has one smaller than itself. True when drawn so.
+bool raster_detail::rasterizer_impl::lod_draw(const bvh_node& node, std::uint32_t node_index, unsigned mask,
+                                              const glm::vec3& position, const frame& basis) {
+  const std::uint32_t count = lod_->count[node_index];
+  if (count == 0 || count >= subtree_triangles_[node_index]) return false;
+  const float r = 0.5f * glm::length(node.hi - node.lo);
+  const float d = glm::length(0.5f * (node.lo + node.hi) - position);
+  if (!(d > 2.0f * r) || !(r * static_cast<float>(n_) < lod_texels_ * d)) return false;
+  ++stats_.lod_nodes;
+  const std::uint32_t first = lod_->first[node_index];
+  for (std::uint32_t k = first; k < first + count; ++k)
+    draw_triangle<mode::depth>(lod_->triangles[k], mask, position, basis, lod_->vertices[k].data());
+  return true;
 }
 
 // Front to back, best first: the node whose box is nearest to the point (ties: the lower index),
@@ -592,6 +615,10 @@ void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& pos
     ++stats_.nodes_visited;
     const unsigned mask = occlusion_test(node, static_cast<unsigned>(entry & 31u), position, basis, rects, ni);
     if (!mask) continue;
+    if (lod_ && lod_draw(node, ni, mask, position, basis)) {
+      occlusion_drawn(mask, rects);
+      continue;
+    }
     if (node.count == 0) {
       for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
         stack_.push_back(key(c, mask));
@@ -606,7 +633,7 @@ void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& pos
 
 template <rasterizer_impl::mode M>
 void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
-                                        const frame& basis) {
+                                        const frame& basis, const std::uint32_t* vertices) {
   ++stats_.triangles_tested;
   const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
                               basis.to_local(tri.v2 - position)};
@@ -625,6 +652,7 @@ void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, u
   // A plane through the point is seen edge-on: it covers no texel centre.
   if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
   rec.index = tri.index;
+  rec.vertices = vertices;
   // The rest of the record (material, texture gradients) is filled in when the triangle first
   // covers a texel centre: most triangles of big scenes cover none.
   std::uint32_t draw = 0;
@@ -1182,9 +1210,9 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
       if (!rec.textured) continue;
       const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
       const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-      const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
-      const glm::vec2& uv0 = uvs[indices[tri]];
-      const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+      const std::uint32_t* v = rec.vertices ? rec.vertices : indices.data() + 3 * static_cast<std::size_t>(rec.index);
+      const glm::vec2& uv0 = uvs[v[0]];
+      const glm::vec2 uv = uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0);
       const glm::vec3 l = texture->sample(uv);
       red[i] = l.x;
       green[i] = l.y;
