@@ -30,7 +30,7 @@
 namespace hemilight {
 
 namespace detail {
-struct lazy_slot;   // data derived from the scene on first use: the ray queries' Embree scene, the rasterizer's LOD proxies (src/scene/scene_access.hpp)
+struct lazy_slot;   // data derived from the scene on first use by the modules above it (src/scene/scene_access.hpp)
 struct derived_access;
 struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene/scene_access.hpp)
 }  // namespace detail
@@ -188,7 +188,7 @@ class scene {
   std::vector<bvh_node> nodes_;
   // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
   friend struct detail::derived_access;
-  std::shared_ptr<detail::lazy_slot> derived_[2];
+  std::shared_ptr<detail::lazy_slot> derived_[3];
 };
 
 }  // namespace hemilight

@@ -120,6 +120,24 @@ struct face_setup {
 
 struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (kernels_avx2.hpp)
 
+// The edges of a scene that exact edge coverage may find hard in some view (edge_coverage.cpp):
+// mesh boundaries, material changes and creases (edges between two triangles of one material in
+// different planes, hard where one faces the point and the other not). Edges inside a plane of one
+// material are never hard and are left out. Built once per scene, kept with it.
+struct edge_table {
+  struct candidate {
+    std::uint32_t triangle;  // scene::triangles() position
+    std::uint32_t k;         // the edge: vertex k to vertex k + 1 (mod 3)
+    std::uint32_t plane_a;   // a crease's two triangles' entries in `planes`; no_triangle: always hard
+    std::uint32_t plane_b;
+  };
+  std::vector<candidate> candidates;
+  std::vector<glm::vec4> planes;  // unit normal, offset of the creases' triangles
+};
+
+// The edge table of `s`, built on the first call (thread-safe; O(T log T)).
+const edge_table& edge_table_of(const scene& s);
+
 // The texels where a fragment's depth equalled the depth already there (a tie, which the drawing
 // order decides), with that depth: occlusion culling's front-to-back pass checks after drawing
 // whether a tie still holds a texel's final depth. Ties are rare (coplanar overlapping triangles);
@@ -210,20 +228,13 @@ class alignas(64) rasterizer_impl {
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
   // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
-  // silhouettes); only texels they may cross need exact coverage (edge.cpp, "Hard edges").
-  struct edge_candidate {
-    std::uint32_t triangle;   // scene_->triangles() position
-    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
-    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
-    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
-  };
-  void edge_find_candidates();
+  // silhouettes); only texels they may cross need exact coverage (edge_coverage.cpp, "Hard
+  // edges"). The scene's candidates are in edge_table_ (built once per scene).
   void edge_mark_hard(const glm::vec3& position, const frame& basis);
   void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
   bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
-  std::vector<edge_candidate> edge_candidates_;
-  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
-  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
+  const edge_table* edge_table_ = nullptr;    // the scene's edges that may be hard (with edge_)
+  std::vector<std::int8_t> edge_facing_;      // per edge_table_->planes entry in this view: +1, -1, 0 (edge-on)
   // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
   // a hard edge may cross texel c (words_per_row_ words a row).
   std::vector<std::uint64_t> hard_bits_;

@@ -323,8 +323,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   // order within each face, which the edge resolve's ties need): up to five per triangle.
   const std::size_t draws = scene_->drawable_triangle_count() * (edge_ ? 5 : 1) + 1;
   key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
-  edge_candidates_.clear();
-  if (edge_) edge_find_candidates();
+  edge_table_ = edge_ ? &edge_table_of(*scene_) : nullptr;
+  edge_facing_.assign(edge_ ? edge_table_->planes.size() : 0, 0);
 }
 
 void raster_detail::rasterizer_impl::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
