@@ -1,4 +1,4 @@
-// Speed against accuracy of the irradiance cache (issue 5's benchmark).
+// Speed against accuracy of the irradiance cache (docs/cache.md, "Measured").
 //
 //   usage: sweep_cache out.csv [grid] [options]
 //     --grid K            points per side of each surface (default 128; also the 2nd positional argument)
