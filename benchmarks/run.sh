@@ -105,13 +105,13 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes sky --n 64,128 \
       --converged 512 --stride 7 --check 1024 --check-stride 4
     # the hexagon room ceiling and the Cornell box on the default 128 x 128 grid (fractions depend on
-    # the grid), with gradients, with and without the second opinion (cache_options::second_opinion);
+    # the grid), with gradients, with and without cache_options::expert.lone_record_change_limit;
     # ~1.5 h more on 2 shared cores (the per-point references at N = 512 dominate: 65,536 hemicubes)
     k128=docs/bench/cache_resolution_k128.csv
     rm -f "$k128"
-    for so in 0.25 0; do
+    for lc in 0.25 0; do
       kc=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --converged 1024 --check 2048 --second-order no
-          --second-opinion "$so" --variant "second_opinion=$so")
+          --lone-record-change-limit "$lc" --variant "lone_record_change_limit=$lc")
       "$build/benchmarks/sweep_cache" "$k128" "${kc[@]}" --a 0.1,0.2,0.3,0.5,0.7,1.0 --scenes hexagon --n 256,512 \
         --stride 28 --check-stride 4
       "$build/benchmarks/sweep_cache" "$k128" "${kc[@]}" --a 0.1,0.2,0.3,0.5,0.7,1.0 --scenes cornell --n 256,512 \

@@ -583,7 +583,7 @@ TEST_CASE("cache: accuracy against a hemicube at every point, with and without g
   INFO("with gradients: RMS " << f.rms(a) << " from " << a.stats.hemicubes << " hemicubes; without: RMS " << f.rms(b)
                               << " from " << b.stats.hemicubes);
   CHECK(f.rms(a) < f.rms(b));
-  CHECK(f.rms(a) < 0.02);  // the issue's target is 1% at <= 10% of the points on real scenes (benchmarked)
+  CHECK(f.rms(a) < 0.02);  // the cache's target, 1% at <= 10% of the points, is benchmarked on real scenes
   CHECK(a.stats.hemicubes < f.p.size() / 3);
 }
 

@@ -958,7 +958,7 @@ double rendered_irradiance(const std::vector<glm::dvec3>& poly, int n, bool edge
 }  // namespace
 
 TEST_CASE("raster: exact edge coverage gives polygons' irradiance to Lambert's formula", "[raster]") {
-  // The rectangle of the issue that asked for the option: [-0.5, 0.5] x [0.3, 0.9] at z = 1,
+  // The rectangle of docs/raster.md's edge-coverage figures: [-0.5, 0.5] x [0.3, 0.9] at z = 1,
   // seen from (0.05, -0.02, 0). Point sampling is off by -17.6% at N = 16 and +2.1% at N = 128
   // (the sign and size depend on where the edges fall); with exact coverage only the texel
   // weights' linearisation within partial texels (second order) and float sums remain: measured
@@ -967,7 +967,7 @@ TEST_CASE("raster: exact edge coverage gives polygons' irradiance to Lambert's f
   const std::vector<glm::dvec3> rect = {glm::dvec3(-0.5, 0.3, 1) - eye, glm::dvec3(0.5, 0.3, 1) - eye,
                                         glm::dvec3(0.5, 0.9, 1) - eye, glm::dvec3(-0.5, 0.9, 1) - eye};
   const double ref = lambert_polygon(rect);
-  CHECK(std::fabs(ref - 0.285808) < 1e-6);  // the issue's figure (checks the formula here)
+  CHECK(std::fabs(ref - 0.285808) < 1e-6);  // its E to six digits (checks the formula here)
   for (const int n : {16, 32, 48, 64, 128, 256}) {
     INFO("N = " << n);
     CHECK(std::fabs(rendered_irradiance(rect, n, true) - ref) <= 1e-4 * ref);
@@ -1085,8 +1085,8 @@ TEST_CASE("raster: exact edge coverage of triangles smaller than a texel sums to
   // lines (the clipping paths). Under a sky of 2 and an emission of 1, a texel inside the
   // rectangle is 1 only if its parts sum to one (4e-6 as in the closed-mesh test: float
   // coverages and sums, dozens of parts a texel); under a black sky, E is Lambert's formula for
-  // the rectangle (1e-4 as for the issue's rectangle: the density's linearisation within
-  // partial texels, measured 1e-5).
+  // the rectangle (1e-4 as for the single rectangle of the Lambert's-formula test above: the
+  // density's linearisation within partial texels, measured 1e-5).
   const int n = 64;
   const double texel = 2.0 / n, cell = 0.23 * texel;
   const double x0 = -0.31, y0 = 0.07;
