@@ -4,7 +4,7 @@
 //   usage: sweep_cache_levels out.csv [--levels arena,keep] [--sizes 512,1024] [--n 64] [--a 0.2]
 //            [--no-cache-sizes 256,512] [--stride 37] [--rolls 2] [--truth-cache DIR] [--variant NAME]
 //            [--append] [--threads 2] [--bounces 1] [--sun]
-//            [--min-reach K] [--clamp-normals yes|no] [--legacy]
+//            [--min-radius-spacings K] [--space-finest yes|no] [--clamp-normals yes|no] [--pretest yes|no] [--legacy]
 // Per level and lightmap size (the level's UVs packed for that size): one bake (bake_lightmap,
 // N = 64 unless --n, one bounce, sky only unless --sun, two threads) through the cache, and with
 // --no-cache-sizes one with a hemicube at every texel (use_cache = false) at those sizes, for the
@@ -15,7 +15,10 @@
 // bake targets' relative RMS) and point_rms = RMS of |dY| / max(Y, 5% of the mean Y) (docs/cache.md's),
 // over the converged valid texels; a texel the cached bake calls invalid counts with its filled
 // value (wrongly_invalid counts them). The flags after --variant set cache options for experiments
-// (a variant's name goes into the CSV).
+// (a variant's name goes into the CSV); --legacy gives the cache as it was before the levels work:
+// min_radius the median nearest-point distance / a (found here by brute force, as the cache found
+// it), no spaced finest seeds, no inside test (the bake still passes point_spacing, which an
+// explicit min_radius overrides).
 #include "hemilight/bake.hpp"
 #include "hemilight/cache.hpp"
 #include "hemilight/levels.hpp"
@@ -27,6 +30,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -58,7 +62,7 @@ struct settings {
   std::vector<int> no_cache_sizes;
   int n = 64, stride = 37, rolls = 2, threads = 2, bounces = 1;
   float a = 0.2f;
-  bool sun = false, append = false;
+  bool sun = false, append = false, legacy = false;
   std::string truth_dir, variant = "default";
   cache_options cache;
 };
@@ -151,6 +155,31 @@ errors against(const bake_result& r, const std::vector<std::size_t>& texels, con
   return e;
 }
 
+// The automatic min_radius before point_spacing (--legacy): the median distance from a point to
+// its nearest other point, over up to 1024 evenly strided sample points, / a (the cache's
+// median_spacing, found here by brute force).
+float legacy_min_radius(const bake_input& in, const bake_options& o) {
+  const lightmap_samples s = compute_lightmap_samples(in, o.width, o.height);
+  const auto sc = scene::create(in.scene);
+  const float min_offset = 2.0f * default_near_distance(*sc);
+  std::vector<glm::vec3> p;
+  for (std::size_t k = 0; k < s.coverage.size(); ++k)
+    if (s.sample_triangle[k] != lightmap_samples::no_triangle && s.coverage[k] >= o.min_coverage && s.coverage[k] > 0.0f)
+      p.push_back(s.position[k] + std::max(min_offset, o.offset_texels * s.texel_world_size[k]) * s.normal[k]);
+  std::vector<float> nn;
+  const std::size_t stride = std::max<std::size_t>(1, p.size() / 1024);
+  for (std::size_t i = 0; i < p.size(); i += stride) {
+    float best = std::numeric_limits<float>::infinity();
+    for (const glm::vec3& q : p) {
+      const float d = glm::length(q - p[i]);
+      if (d > 0.0f) best = std::min(best, d);
+    }
+    nn.push_back(best);
+  }
+  std::nth_element(nn.begin(), nn.begin() + std::ptrdiff_t(nn.size() / 2), nn.end());
+  return nn[nn.size() / 2] / o.cache.error_threshold;
+}
+
 // Relative RMS of the cached bake against the per-texel one over texels valid in both.
 double against_per_texel(const bake_result& r, const bake_result& ref) {
   double num = 0.0, den = 0.0;
@@ -183,7 +212,13 @@ int run(const std::string& path, const settings& st) {
     for (int size : st.sizes) {
       level_options lo;
       lo.lightmap_size = size;
-      const level L = make_level(name, lo);
+      level L;
+      try {
+        L = make_level(name, lo);
+      } catch (const error& e) {  // the level's charts do not fit this size: no row
+        std::printf("%s %d²: skipped (%s)\n", name.c_str(), size, e.what());
+        continue;
+      }
       bake_input in;
       in.scene = L.mesh.desc();
       bake_options o;
@@ -194,6 +229,11 @@ int run(const std::string& path, const settings& st) {
       o.cache = st.cache;
       o.cache.error_threshold = st.a;
       if (st.sun) o.lights = L.lights;
+      if (st.legacy) {  // the cache as it was before point_spacing, space_finest_seeds and inside_test
+        o.cache.min_radius = legacy_min_radius(in, o);
+        o.cache.expert.space_finest_seeds = false;
+        o.cache.expert.pretest_inside = false;
+      }
       const std::string load = load_average();
       const bake_result r = bake_lightmap(in, o);
       const cache_stats& cs = r.stats.passes.front();
@@ -297,14 +337,16 @@ int main(int argc, char** argv) {
       st.truth_dir = argv[++i];
     } else if (a == "--variant" && more) {
       st.variant = argv[++i];
+    } else if (a == "--legacy") {
+      st.legacy = true;
     } else if (a == "--append") {
       st.append = true;
     } else if (a == "--sun") {
       st.sun = true;
     } else if (a == "--min-radius" && more) {
       st.cache.min_radius = float(std::atof(argv[++i]));
-    } else if (a == "--min-reach" && more) {
-      st.cache.min_reach = float(std::atof(argv[++i]));
+    } else if (a == "--min-radius-spacings" && more) {
+      st.cache.min_radius_spacings = float(std::atof(argv[++i]));
     } else if (a == "--space-finest" && more) {
       st.cache.expert.space_finest_seeds = std::string(argv[++i]) == "yes";
     } else if (a == "--clamp-normals" && more) {

@@ -1058,7 +1058,7 @@ TEST_CASE("cache: the statistics say what limits each record's radius and why ea
   CHECK(st.median_radius == radii[radii.size() / 2]);
 }
 
-TEST_CASE("cache: point_spacing sets the automatic min_radius to min_reach spacings of reach", "[cache]") {
+TEST_CASE("cache: point_spacing sets the automatic min_radius to min_radius_spacings spacings (at least 1 / a)", "[cache]") {
   lit_floor f;
   // Spacings that vary over the points (a median the nearest-neighbour distance, 0.05, is not).
   std::vector<float> spacing(f.p.size());
@@ -1066,19 +1066,22 @@ TEST_CASE("cache: point_spacing sets the automatic min_radius to min_reach spaci
   std::vector<float> sorted = spacing;
   std::sort(sorted.begin(), sorted.end());
   const float median = sorted[sorted.size() / 2];
-  for (float reach : {1.0f, 1.5f, 2.0f}) {
-    cache_options o;
-    o.min_reach = reach;
-    cache_run run;
-    run.point_spacing = spacing.data();
-    const cache_result r = cache_irradiance(f.p.data(), f.n.data(), f.p.size(), f.sampler, o, run);
-    CHECK(r.stats.min_radius == reach * median / o.error_threshold);
-    for (const cache_record& rec : r.records) CHECK(rec.radius >= r.stats.min_radius);
-  }
-  // An explicit min_radius wins; without point_spacing min_reach is not used.
+  for (float k : {1.0f, 5.0f, 10.0f, 20.0f})
+    for (float a : {0.1f, 0.2f}) {
+      cache_options o;
+      o.min_radius_spacings = k;
+      o.error_threshold = a;
+      cache_run run;
+      run.point_spacing = spacing.data();
+      const cache_result r = cache_irradiance(f.p.data(), f.n.data(), f.p.size(), f.sampler, o, run);
+      // The radius in spacings, but never a reach (a R) below one spacing.
+      CHECK(r.stats.min_radius == std::max(k, 1.0f / a) * median);
+      for (const cache_record& rec : r.records) CHECK(rec.radius >= r.stats.min_radius);
+    }
+  // An explicit min_radius wins; without point_spacing min_radius_spacings is not used.
   cache_options o;
   o.min_radius = 0.3f;
-  o.min_reach = 2.0f;
+  o.min_radius_spacings = 20.0f;
   cache_run run;
   run.point_spacing = spacing.data();
   CHECK(cache_irradiance(f.p.data(), f.n.data(), f.p.size(), f.sampler, o, run).stats.min_radius == 0.3f);
@@ -1087,8 +1090,8 @@ TEST_CASE("cache: point_spacing sets the automatic min_radius to min_reach spaci
   // Bad spacings and reaches are named.
   spacing[5] = 0.0f;
   CHECK_THROWS_WITH(cache_irradiance(f.p.data(), f.n.data(), f.p.size(), f.sampler, o, run), Catch::Contains("point_spacing[5]"));
-  o.min_reach = 0.2f;
-  CHECK_THROWS_WITH(f.run(o), Catch::Contains("min_reach"));
+  o.min_radius_spacings = 0.5f;
+  CHECK_THROWS_WITH(f.run(o), Catch::Contains("min_radius_spacings"));
 }
 
 TEST_CASE("cache: inside_test skips the hemicubes of seeds it calls inside; the rest is as a hemicube says", "[cache]") {

@@ -118,7 +118,7 @@ struct cache_expert_options {
   /// At the finest spacing, seeds are picked as in the coarser rounds (at least the spacing apart
   /// among points of similar normal), round after round until no point is open; false: every open
   /// point becomes a seed at once.
-  bool space_finest_seeds = false;
+  bool space_finest_seeds = true;
   /// Neighbour clamping between records of any normals; false: only between records whose
   /// normals are similar (n_i . n_j > 0.9), as the disagreement shrink.
   bool clamp_across_normals = true;
@@ -135,10 +135,11 @@ struct cache_options {
   /// min_radius = (median spacing of the points) / a, max_radius = 0.2 x the diagonal of the
   /// points' bounding box (raised to min_radius if smaller).
   float min_radius = 0.0f, max_radius = 0.0f;
-  /// With the automatic min_radius and cache_run::point_spacing given: min_radius = min_reach x
-  /// (median of point_spacing) / a, so that a record at min_radius reaches (a R) min_reach point
-  /// spacings. Finite, in [0.5, 16].
-  float min_reach = 1.0f;
+  /// With the automatic min_radius and cache_run::point_spacing given: min_radius =
+  /// max(min_radius_spacings, 1 / a) x (median of point_spacing). A record at min_radius then
+  /// reaches (a R) a x min_radius_spacings point spacings, and at least one: two texels at the
+  /// default a = 0.2, one at a <= 0.1. Finite, in [1, 1000].
+  float min_radius_spacings = 10.0f;
   bool use_gradients = true;  ///< interpolate with g_r and g_t
   cache_weight weight = cache_weight::ward;
   /// Second-order interpolation (needs use_gradients): each record gets a Hessian fitted from its
@@ -172,8 +173,8 @@ struct cache_run {
   const std::uint8_t* known_inside = nullptr;
   /// Optional, count entries (not owned, read during the call): per point, the spacing of the
   /// points around it on its own surface (scene units, finite, > 0; the baker passes each texel's
-  /// world size). With it the automatic min_radius is cache_options::min_reach x their median / a
-  /// instead of the median distance between nearest points / a, which thin parts (points close
+  /// world size). With it the automatic min_radius is cache_options::min_radius_spacings (at least
+  /// 1 / a) x their median instead of the median distance between nearest points / a, which thin parts (points close
   /// together in 3D across surfaces) pull far below the spacing on the surfaces. nullptr = none.
   const float* point_spacing = nullptr;
   /// Optional: a test cheaper than a hemicube (the baker: a few rays) of a seed before its

@@ -148,12 +148,15 @@ std::function<bool(int, const glm::vec3&, const glm::vec3&)> rays_inside_test(co
   }
   prepare_rays(*sc);
   const float t_max = 4.0f * std::max(sc->size(), 1e-6f);
-  return [sc, local, t_max](int, const glm::vec3& p, const glm::vec3& n) {
+  // The rays start at the hemicube's near distance, which hides nearer geometry from hemicubes.
+  const float near = default_near_distance(*sc);
+  return [sc, local, t_max, near](int, const glm::vec3& p, const glm::vec3& n) {
     const frame f = make_frame(n);
     int back = 0, other = 0;
     for (const glm::vec3& l : local) {
       ray_hit hit;
-      if (intersect(*sc, p, f.to_world(l), t_max, hit) && !hit.front_face)
+      const glm::vec3 d = f.to_world(l);
+      if (intersect(*sc, p + near * d, d, t_max, hit) && !hit.front_face)
         ++back;
       else
         ++other;

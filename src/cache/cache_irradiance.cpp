@@ -268,7 +268,7 @@ class placement {
     if (o_.min_radius == 0.0f && r_.point_spacing) {
       std::vector<float> given(r_.point_spacing, r_.point_spacing + count_);
       std::nth_element(given.begin(), given.begin() + std::ptrdiff_t(count_ / 2), given.end());
-      o_.min_radius = o_.min_reach * given[count_ / 2] / a;
+      o_.min_radius = std::max(o_.min_radius_spacings, 1.0f / a) * given[count_ / 2];
     }
     if (o_.min_radius == 0.0f) {
       const float spacing = median_spacing(p_, count_, diagonal_, grid_of_points_);
