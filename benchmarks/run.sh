@@ -10,6 +10,8 @@
 #                                     ward_continuous, first order (docs/cache.md; 15-30 min; not run by default)
 #   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
 #                                     both weights (docs/cache.md; ~25 min; not run by default)
+#   bash benchmarks/run.sh cache_levels       the cache on the stand-in levels: hemicube share, error against
+#                                     converged, radius counters, before and after (docs/cache.md; ~1.5 h; not by default)
 #   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 #   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
@@ -32,6 +34,7 @@ if [ ${#names[@]} -eq 0 ]; then
     [ -x "$f" ] || continue
     n=$(basename "$f"); n=${n#bench_}; n=${n#sweep_}
     [ "$n" = bake_scaling ] && continue  # long (a 1M-triangle bake, 4096^2 lightmaps): only when named
+    [ "$n" = cache_levels ] && continue  # long (bakes of the levels up to 1024²): only when named
     [[ " ${names[*]-} " == *" $n "* ]] || names+=("$n")
   done
 fi
@@ -91,6 +94,23 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_cache" "$csv" --append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --second-order no \
       --weight ward_continuous --variant ward_continuous --converged 2048 --stride 76 --scenes cornell --n 1024 --a 0.57,0.58
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
+  if [ "$n" = cache_levels ]; then
+    # The cache on the stand-in levels (docs/cache.md, "Levels"): hemicube share, error against a
+    # converged reference (N = 256, 2 rolls, every 37th texel; every 97th at 1024²), the radius
+    # counters, before (--legacy) and now; at 256² and 512² also the bake without the cache (time
+    # ratio). ~1.5 h on 2 cores; the converged references are kept in build-bench/cache_levels_truth.
+    echo "== sweep_cache_levels"
+    csv=docs/bench/cache_levels.csv truth="$build/cache_levels_truth"
+    rm -f "$csv"; mkdir -p "$truth"
+    for v in legacy default; do
+      flags=(--append --truth-cache "$truth" --variant "$v"); [ "$v" = legacy ] && flags+=(--legacy)
+      "$build/benchmarks/sweep_cache_levels" "$csv" "${flags[@]}" --levels arena,keep --sizes 256,512 --no-cache-sizes 256,512
+      "$build/benchmarks/sweep_cache_levels" "$csv" "${flags[@]}" --levels arena,keep --sizes 1024 --stride 97
+    done
+    "$build/benchmarks/sweep_cache_levels" "$csv" --append --truth-cache "$truth" --levels city_block,terrain_town --sizes 512
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache_levels.py docs/bench
     continue
   fi
   if [ "$n" = cache_resolution ]; then

@@ -28,6 +28,7 @@
 //     --weight W          cache_options::weight: ward, ward_continuous or tabellion_lamorlette
 //                         (default: the option's default)
 //     --second-order yes|no  cache_options::second_order (default: the option's default, yes)
+//     --space-finest yes|no  cache_expert_options::space_finest_seeds (default: the option's default)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
 //     --record-regions    Cornell box: print where the records are (floor / walls, dark or lit, the
@@ -177,6 +178,7 @@ int main(int argc, char** argv) {
   cache_weight weight = cache_options{}.weight;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
   bool second_order = cache_options{}.second_order;
+  bool space_finest = cache_options{}.expert.space_finest_seeds;
   bool record_regions = false;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
@@ -239,6 +241,10 @@ int main(int argc, char** argv) {
       const std::string v = value();
       if (v != "yes" && v != "no") usage(("bad --second-order '" + v + "' (yes, no)").c_str());
       second_order = v == "yes";
+    } else if (arg == "--space-finest") {
+      const std::string v = value();
+      if (v != "yes" && v != "no") usage(("bad --space-finest '" + v + "' (yes, no)").c_str());
+      space_finest = v == "yes";
     } else if (arg == "--record-regions") {
       record_regions = true;
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
@@ -421,6 +427,7 @@ int main(int argc, char** argv) {
           o.expert.lone_record_reach = lone_record_reach;
           o.weight = weight;
           o.second_order = second_order;
+          o.expert.space_finest_seeds = space_finest;
           cache_run run;
           run.thread_count = threads;
           const double load = loadavg();
