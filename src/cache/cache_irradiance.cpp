@@ -334,7 +334,7 @@ class placement {
 
   // 1. Coverage of every candidate point whose answer can have changed (parallel, read-only on
   // the records): the dirty points (all of them at first; then those in the reach of a record
-  // added or shrunk since they were last checked, within nearby_opinion's reach of a new record,
+  // added or shrunk since they were last checked, within expert.lone_record_neighbour_reach's reach of a new record,
   // or newly presumed inside). Every other point, open or covered, sees the same records with the
   // same radii as when it was last checked, and its opinions come from the same records, so its
   // answer stands. Dirty points that are not yet candidates stay dirty until they are (at the
@@ -448,15 +448,15 @@ class placement {
       why = open_reason::records_disagree;
     }
     // Second opinion: a point that only one record covers is not covered while that record's
-    // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
+    // first-order term there exceeds expert.lone_record_change_limit x a x max(E_i, floor): no other record can
     // disagree with an extrapolation that may be wrong (an edge between two rows of points, a
     // second derivative the gradient does not see).
     if (ok && o_.expert.lone_record_change_limit > 0.0f && !own && detail.records == 1) {
       ok = detail.first_order <= o_.expert.lone_record_change_limit * a;
       why = open_reason::lone_change;
     }
-    // Sole record reach: a point that one record covers must lie inside sole_record_reach of
-    // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
+    // Sole record reach: a point that one record covers must lie inside expert.lone_record_reach of
+    // that record's reach (Ward: weight >= 1 / (expert.lone_record_reach x a)), not on its rim.
     if (ok && o_.expert.lone_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward) {
       ok = detail.max_weight >= 1.0f / (o_.expert.lone_record_reach * a);
       why = open_reason::lone_reach;
@@ -805,7 +805,7 @@ class placement {
   float reach_of(std::size_t j) const { return o_.error_threshold * radius_of(j) * 1.0001f; }
 
   // 6a. The changed points (in a new record's sphere, or in the old sphere of a shrunk one, which
-  // holds its new one, or within nearby_opinion's reach of a new record) become dirty. Each
+  // holds its new one, or within expert.lone_record_neighbour_reach's reach of a new record) become dirty. Each
   // worker marks its own flags and lists what it marked (merged into dirty_list_ after: which
   // points are dirty does not depend on which worker marked what), and counts each new record's
   // points (listed_points_).
