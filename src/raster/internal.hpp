@@ -209,10 +209,10 @@ class alignas(64) rasterizer_impl {
                   const double* exact = nullptr);
   bool draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs, draw_record& rec, std::uint32_t& draw,
                         const frame& basis, const scene::triangle& tri);
-  template <mode M>
+  template <mode M, bool log>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis);
-  template <mode M>  // the same, compiled for AVX-512 (leaf_avx.inl)
+  template <mode M, bool log>  // the same, compiled for AVX-512 (leaf_avx.inl)
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
@@ -277,10 +277,11 @@ class alignas(64) rasterizer_impl {
     std::int32_t x0[5], x1[5], y0[5], y1[5];  // per face, the texels whose centres the node may cover
   };
   void occlusion_prepare();
-  // The faces of `mask` on which the node may cover a texel centre not hidden by the occluders
-  // (counted in stats_ when hidden on all of them); their texel rectangles go to `rects`.
+  // The faces of `mask` on which the node (or a leaf's group) may cover a texel centre not hidden
+  // by the occluders; their texel rectangles go to `rects`. Hidden on all of them: counted in
+  // stats_ with its `triangles`.
   unsigned occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis,
-                          node_rects& rects, std::uint32_t node_index);
+                          node_rects& rects, std::uint32_t triangles);
   void occlusion_drawn(unsigned mask, const node_rects& rects);
   void occlusion_freeze();
   bool hidden_in_tile(int face, int tx, int ty, int x0, int x1, int y0, int y1, float nearest);
@@ -313,6 +314,8 @@ class alignas(64) rasterizer_impl {
   std::size_t tile_offset_[5] = {};            // each face's first tile
   int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
   std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)
+  std::vector<bvh_node> group_boxes_;             // per group of eight triangles of a leaf: its box
+  std::vector<std::uint32_t> group_first_;        // per leaf node: its first entry in group_boxes_
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;

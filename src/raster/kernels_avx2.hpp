@@ -208,16 +208,6 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
   }
 }
 
-// small_triangle_avx2_body in depth mode, logging ties, as a function of its own: the set-up
-// (leaf_avx.inl) inlines only the body without logging, so the common path keeps its code.
-HEMILIGHT_TARGET_AVX2 __attribute__((noinline)) void small_triangle_avx2_logged(
-    const std::int32_t* base, const std::int32_t* sx, const std::int32_t* sy, std::size_t stride, std::int64_t x_begin,
-    std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n, float* depth, std::uint32_t* ids, double z00,
-    double dzdy, float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
-  small_triangle_avx2_body<false, true>(base, sx, sy, stride, x_begin, x_end, y_begin, y_end, n, depth, ids, nullptr, z00, dzdy,
-                                        dzdx, draw, ties);
-}
-
 // small_triangle_avx2_body as a function (for draw_fixed, outside the AVX2 set-up).
 template <bool count_mode>
 HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, const std::int32_t* sx,

@@ -321,11 +321,14 @@ bool raster_detail::rasterizer_impl::texel_rect(int face, float u0, float u1, fl
   const float fx0 = (u0 + 1.0f) * half - 0.5f, fx1 = (u1 + 1.0f) * half - 0.5f;
   const float fy0 = (v0 + v_offset) * half - 0.5f, fy1 = (v1 + v_offset) * half - 0.5f;
   const float m = rect_margin + 1e-5f * (std::fabs(fx0) + std::fabs(fx1) + std::fabs(fy0) + std::fabs(fy1));
+  // ceil and floor of x clamped to [-1, count], by truncating x + 2 >= 1 (no libm call).
   const auto first = [](float x, int count) {
-    return static_cast<int>(std::ceil(std::min(std::max(x, -1.0f), static_cast<float>(count))));
+    const float c = std::min(std::max(x, -1.0f), static_cast<float>(count)) + 2.0f;
+    const int t = static_cast<int>(c);
+    return t + (static_cast<float>(t) < c ? 1 : 0) - 2;
   };
   const auto last = [](float x, int count) {
-    return static_cast<int>(std::floor(std::min(std::max(x, -1.0f), static_cast<float>(count))));
+    return static_cast<int>(std::min(std::max(x, -1.0f), static_cast<float>(count)) + 2.0f) - 2;
   };
   x0 = std::max(first(fx0 - m, n_), 0);
   x1 = std::min(last(fx1 + m, n_), n_ - 1);
@@ -395,7 +398,7 @@ bool raster_detail::rasterizer_impl::plane_hidden(int face, const texel_box& box
 }
 
 unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position,
-                                                        const frame& basis, node_rects& rects, std::uint32_t node_index) {
+                                                        const frame& basis, node_rects& rects, std::uint32_t triangles) {
   // The box's corners in the local frame, grown by the float error of moving points there (the
   // triangles' vertices carry the same kind of error), as eight lanes per coordinate (corner k
   // takes x from hi if k & 1, y if k & 2, z if k & 4): plain loops the compiler vectorises.
@@ -458,7 +461,7 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
   }
   if (!mask && hidden) {
     ++stats_.nodes_occluded;
-    stats_.triangles_occluded += subtree_triangles_[node_index];
+    stats_.triangles_occluded += triangles;
   }
   return mask;
 }

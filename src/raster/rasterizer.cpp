@@ -300,12 +300,30 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   lod_ = lod_texels_ > 0.0f ? &lod_proxies_of(*scene_) : nullptr;
   occlusion_ = options.diagnostics.occlusion_culling &&
                scene_->drawable_triangle_count() >= options.diagnostics.occlusion_min_triangles;
-  // Per node, the triangles below it (children follow their parent in the array).
+  // Per node, the triangles below it (children follow their parent in the array); with occlusion
+  // culling, the boxes of each leaf's groups of eight triangles (tested one by one).
   const std::vector<bvh_node>& nodes = scene_->bvh();
   subtree_triangles_.assign(nodes.size(), 0u);
   for (std::size_t i = nodes.size(); i-- > 0;)
     subtree_triangles_[i] = nodes[i].count ? nodes[i].count
                                            : subtree_triangles_[nodes[i].first] + subtree_triangles_[nodes[i].first + 1];
+  group_first_.assign(occlusion_ ? nodes.size() : 0, 0u);
+  group_boxes_.clear();
+  if (occlusion_) {
+    const std::vector<scene::triangle>& tris = scene_->triangles();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (!nodes[i].count) continue;
+      group_first_[i] = static_cast<std::uint32_t>(group_boxes_.size());
+      for (std::uint32_t k = 0; k < nodes[i].count; k += 8) {
+        bvh_node g{glm::vec3(INFINITY), glm::vec3(-INFINITY), nodes[i].first + k, std::min<std::uint32_t>(8, nodes[i].count - k)};
+        for (std::uint32_t t = g.first; t < g.first + g.count; ++t) {
+          g.lo = glm::min(glm::min(g.lo, tris[t].v0), glm::min(tris[t].v1, tris[t].v2));
+          g.hi = glm::max(glm::max(g.hi, tris[t].v0), glm::max(tris[t].v1, tris[t].v2));
+        }
+        group_boxes_.push_back(g);
+      }
+    }
+  }
 
   const glm::vec3 sky = scene_->sky_radiance();
   shades_.clear();
@@ -520,11 +538,16 @@ inline void raster_detail::rasterizer_impl::draw_leaf(const bvh_node& node, unsi
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
   if (avx2_) {
-    for (std::uint32_t k = 0; k < node.count; k += 8)
-      if (avx512_)
-        draw_leaf_avx512<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
+    const bool log = M == mode::depth && tie_sink_;
+    for (std::uint32_t k = 0; k < node.count; k += 8) {
+      const std::uint32_t first = node.first + k, count = std::min<std::uint32_t>(8, node.count - k);
+      if (log)
+        avx512_ ? draw_leaf_avx512<M, true>(tris.data(), first, count, mask, sf, basis)
+                : draw_leaf_avx2<M, true>(tris.data(), first, count, mask, sf, basis);
       else
-        draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
+        avx512_ ? draw_leaf_avx512<M, false>(tris.data(), first, count, mask, sf, basis)
+                : draw_leaf_avx2<M, false>(tris.data(), first, count, mask, sf, basis);
+    }
     return;
   }
 #else
@@ -554,7 +577,7 @@ void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const f
     ++stats_.nodes_visited;
     unsigned mask = static_cast<unsigned>(entry & 31u) & node_faces(node, position, basis);
     if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
-    if (mask && cull) mask = occlusion_test(node, mask, position, basis, rects, ni);
+    if (mask && cull) mask = occlusion_test(node, mask, position, basis, rects, subtree_triangles_[ni]);
     if (!mask) continue;
     if (M == mode::depth && lod_ && lod_draw(node, ni, mask, position, basis)) continue;
     if (node.count == 0) {
@@ -613,7 +636,7 @@ void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& pos
     const auto ni = static_cast<std::uint32_t>(entry >> 5 & 0x7ffffffu);
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
-    const unsigned mask = occlusion_test(node, static_cast<unsigned>(entry & 31u), position, basis, rects, ni);
+    const unsigned mask = occlusion_test(node, static_cast<unsigned>(entry & 31u), position, basis, rects, subtree_triangles_[ni]);
     if (!mask) continue;
     if (lod_ && lod_draw(node, ni, mask, position, basis)) {
       occlusion_drawn(mask, rects);
@@ -626,8 +649,20 @@ void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& pos
       }
       continue;
     }
-    draw_leaf<mode::depth>(node, mask, position, basis, sf);
-    occlusion_drawn(mask, rects);
+    if (node.count <= 8) {
+      draw_leaf<mode::depth>(node, mask, position, basis, sf);
+      occlusion_drawn(mask, rects);
+      continue;
+    }
+    // A bigger leaf in groups of eight (the set-up's width), each tested on its own box: a leaf in
+    // view is often hidden in part.
+    for (std::uint32_t g = group_first_[ni], k = 0; k < node.count; ++g, k += 8) {
+      const bvh_node& group = group_boxes_[g];
+      const unsigned group_mask = occlusion_test(group, mask, position, basis, rects, group.count);
+      if (!group_mask) continue;
+      draw_leaf<mode::depth>(group, group_mask, position, basis, sf);
+      occlusion_drawn(group_mask, rects);
+    }
   }
 }
 
