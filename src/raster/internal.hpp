@@ -314,8 +314,6 @@ class alignas(64) rasterizer_impl {
   std::size_t tile_offset_[5] = {};            // each face's first tile
   int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
   std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)
-  std::vector<bvh_node> group_boxes_;             // per group of eight triangles of a leaf: its box
-  std::vector<std::uint32_t> group_first_;        // per leaf node: its first entry in group_boxes_
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;

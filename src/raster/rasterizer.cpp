@@ -300,30 +300,12 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   lod_ = lod_texels_ > 0.0f ? &lod_proxies_of(*scene_) : nullptr;
   occlusion_ = options.diagnostics.occlusion_culling &&
                scene_->drawable_triangle_count() >= options.diagnostics.occlusion_min_triangles;
-  // Per node, the triangles below it (children follow their parent in the array); with occlusion
-  // culling, the boxes of each leaf's groups of eight triangles (tested one by one).
+  // Per node, the triangles below it (children follow their parent in the array).
   const std::vector<bvh_node>& nodes = scene_->bvh();
   subtree_triangles_.assign(nodes.size(), 0u);
   for (std::size_t i = nodes.size(); i-- > 0;)
     subtree_triangles_[i] = nodes[i].count ? nodes[i].count
                                            : subtree_triangles_[nodes[i].first] + subtree_triangles_[nodes[i].first + 1];
-  group_first_.assign(occlusion_ ? nodes.size() : 0, 0u);
-  group_boxes_.clear();
-  if (occlusion_) {
-    const std::vector<scene::triangle>& tris = scene_->triangles();
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      if (!nodes[i].count) continue;
-      group_first_[i] = static_cast<std::uint32_t>(group_boxes_.size());
-      for (std::uint32_t k = 0; k < nodes[i].count; k += 8) {
-        bvh_node g{glm::vec3(INFINITY), glm::vec3(-INFINITY), nodes[i].first + k, std::min<std::uint32_t>(8, nodes[i].count - k)};
-        for (std::uint32_t t = g.first; t < g.first + g.count; ++t) {
-          g.lo = glm::min(glm::min(g.lo, tris[t].v0), glm::min(tris[t].v1, tris[t].v2));
-          g.hi = glm::max(glm::max(g.hi, tris[t].v0), glm::max(tris[t].v1, tris[t].v2));
-        }
-        group_boxes_.push_back(g);
-      }
-    }
-  }
 
   const glm::vec3 sky = scene_->sky_radiance();
   shades_.clear();
@@ -649,20 +631,8 @@ void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& pos
       }
       continue;
     }
-    if (node.count <= 8) {
-      draw_leaf<mode::depth>(node, mask, position, basis, sf);
-      occlusion_drawn(mask, rects);
-      continue;
-    }
-    // A bigger leaf in groups of eight (the set-up's width), each tested on its own box: a leaf in
-    // view is often hidden in part.
-    for (std::uint32_t g = group_first_[ni], k = 0; k < node.count; ++g, k += 8) {
-      const bvh_node& group = group_boxes_[g];
-      const unsigned group_mask = occlusion_test(group, mask, position, basis, rects, group.count);
-      if (!group_mask) continue;
-      draw_leaf<mode::depth>(group, group_mask, position, basis, sf);
-      occlusion_drawn(group_mask, rects);
-    }
+    draw_leaf<mode::depth>(node, mask, position, basis, sf);
+    occlusion_drawn(mask, rects);
   }
 }
 
