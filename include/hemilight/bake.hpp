@@ -58,6 +58,13 @@ struct bake_options {
   float offset_texels = 0.05f;
   /// Rings of dilation around every chart, >= 0; -1 fills every empty texel of the lightmap.
   int dilation = 16;
+  /// Stitch the seams (seams.hpp): after the passes, the texels that bilinear lookups along
+  /// near-coplanar seams read (both sides, padding included) are set by least squares so that
+  /// both sides agree along the seam while staying close to their baked values; dilation follows.
+  /// Within a mesh, between meshes and between pages; every output (irradiance, SH, HL2, shadow
+  /// mask). Cost: O(T log T) to find the seams, then about linear in the seams' texels
+  /// (docs/bake.md, "Seams").
+  bool stitch_seams = true;
   /// Output the L1 SH lightmaps (bake_result::sh_l1). Cost: 3 multiply-adds per hemicube texel in
   /// the directional passes.
   bool output_sh_l1 = false;
@@ -90,6 +97,8 @@ struct bake_stats {
   std::vector<cache_stats> passes;    ///< the cache's statistics per pass
   double coverage_seconds = 0.0;      ///< exact UV coverage and samples (compute_lightmap_samples)
   double direct_seconds = 0.0;        ///< the lights' direct irradiance (0 without lights)
+  std::size_t seam_texels = 0;        ///< texels set by seam stitching (0 without stitch_seams)
+  double stitch_seconds = 0.0;        ///< finding and stitching the seams, every output
   double seconds = 0.0;               ///< the whole bake (wall time)
 };
 

@@ -13,7 +13,8 @@
 //   sampler    sampler.hpp: irradiance at a point from one hemicube, directional projections
 //   cache      cache.hpp: the irradiance cache: records, radii, deterministic placement
 //   probes     probes.hpp: light probes: SH9 of the radiance at points
-//   bake       bake.hpp: the lightmap baker: UV coverage, samples, bounces, dilation
+//   bake       bake.hpp: the lightmap baker: UV coverage, samples, bounces, dilation;
+//              seams.hpp: the seams of a lightmap and their measured step (the baker stitches them)
 // The reference scenes by name are fixtures, outside the library (fixtures/, reference_scenes.hpp).
 #pragma once
 
@@ -33,3 +34,4 @@
 #include "hemilight/rays.hpp"
 #include "hemilight/sampler.hpp"
 #include "hemilight/scene.hpp"
+#include "hemilight/seams.hpp"

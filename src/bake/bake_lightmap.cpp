@@ -391,8 +391,17 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   bake_detail::bake_layout layout;
   layout.width = o.width;
   layout.height = o.height;
+  double seam_seconds = 0.0;
+  if (o.stitch_seams) {
+    const auto ts = std::chrono::steady_clock::now();
+    layout.seams = bake_detail::lightmap_seams(input, o.width, o.height, seam_options{}.coplanar_degrees);
+    layout.seam_pages = {bake_detail::page_rect{0, 0, o.width, o.height}};
+    seam_seconds = bake_detail::seconds_since(ts);
+  }
   std::vector<std::uint8_t> filled;
-  return bake_detail::bake_samples(bake_detail::compute_sparse_samples(input, o.width, o.height), sc, o, layout, t0, filled);
+  bake_result r = bake_detail::bake_samples(bake_detail::compute_sparse_samples(input, o.width, o.height), sc, o, layout, t0, filled);
+  r.stats.stitch_seconds += seam_seconds;
+  return r;
 }
 
 }  // namespace hemilight

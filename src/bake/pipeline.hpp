@@ -7,6 +7,7 @@
 #pragma once
 
 #include "coverage.hpp"
+#include "seam_search.hpp"
 
 #include "hemilight/bake.hpp"
 #include "hemilight/lights.hpp"
@@ -52,6 +53,10 @@ struct bake_layout {
   std::vector<occluder_block> occluders;
   bool occluders_reflect = false;  // occluders add albedo x the mean irradiance / pi to their emission
   bool textured_first_pass = false;  // pass 1 sees the emission through a texture (emission images)
+  // The seams the outputs are stitched along (bake_options::stitch_seams; empty: none) and the
+  // pages' rectangles in the grid their sides refer to.
+  std::vector<seam_piece> seams;
+  std::vector<page_rect> seam_pages;
   const char* who = "bake_lightmap";
 
   const std::uint8_t* blocked_mask() const { return blocked.empty() ? nullptr : blocked.data(); }

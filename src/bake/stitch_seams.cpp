@@ -1,0 +1,219 @@
+// Seam stitching (stitch_seams.hpp): the Gauss-Legendre points of the seams, the least-squares
+// systems (scalar, HL2) and their solves, as the chain stitch_points -> unknown_texels ->
+// assemble (design_matrix, normal_matrix) -> factorise; per image: initial_values -> solve ->
+// write back.
+#include "stitch_seams.hpp"
+
+#include "dilate.hpp"
+
+#include "hemilight/error.hpp"
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace hemilight::bake_detail {
+
+namespace {
+
+// Parameters in [0, 1] where side s's bilinear coordinates (texel coordinates - 0.5) cross an
+// integer, appended to `cuts`.
+void grid_crossings(const seam_side& s, std::vector<double>& cuts) {
+  for (int axis = 0; axis < 2; ++axis) {
+    const double a = double(s.t0[axis]) - 0.5, b = double(s.t1[axis]) - 0.5;
+    if (a == b) continue;
+    const double lo = std::min(a, b), hi = std::max(a, b);
+    for (double k = std::ceil(lo); k <= hi; ++k) {
+      const double t = (k - a) / (b - a);
+      if (t > 0.0 && t < 1.0) cuts.push_back(t);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<stitch_point> stitch_points(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages,
+                                        std::size_t grid_width) {
+  // Three-point Gauss-Legendre on [-1, 1]: exact for the squared step, a polynomial of degree 4
+  // along a part where both sides stay in one bilinear cell.
+  const double node[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  std::vector<stitch_point> out;
+  std::vector<double> cuts;
+  for (const seam_piece& p : pieces) {
+    if (!p.coplanar) continue;
+    cuts.assign({0.0, 1.0});
+    grid_crossings(p.a, cuts);
+    grid_crossings(p.b, cuts);
+    std::sort(cuts.begin(), cuts.end());
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+      const double h = 0.5 * (cuts[i + 1] - cuts[i]), m = 0.5 * (cuts[i + 1] + cuts[i]);
+      if (!(h > 1e-9)) continue;
+      for (int g = 0; g < 3; ++g) {
+        const auto t = float(m + h * node[g]);
+        stitch_point s;
+        s.a = bilinear_footprint(pages[std::size_t(p.a.page)], grid_width, p.a.t0 + t * (p.a.t1 - p.a.t0));
+        s.b = bilinear_footprint(pages[std::size_t(p.b.page)], grid_width, p.b.t0 + t * (p.b.t1 - p.b.t0));
+        s.weight = weight[g] * h * double(p.length_texels);
+        s.ta = p.a.tangent;
+        s.ba = p.a.bitangent;
+        s.tb = p.b.tangent;
+        s.bb = p.b.bitangent;
+        out.push_back(s);
+      }
+    }
+  }
+  return out;
+}
+
+struct seam_stitcher::system {
+  int components = 1;  // unknowns per texel: 1 (scalar images), 3 (the HL2 triple)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+};
+
+namespace {
+
+using triplet = Eigen::Triplet<double>;
+
+std::vector<std::size_t> unknown_texels(const std::vector<stitch_point>& points) {
+  std::vector<std::size_t> t;
+  t.reserve(8 * points.size());
+  for (const stitch_point& p : points)
+    for (std::size_t k = 0; k < 4; ++k) {
+      t.push_back(p.a.texel[k]);
+      t.push_back(p.b.texel[k]);
+    }
+  std::sort(t.begin(), t.end());
+  t.erase(std::unique(t.begin(), t.end()), t.end());
+  return t;
+}
+
+Eigen::Index column_of(const std::vector<std::size_t>& texels, std::size_t texel) {
+  return Eigen::Index(std::lower_bound(texels.begin(), texels.end(), texel) - texels.begin());
+}
+
+// The HL2 basis directions' azimuths in the tangent frame (docs/bake.md): (-1/sqrt6, 1/sqrt2) is
+// at 120 degrees, (-1/sqrt6, -1/sqrt2) at 240, (sqrt(2/3), 0) at 0.
+constexpr double hl2_azimuth[3] = {2.0943951023931957, 4.1887902047863905, 0.0};
+
+// Row r of the map from a side's HL2 triple to (mean, first harmonic . e1, first harmonic . e2)
+// with (e1, e2) = side a's (tangent, bitangent): the triple samples h(phi) = c0 + c1 . (cos phi,
+// sin phi) at the three azimuths, so c0 = mean, c1 = 2/3 sum h_k (cos, sin)(phi_k), and the
+// world-space harmonic is c1.x t + c1.y b.
+double hl2_coefficient(int r, int k, const glm::vec3& t, const glm::vec3& b, const glm::vec3& e1, const glm::vec3& e2) {
+  if (r == 0) return 1.0 / 3.0;
+  const glm::vec3& e = r == 1 ? e1 : e2;
+  const double c = std::cos(hl2_azimuth[k]), s = std::sin(hl2_azimuth[k]);
+  return 2.0 / 3.0 * (c * double(glm::dot(t, e)) + s * double(glm::dot(b, e)));
+}
+
+// A = W^(1/2) times the map from the unknowns to the steps at the points.
+Eigen::SparseMatrix<double> design_matrix(const std::vector<stitch_point>& points, const std::vector<std::size_t>& texels,
+                                          int components) {
+  std::vector<triplet> entries;
+  entries.reserve(points.size() * std::size_t(8 * components * components));
+  const auto n = Eigen::Index(components);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const stitch_point& p = points[i];
+    const double w = std::sqrt(p.weight);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Index ca = column_of(texels, p.a.texel[k]), cb = column_of(texels, p.b.texel[k]);
+      for (int r = 0; r < components; ++r) {
+        const Eigen::Index row = Eigen::Index(i) * n + r;
+        for (int c = 0; c < components; ++c) {
+          const double alpha_a = components == 1 ? 1.0 : hl2_coefficient(r, c, p.ta, p.ba, p.ta, p.ba);
+          const double alpha_b = components == 1 ? 1.0 : hl2_coefficient(r, c, p.tb, p.bb, p.ta, p.ba);
+          entries.emplace_back(row, ca * n + c, w * double(p.a.weight[k]) * alpha_a);
+          entries.emplace_back(row, cb * n + c, -w * double(p.b.weight[k]) * alpha_b);
+        }
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> a(Eigen::Index(points.size()) * n, Eigen::Index(texels.size()) * n);
+  a.setFromTriplets(entries.begin(), entries.end());
+  return a;
+}
+
+// A^T A + lambda I.
+Eigen::SparseMatrix<double> normal_matrix(const Eigen::SparseMatrix<double>& a) {
+  Eigen::SparseMatrix<double> n = a.transpose() * a;
+  Eigen::SparseMatrix<double> id(n.rows(), n.cols());
+  id.setIdentity();
+  return n + stitch_regularization * id;
+}
+
+void factorise(Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt, const Eigen::SparseMatrix<double>& n) {
+  ldlt.compute(n);
+  // The matrix is symmetric positive definite by construction (lambda > 0): a failure is a bug.
+  if (ldlt.info() != Eigen::Success) throw error(status::internal, "bake: the seam stitching system could not be factorised");
+}
+
+// The values to start from at the unknown texels: the image's own where filled, else those of a
+// 4-ring dilation of the filled texels (0 where even that does not reach).
+image initial_values(const image& img, const std::vector<std::uint8_t>& filled, const std::uint8_t* blocked,
+                     const std::vector<std::size_t>& texels) {
+  bool all_filled = true;
+  for (std::size_t k : texels) all_filled = all_filled && filled[k];
+  image start = img;
+  if (all_filled) return start;
+  std::vector<std::uint8_t> f = filled;
+  dilate_masked(start, f, 4, blocked);
+  return start;
+}
+
+}  // namespace
+
+seam_stitcher::seam_stitcher(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages, int grid_width, bool hl2)
+    : points_(stitch_points(pieces, pages, std::size_t(grid_width))) {
+  texels_ = unknown_texels(points_);
+  if (texels_.empty()) return;
+  scalar_ = std::make_unique<system>();
+  factorise(scalar_->ldlt, normal_matrix(design_matrix(points_, texels_, 1)));
+  if (hl2) {
+    hl2_ = std::make_unique<system>();
+    hl2_->components = 3;
+    factorise(hl2_->ldlt, normal_matrix(design_matrix(points_, texels_, 3)));
+  }
+}
+
+seam_stitcher::~seam_stitcher() = default;
+
+void seam_stitcher::stitch(image& img, std::vector<std::uint8_t>& filled, const std::uint8_t* blocked, float lo, float hi) const {
+  if (empty()) return;
+  const image start = initial_values(img, filled, blocked, texels_);
+  const auto ch = std::size_t(img.channels);
+  const auto n = Eigen::Index(texels_.size());
+  Eigen::MatrixXd rhs(n, Eigen::Index(ch));
+  for (Eigen::Index u = 0; u < n; ++u)
+    for (std::size_t c = 0; c < ch; ++c) rhs(u, Eigen::Index(c)) = stitch_regularization * double(start.pixels[texels_[std::size_t(u)] * ch + c]);
+  const Eigen::MatrixXd x = scalar_->ldlt.solve(rhs);
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const std::size_t k = texels_[std::size_t(u)];
+    for (std::size_t c = 0; c < ch; ++c) img.pixels[k * ch + c] = std::clamp(float(x(u, Eigen::Index(c))), lo, hi);
+    filled[k] = 1;
+  }
+}
+
+void seam_stitcher::stitch_hl2(std::array<image, 3>& hl2, std::vector<std::uint8_t>& filled, const std::uint8_t* blocked) const {
+  if (empty()) return;
+  std::array<image, 3> start;
+  for (std::size_t j = 0; j < 3; ++j) start[j] = initial_values(hl2[j], filled, blocked, texels_);
+  const auto n = Eigen::Index(texels_.size());
+  Eigen::MatrixXd rhs(3 * n, 3);  // unknown 3u + k (basis k) per colour channel c
+  for (Eigen::Index u = 0; u < n; ++u)
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t c = 0; c < 3; ++c)
+        rhs(3 * u + Eigen::Index(j), Eigen::Index(c)) = stitch_regularization * double(start[j].pixels[texels_[std::size_t(u)] * 3 + c]);
+  const Eigen::MatrixXd x = hl2_->ldlt.solve(rhs);
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const std::size_t k = texels_[std::size_t(u)];
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t c = 0; c < 3; ++c)
+        hl2[j].pixels[k * 3 + c] = std::max(0.0f, float(x(3 * u + Eigen::Index(j), Eigen::Index(c))));
+    filled[k] = 1;
+  }
+}
+
+}  // namespace hemilight::bake_detail
