@@ -388,6 +388,36 @@ const raster_detail::edge_table& raster_detail::edge_table_of(const scene& s) {
   return *static_cast<const edge_table*>(slot->value.get());
 }
 
+// Resets the per-render state before a render of count texels at the given resolution: the
+// per-texel lists where the last render used them (all of them if N changed), the hard-texel
+// marks and rows.
+void raster_detail::rasterizer_impl::edge_prepare(std::size_t count, int resolution) {
+  if (edges_.fragment_count.size() != count)
+    edges_.fragment_count.assign(count, 0u);
+  else
+    for (const std::uint32_t t : edges_.fragment_texels) edges_.fragment_count[t] = 0u;
+  edges_.fragments.clear();
+  edges_.fragment_shapes.clear();
+  edges_.fragment_texels.clear();
+  edges_.groups.clear();
+  if (edges_.whole_z.size() != count) {
+    edges_.whole_z.assign(count, 0.0f);
+    edges_.whole_id.resize(count);
+  } else {
+    for (const std::uint32_t t : edges_.hard_texels) edges_.whole_z[t] = 0.0f;
+  }
+  edges_.words_per_row = (static_cast<std::size_t>(resolution) + 63) / 64;
+  edges_.hard_bits.assign(edges_.words_per_row * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
+  edges_.silhouette_bits.assign(edges_.hard_bits.size(), 0u);
+  edges_.hard_texels.clear();
+  edges_.hard_rows.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
+  for (std::size_t i = 0; i < edges_.hard_rows.size(); i += 2) {
+    edges_.hard_rows[i] = resolution;
+    edges_.hard_rows[i + 1] = -1;
+  }
+  edges_.hard_faces = 0;
+}
+
 // The slopes of each texel's weight density (edges_.density), once per resolution. The
 // integrator weights a texel by the projected solid angle over it, of density (1 + u^2 + v^2)^-2
 // on the top face (z = 1) and v (1 + u^2 + v^2)^-2 on the side faces (v = height); relative to

@@ -256,6 +256,7 @@ class alignas(64) rasterizer_impl {
     std::vector<std::uint32_t> fragment_texels;   // texels with fragments, in first-touch order
     std::vector<edge_group> groups;
   };
+  void edge_prepare(std::size_t count, int resolution);
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
   void edge_mark_hard(const glm::vec3& position, const frame& basis);

@@ -1,7 +1,7 @@
 // The hemicube rasterizer (raster.hpp): binding, traversal and culling, clipping and snapping,
 // the coverage paths of one triangle (draw_fixed) and the resolve. The SIMD kernel sets it
 // dispatches to are in kernels_sse2.hpp, kernels_avx2.hpp and leaf_avx.inl (one translation unit,
-// so the kernels inline where their target allows); exact edge coverage is in edge.cpp.
+// so the kernels inline where their target allows); exact edge coverage is in edge_coverage.cpp.
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
 #include "lod.hpp"
@@ -386,33 +386,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   ties_.clear();
   ties_.limit = 2 * count;
   tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
-  if (edge_) {
-    // The per-texel lists are reset where the last render used them (all of them if N changed).
-    if (edges_.fragment_count.size() != count)
-      edges_.fragment_count.assign(count, 0u);
-    else
-      for (const std::uint32_t t : edges_.fragment_texels) edges_.fragment_count[t] = 0u;
-    edges_.fragments.clear();
-    edges_.fragment_shapes.clear();
-    edges_.fragment_texels.clear();
-    edges_.groups.clear();
-    if (edges_.whole_z.size() != count) {
-      edges_.whole_z.assign(count, 0.0f);
-      edges_.whole_id.resize(count);
-    } else {
-      for (const std::uint32_t t : edges_.hard_texels) edges_.whole_z[t] = 0.0f;
-    }
-    edges_.words_per_row = (static_cast<std::size_t>(resolution) + 63) / 64;
-    edges_.hard_bits.assign(edges_.words_per_row * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
-    edges_.silhouette_bits.assign(edges_.hard_bits.size(), 0u);
-    edges_.hard_texels.clear();
-    edges_.hard_rows.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
-    for (std::size_t i = 0; i < edges_.hard_rows.size(); i += 2) {
-      edges_.hard_rows[i] = resolution;
-      edges_.hard_rows[i + 1] = -1;
-    }
-    edges_.hard_faces = 0;
-  }
+  if (edge_) edge_prepare(count, resolution);
 }
 
 std::uint32_t raster_detail::rasterizer_impl::seen_triangle(std::size_t texel) const noexcept {
