@@ -41,7 +41,8 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, environment_rgb), HEMILIGHT_SPAN(hemilight_bake_options, environment_size),
     HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
-    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage)};
+    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage),
+    HEMILIGHT_SPAN(hemilight_bake_options, strict)};  // (reserved1 is padding: never read)
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -49,7 +50,10 @@ const span bake_stats_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_stats, struct_size), HEMILIGHT_SPAN(hemilight_bake_stats, sampled_texels),
     HEMILIGHT_SPAN(hemilight_bake_stats, invalid_texels), HEMILIGHT_SPAN(hemilight_bake_stats, dilated_texels),
     HEMILIGHT_SPAN(hemilight_bake_stats, overlapping_texels), HEMILIGHT_SPAN(hemilight_bake_stats, hemicubes),
-    HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds)};
+    HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds),
+    HEMILIGHT_SPAN(hemilight_bake_stats, degenerate_triangles), HEMILIGHT_SPAN(hemilight_bake_stats, no_uv_area_triangles),
+    HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_mesh), HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_triangle),
+    HEMILIGHT_SPAN(hemilight_bake_stats, clamped_uvs)};
 const span cubemap_irradiance_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, struct_size),
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, method),
@@ -60,15 +64,20 @@ const span cubemap_irradiance_options_fields[] = {
 // The sizes of this ABI's layouts (x86-64 and every LP64 ABI). A struct that grows keeps its old
 // size here and its new fields start at or after it: edge_coverage was appended to the cache
 // options of 96 bytes (after the padding field reserved0, since offset 92 was the old layout's
-// tail padding) and to the bake options of 144.
+// tail padding) and to the bake options of 144; strict to the bake options of 152 (after the
+// padding field reserved1); the bake statistics' input counts to the statistics of 64.
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 104, "hemilight_cache_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_cache_options, edge_coverage) >= 96,
               "hemilight_cache_options: edge_coverage must start past the earlier layout's sizeof");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 152, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 160, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, edge_coverage) >= 144,
               "hemilight_bake_options: edge_coverage must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, strict) >= 152,
+              "hemilight_bake_options: strict must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 104, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_stats, degenerate_triangles) >= 64,
+              "hemilight_bake_stats: the input counts must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cubemap_irradiance_options) == 24,
               "hemilight_cubemap_irradiance_options changed: see above");
 
@@ -149,6 +158,7 @@ hemilight_bake_options default_bake_options() {
   o.shadow_mask_rgba = nullptr;
   o.shadow_mask_capacity = 0;
   o.edge_coverage = bake_options{}.sampler.raster.edge_coverage ? 1 : 0;
+  o.strict = bake_options{}.strict ? 1 : 0;
   return o;
 }
 
@@ -254,6 +264,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.output_hl2 = output_hl2;
   for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
   o.sampler.raster.edge_coverage = c.edge_coverage == 1;
+  o.strict = c.strict == 1;
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;

@@ -539,6 +539,14 @@ typedef struct hemilight_bake_options {
   /* Since 0.14; 0 or 1: every hemicube of the bake with exact edge coverage, as
    * hemilight_cache_options.edge_coverage (default 0). */
   int edge_coverage;
+  int reserved1;           /* padding, not read: keeps strict past the earlier layout's sizeof */
+  /* Since 0.15; 0 or 1 (default 0). A triangle with 3D area but no lightmap UV area (at most 1e-12
+   * of the UV square): 0, it still occludes, gets no texels and is counted in the statistics
+   * (no_uv_area_triangles, first_no_uv_area_mesh and _triangle); 1, the bake fails with
+   * INVALID_ARGUMENT naming it. Degenerate triangles (no 3D area at float precision: twice their
+   * area at most 2^-22 x longest edge x largest coordinate magnitude) are skipped either way:
+   * no texels, never occlude, counted (degenerate_triangles). */
+  int strict;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */
@@ -557,6 +565,13 @@ typedef struct hemilight_bake_stats {
   size_t hemicubes;          /* hemicubes rendered, all bounces */
   size_t records;            /* irradiance cache records, all bounces */
   double seconds;            /* wall time */
+  /* Since 0.15: the input the bake went past (hemilight_bake_options.strict). */
+  size_t degenerate_triangles;       /* triangles without 3D area: skipped (no texels, never occlude) */
+  size_t no_uv_area_triangles;       /* triangles with 3D area but no lightmap UV area: occlude, no texels */
+  size_t first_no_uv_area_mesh;      /* the first of them: its mesh (index into meshes) and its index in */
+  size_t first_no_uv_area_triangle;  /* that mesh; both SIZE_MAX when there is none */
+  size_t clamped_uvs;                /* lightmap UVs (vertices; scene bakes: page UVs) at most 0.001 outside
+                                        [0, 1], clamped onto it (beyond 0.001 they are refused) */
 } hemilight_bake_stats;
 
 /* As hemilight_cache_stats_init, for bake statistics. */
@@ -575,10 +590,14 @@ static inline void hemilight_bake_stats_init(hemilight_bake_stats* stats) {
  * valid: NULL, or at least width height bytes (valid_capacity): 1 where the texel was sampled
  *   and its samples were valid (not inside geometry), 0 for dilated or invalid texels.
  * stats may be NULL. Write the result with hemilight_exr_save_rgb.
+ * Degenerate input is not refused: triangles without 3D area are skipped, UVs at most 0.001
+ * outside [0, 1] clamped, triangles with 3D area but no UV area occlude without texels (unless
+ * options->strict); the statistics count each.
  * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
  * NULL options/irradiance_rgb, capacities too small, options out of range (the message names the
- * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs outside [0, 1],
- * indices out of range, a triangle with 3D area but zero UV area, invalid materials, no texel
+ * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs more than 0.001
+ * outside [0, 1], indices out of range, with options->strict a triangle with 3D area but zero UV
+ * area ("meshes[1]: triangle 0 (indices[0..2]) has zero area ..."), invalid materials, no texel
  * covered, an environment map with a bad size or a negative or non-finite value (named by index);
  * OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
  * Cost: see hemilight_cache_irradiance, once per bounce. */
@@ -776,8 +795,9 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
  * mesh_count or page_count 0, NULL meshes/placements/pages, a page size out of range, a NULL
  * irradiance_rgb or a capacity too small, an albedo or emission value out of range
  * ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or non-finite
- * scale/offset, a page UV outside [0, 1] ("meshes[2].lightmap_uvs[9] (vertex 4, v) = 0.9 maps to
- * 1.3 in page 1"), a triangle with no area in its page, everything hemilight_bake_lightmap rejects
+ * scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9] (vertex 4,
+ * v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in its page
+ * (without: counted, as hemilight_bake_lightmap does), everything hemilight_bake_lightmap rejects
  * in the meshes and options, no texel sampled in any page; OUT_OF_MEMORY, CANCELLED as there.
  * Cost: as hemilight_bake_lightmap over the sum of the pages' texels. */
 HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
