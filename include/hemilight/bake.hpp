@@ -14,6 +14,7 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
+#include "hemilight/unwrap.hpp"  // generate_lightmap_uvs: lightmap UVs for what the baker bakes
 
 #include <array>
 #include <cstddef>
@@ -326,15 +327,6 @@ image bake_radiance_texture(const bake_input& input, const bake_options& options
 /// of texels filled. Throws error(invalid_argument) if filled's size is not width x height or
 /// rings < -1. Cost: O(texels x rings).
 std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings);
-
-/// Gives `mesh` lightmap UVs for the baker: planar groups of edge-connected triangles (same
-/// plane, shared edge by position) become charts, each projected onto its plane at one common
-/// texel density and packed in shelves into a size x size lightmap with `padding` empty texels
-/// between charts (and at the border). Vertices shared by several charts are duplicated, so the
-/// mesh's vertex count may grow; triangles keep their order and materials. Meant for the
-/// built-in scenes (boxes, rooms), not as a general unwrapper. Throws error(invalid_argument)
-/// for size < 8, padding < 0 or 4 padding >= size. Cost: O(T log T) plus a few packings.
-void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding = 2);
 
 // ---- directional lightmaps ------------------------------------------------------------------
 
