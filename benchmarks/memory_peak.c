@@ -12,7 +12,12 @@
  *           filter   hemilight_cubemap_filter_cosine_power (p = 64) of an N^3 cube map to N / 2
  *           irrad    hemilight_cubemap_filter_irradiance (quadrature) of an N^3 cube map to 32
  * The scene: a unit box open at the top (10 quads, 20 triangles) under a sky of radiance 1.
- * Prints one line: entry, N, threads, count, seconds, KiB before, peak, after, after release. */
+ * Prints one line: entry, N, threads, count, seconds, KiB before, peak, after, after release.
+ *
+ *   memory_peak exr_rgb|exr_cube FILE [capacity] [repeats]
+ *     hemilight_exr_load_rgb or hemilight_exr_load_cubemap_rgb of FILE into a buffer of `capacity`
+ *     floats (default 48: what a crafted file's refusal costs), `repeats` times (default 1).
+ *     Prints the status, the median seconds per call, and KiB before, peak and after. */
 #define _POSIX_C_SOURCE 200112L
 #include "hemilight.h"
 
@@ -62,8 +67,44 @@ static hemilight_scene* box(void) {
   return s;
 }
 
+static int compare_doubles(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return x < y ? -1 : x > y ? 1 : 0;
+}
+
+/* memory_peak exr_rgb|exr_cube FILE [capacity] [repeats] (top of this file). */
+static int exr_main(const char* entry, int argc, char** argv) {
+  const char* path = argc > 2 ? argv[2] : "";
+  const size_t capacity = argc > 3 ? (size_t)atol(argv[3]) : 48;
+  const int repeats = argc > 4 && atoi(argv[4]) > 0 ? atoi(argv[4]) : 1;
+  float* buffer = (float*)malloc((capacity > 0 ? capacity : 1) * sizeof(float));
+  double* seconds = (double*)malloc((size_t)repeats * sizeof(double));
+  hemilight_status st = HEMILIGHT_OK;
+  long before, peak;
+  int i, w = 0, h = 0;
+  if (!buffer || !seconds) return 1;
+  before = status_kib("VmRSS:");
+  for (i = 0; i < repeats; ++i) {
+    const double t0 = now();
+    if (strcmp(entry, "exr_rgb") == 0)
+      st = hemilight_exr_load_rgb(path, buffer, capacity, &w, &h);
+    else
+      st = hemilight_exr_load_cubemap_rgb(path, buffer, capacity, &w);
+    seconds[i] = now() - t0;
+  }
+  peak = status_kib("VmHWM:");
+  qsort(seconds, (size_t)repeats, sizeof(double), compare_doubles);
+  printf("%s capacity=%lu repeats=%d status=%d median_seconds=%.6f rss_before_kib=%ld peak_kib=%ld after_kib=%ld\n", entry,
+         (unsigned long)capacity, repeats, (int)st, seconds[repeats / 2], before, peak, status_kib("VmRSS:"));
+  if (st != HEMILIGHT_OK) printf("  %s\n", hemilight_last_error());
+  free(seconds);
+  free(buffer);
+  return 0;
+}
+
 int main(int argc, char** argv) {
   const char* entry = argc > 1 ? argv[1] : "sample";
+  if (strcmp(entry, "exr_rgb") == 0 || strcmp(entry, "exr_cube") == 0) return exr_main(entry, argc, argv);
   const int n = argc > 2 ? atoi(argv[2]) : 64;
   const int threads = argc > 3 ? atoi(argv[3]) : 1;
   const size_t count = argc > 4 ? (size_t)atol(argv[4]) : 1;

@@ -14,14 +14,18 @@ using hemilight::capi::all_finite;
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
 
+// with_backfaces: hemilight_sample_probes_with_backfaces (backface_fraction is required with count > 0).
 hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, const float* positions, size_t count,
-                               int resolution, int thread_count, float* sh9_rgb, float* backface_fraction) {
+                               int resolution, int thread_count, float* sh9_rgb, bool with_backfaces,
+                               float* backface_fraction) {
   return guarded(fn, [&] {
-    // Step 1: the arguments and every point, before anything is rendered.
+    // Step 1: the arguments and every point, before anything is rendered; every argument whatever
+    // the count (the arrays may be NULL only when it is 0: then nothing is done).
     if (!scene) return invalid(fn, "scene is NULL");
-    if (count == 0) return HEMILIGHT_OK;
-    if (!positions) return invalid(fn, "positions is NULL");
-    if (!sh9_rgb) return invalid(fn, "sh9_rgb is NULL");
+    const std::string with_count = " but count is " + std::to_string(count);
+    if (count > 0 && !positions) return invalid(fn, "positions is NULL" + with_count);
+    if (count > 0 && !sh9_rgb) return invalid(fn, "sh9_rgb is NULL" + with_count);
+    if (count > 0 && with_backfaces && !backface_fraction) return invalid(fn, "backface_fraction is NULL" + with_count);
     if (count > hemilight::max_scene_elements)
       return invalid(fn, "count " + std::to_string(count) + " is over the limit of " +
                              std::to_string(hemilight::max_scene_elements) + " probes per call");
@@ -33,6 +37,7 @@ hemilight_status sample_probes(const char* fn, const hemilight_scene* scene, con
         return invalid(fn, "point " + std::to_string(i) + ": position (" + std::to_string(positions[3 * i]) + ", " +
                                std::to_string(positions[3 * i + 1]) + ", " + std::to_string(positions[3 * i + 2]) +
                                ") is not finite or beyond 1e18");
+    if (count == 0) return HEMILIGHT_OK;
     // Step 2: the probes (into the library's own arrays: nothing is written on failure).
     std::vector<glm::vec3> p(count);
     for (std::size_t i = 0; i < count; ++i) p[i] = {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};
@@ -63,15 +68,14 @@ extern "C" {
 
 hemilight_status hemilight_sample_probes(const hemilight_scene* scene, const float* positions, size_t count, int resolution,
                                          int thread_count, float* sh9_rgb) {
-  return sample_probes("hemilight_sample_probes", scene, positions, count, resolution, thread_count, sh9_rgb, nullptr);
+  return sample_probes("hemilight_sample_probes", scene, positions, count, resolution, thread_count, sh9_rgb, false, nullptr);
 }
 
 hemilight_status hemilight_sample_probes_with_backfaces(const hemilight_scene* scene, const float* positions, size_t count,
                                                         int resolution, int thread_count, float* sh9_rgb,
                                                         float* backface_fraction) {
-  const char* fn = "hemilight_sample_probes_with_backfaces";
-  if (count > 0 && !backface_fraction) return guarded(fn, [&] { return invalid(fn, "backface_fraction is NULL"); });
-  return sample_probes(fn, scene, positions, count, resolution, thread_count, sh9_rgb, backface_fraction);
+  return sample_probes("hemilight_sample_probes_with_backfaces", scene, positions, count, resolution, thread_count, sh9_rgb,
+                       true, backface_fraction);
 }
 
 hemilight_status hemilight_sh9_irradiance(const float sh9_rgb[27], const float normal[3], float irradiance[3]) {

@@ -240,12 +240,13 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
                                                    size_t count, int resolution, int thread_count, hemilight_irradiance* out) {
   const char* fn = "hemilight_sample_irradiance_batch";
   return guarded(fn, [&] {
-    // Step 1: the arguments and every point, before anything is rendered.
+    // Step 1: the arguments and every point, before anything is rendered; every argument whatever
+    // the count (the arrays may be NULL only when it is 0: then nothing is done).
     if (!scene) return invalid(fn, "scene is NULL");
-    if (count == 0) return HEMILIGHT_OK;
-    if (!positions) return invalid(fn, "positions is NULL");
-    if (!normals) return invalid(fn, "normals is NULL");
-    if (!out) return invalid(fn, "out is NULL");
+    const std::string with_count = " but count is " + std::to_string(count);
+    if (count > 0 && !positions) return invalid(fn, "positions is NULL" + with_count);
+    if (count > 0 && !normals) return invalid(fn, "normals is NULL" + with_count);
+    if (count > 0 && !out) return invalid(fn, "out is NULL" + with_count);
     if (count > hemilight::max_scene_elements)
       return invalid(fn, "count " + std::to_string(count) + " is over the limit of " + std::to_string(hemilight::max_scene_elements) +
                              " points per call");
@@ -254,6 +255,7 @@ hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene,
     for (std::size_t i = 0; i < count; ++i)
       if (!hemilight::capi::point_ok(positions + 3 * i, normals + 3 * i))  // the message only for the bad one
         return check_point(fn, "point " + std::to_string(i) + ": ", positions + 3 * i, normals + 3 * i);
+    if (count == 0) return HEMILIGHT_OK;
     // Step 2: the points on the workers, one context each, into a buffer of our own (each
     // point's result depends on that point alone: the same for any thread count).
     // Contexts are made by the workers on their first chunk: only workers that run allocate (at

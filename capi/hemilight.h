@@ -13,6 +13,7 @@
  *     light colours are limited to 1e30 so that sums of them stay finite; a result that would
  *     still overflow float (a light of huge intensity next to a point) fails with
  *     INVALID_ARGUMENT ("... overflows float") and writes nothing.
+ *   - Coordinates of vertices, lights and query points are limited to 1e18 in magnitude.
  *   - Directions and positions are float[3] (x, y, z); frames are right-handed.
  *   - Radiance is in W m^-2 sr^-1 (or any consistent unit); irradiance is the integral of
  *     L cos(theta) d omega, so a uniform sky of radiance L gives pi L. No hidden 1/pi.
@@ -21,6 +22,13 @@
  *     x along the GL s coordinate and y along t.
  *   - Thread safety: every function may be called from any thread; objects are immutable after
  *     creation unless a function says otherwise.
+ *   - Arrays and counts (every entry that takes an array with a count): every argument is checked
+ *     whatever the counts, so a count of 0 never hides a bad one (a NULL scene, an invalid N or
+ *     thread_count fails with count 0 as with count 1000). An array may be NULL only when its
+ *     count is 0. With valid arguments, count 0 succeeds and writes nothing (the batch, the
+ *     probes) or makes an empty set (hemilight_scene_create, hemilight_scene_with_lights, a bake
+ *     mesh without vertices, options->light_count); an entry that needs elements says so in its
+ *     Errors (hemilight_cache_irradiance: count 0; the bakes: mesh_count 0, page_count 0).
  *
  * Structs that grow (what stays compatible)
  *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
@@ -108,31 +116,35 @@ HEMILIGHT_API hemilight_status hemilight_hemicube_texel_info(int resolution, siz
 
 /* Width and height of an EXR image, and whether it is a cube map (envmap attribute = cube, or
  * height == 6 x width). Any output may be NULL. Errors: INVALID_ARGUMENT (path NULL), IO (missing,
- * unreadable or corrupt file), UNSUPPORTED (no R, G, B channels). */
+ * a directory, unreadable, truncated or corrupt file, a header attribute larger than the file),
+ * UNSUPPORTED (no R, G, B channels, or subsampled ones), OUT_OF_MEMORY (over 2^28 pixels). */
 HEMILIGHT_API hemilight_status hemilight_exr_info(const char* path, int* width, int* height, int* is_cubemap);
 
 /* Reads an EXR image as float RGB into rgb (capacity in floats, at least width x height x 3).
  * width and height (may be NULL) receive the size. Errors: as hemilight_exr_info, and
- * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). */
+ * INVALID_ARGUMENT when rgb is NULL or capacity is too small (nothing is written then). The size
+ * in the header is compared with capacity before any pixel is decoded: a refusal costs the
+ * header's reading alone, whatever size the file claims. */
 HEMILIGHT_API hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t capacity, int* width,
                                                       int* height);
 
 /* Writes float RGB pixels (width x height x 3 floats) as an EXR file, 32-bit float channels or,
  * when half_float is nonzero, 16-bit half. The file is replaced atomically: on failure any
- * existing file is left as it was. Errors: INVALID_ARGUMENT (NULL, sizes <= 0 or over the limit,
- * non-finite values are allowed), IO (cannot write). */
+ * existing file is left as it was. Errors: INVALID_ARGUMENT (NULL, sizes <= 0, width x height over
+ * 2^28 pixels; non-finite values are allowed), IO (cannot write). */
 HEMILIGHT_API hemilight_status hemilight_exr_save_rgb(const char* path, const float* rgb, int width, int height,
                                                       int half_float);
 
 /* Reads an ENVMAP_CUBE EXR (size x 6 size) as six GL-ordered faces of float RGB into faces
  * (capacity in floats, at least 6 x size x size x 3); size receives the face size (may be NULL).
  * Errors: as hemilight_exr_load_rgb, and UNSUPPORTED when the image is not 6x as tall as wide or
- * is a latlong map. */
+ * is a latlong map. The shape and the capacity are checked from the header, before any pixel is
+ * decoded. */
 HEMILIGHT_API hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, float* faces, size_t capacity,
                                                               int* size);
 
 /* Writes six GL-ordered float RGB faces of size x size as an OpenEXR ENVMAP_CUBE file.
- * Errors: as hemilight_exr_save_rgb. */
+ * Errors: as hemilight_exr_save_rgb, the size outside [1, 6688]. */
 HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, const float* faces, int size,
                                                               int half_float);
 
@@ -145,15 +157,16 @@ HEMILIGHT_API hemilight_status hemilight_exr_save_cubemap_rgb(const char* path, 
 typedef struct hemilight_scene hemilight_scene;
 
 /* Creates a scene, copying the arrays (the caller may free them afterwards):
- *   positions          3 * vertex_count floats (x, y, z), finite
+ *   positions          3 * vertex_count floats (x, y, z), finite, at most 1e18 in magnitude
  *   indices            3 * triangle_count vertex indices, each < vertex_count
  *   triangle_radiance  3 * triangle_count floats (RGB per triangle), in [0, 1e30]
  *   sky_radiance       3 floats, in [0, 1e30]
  * An empty scene (vertex_count = triangle_count = 0; the arrays may then be NULL) is valid: every
  * texel sees the sky. On success *out receives the scene; release it with hemilight_scene_release.
  * Errors (nothing written to *out): INVALID_ARGUMENT for a NULL pointer with a nonzero count, a
- * NULL out or sky_radiance, counts over 2^31 - 1, NaN/Inf positions, out-of-range indices,
- * negative or non-finite radiance; the message names the argument and the index, e.g.
+ * NULL out or sky_radiance, counts over 2^31 - 1, positions NaN/Inf or beyond 1e18 in magnitude,
+ * out-of-range indices, radiance negative, non-finite or above 1e30; the message names the
+ * argument and the index, e.g.
  * "indices[17] = 900 is out of range: 12 vertices". OUT_OF_MEMORY if allocation fails.
  * Cost: O(T log^2 T) for T triangles (building the culling hierarchy); ~100 bytes per triangle. */
 HEMILIGHT_API hemilight_status hemilight_scene_create(const float* positions, size_t vertex_count,
@@ -169,9 +182,10 @@ HEMILIGHT_API void hemilight_scene_release(hemilight_scene* scene);
  * handle keeps the other valid) whose sky is an environment cube map: texels that hit nothing see
  * the map's radiance along their world direction (seamless bilinear) instead of the constant sky.
  * faces_rgb: six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z), size x size RGB floats each,
- * face-major, finite and >= 0; copied. Directions are the scene's world axes. Release the new
+ * face-major, each in [0, 1e30]; copied. Directions are the scene's world axes. Release the new
  * handle with hemilight_scene_release. Errors (nothing written to *out): INVALID_ARGUMENT for NULL
- * arguments, size outside [1, 6688], negative or non-finite values (the message names the index).
+ * arguments, size outside [1, 6688], values negative, non-finite or above 1e30 (the message names
+ * the index).
  * Cost: O(6 size^2) to copy the map. */
 HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_scene* scene, const float* faces_rgb,
                                                                 int size, hemilight_scene** out);
@@ -211,8 +225,9 @@ typedef enum hemilight_light_type {
  * units), radians, W. */
 typedef struct hemilight_light {
   hemilight_light_type type;
-  float color[3];      /* DIRECTIONAL: W/m^2 on a plane facing it; POINT, SPOT: W/sr; RECT: W/m^2/sr; each >= 0 */
-  float position[3];   /* POINT, SPOT: position; RECT: centre */
+  float color[3];      /* DIRECTIONAL: W/m^2 on a plane facing it; POINT, SPOT: W/sr; RECT: W/m^2/sr;
+                          each in [0, 1e30] */
+  float position[3];   /* POINT, SPOT: position; RECT: centre; each at most 1e18 in magnitude (all types) */
   float direction[3];  /* DIRECTIONAL: direction of travel; SPOT: axis; RECT: normal of the lit side (any length > 0) */
   float tangent[3];    /* RECT: direction of its width (any length > 0, not parallel to direction) */
   float width, height; /* RECT: size, each > 0 */
@@ -234,9 +249,11 @@ HEMILIGHT_API void hemilight_light_init(hemilight_light* light, hemilight_light_
  * hemilight_scene_release. Errors (nothing written to *out): INVALID_ARGUMENT for NULL scene or
  * out, NULL lights with count > 0, and a bad light, the message naming its index and field
  * ("hemilight_scene_with_lights: lights[2].spot_outer = 1.7 is past pi/2"): an unknown type, NaN
- * or Inf in any field, a negative colour, a zero direction (DIRECTIONAL, SPOT, RECT), a negative
- * radius or a DIRECTIONAL radius past pi/2, spot angles out of order or past pi/2, RECT width or
- * height <= 0 or a tangent zero or parallel to the normal, casts_shadows not 0 or 1;
+ * or Inf in any field, a position beyond 1e18 in magnitude, a colour negative or above 1e30, a
+ * zero direction (DIRECTIONAL, SPOT, RECT), a negative radius (all but RECT) or a DIRECTIONAL
+ * radius past pi/2, a negative spot_inner, spot angles out of order or past pi/2, RECT width or
+ * height <= 0 or a tangent zero or parallel to the normal (within 1e-3 rad), casts_shadows not 0
+ * or 1;
  * OUT_OF_MEMORY, UNSUPPORTED or INTERNAL if the shadow rays' acceleration structure (Embree) cannot
  * be built. Cost: O(count), and with lights the first time for this geometry the ray structure
  * (about 0.3 ms per 1,000 triangles, ~100 bytes per triangle; include/hemilight/rays.hpp). */
@@ -267,7 +284,8 @@ typedef struct hemilight_irradiance {
  * itself does not see the surface it lies on; offset it from the surface if that surface is not in
  * the scene. The hemicube's frame is built from the normal (deterministic, no roll).
  * Errors (out untouched): INVALID_ARGUMENT for NULL scene/position/normal/out, NaN/Inf position or
- * normal, a zero normal, N odd or outside [2, 4096].
+ * normal, a position beyond 1e18 in magnitude, a zero normal, N odd or outside [2, 4096], a result
+ * that overflows float (a light too close: "Conventions").
  * Cost: one hemicube (Cornell box, N = 64: about 25 us on one core, docs/capi.md). Each thread
  * keeps a context for the last N it used up to N = 512 (scratch and a reference to its tables:
  * 342 N^2 bytes, 1.3 MiB at N = 64, 86 MiB at N = 512; hemilight_release_tables frees it)
@@ -295,8 +313,10 @@ HEMILIGHT_API hemilight_status hemilight_sampler_create(const hemilight_scene* s
                                                         hemilight_sampler** out);
 
 /* hemilight_sample_irradiance at the sampler's scene and N: bitwise the same result for the same
- * point. Errors (out untouched): as hemilight_sample_irradiance, plus a sampler in use by another
- * thread. Cost: one hemicube, nothing else (Cornell box, N = 64: about 25 us on one core). */
+ * point. Errors (out untouched): INVALID_ARGUMENT for a NULL sampler or out, a point that
+ * hemilight_sample_irradiance refuses (or whose result overflows float), a sampler in use by
+ * another thread. Cost: one hemicube, nothing else (Cornell box, N = 64: about 25 us on one
+ * core). */
 HEMILIGHT_API hemilight_status hemilight_sampler_irradiance(hemilight_sampler* sampler, const float position[3],
                                                             const float normal[3], hemilight_irradiance* out);
 
@@ -305,10 +325,12 @@ HEMILIGHT_API void hemilight_sampler_release(hemilight_sampler* sampler);
 
 /* hemilight_sample_irradiance at `count` points on `thread_count` threads (0 = all cores):
  * positions and normals are 3 * count floats, out receives count results, each bitwise what
- * hemilight_sample_irradiance gives for that point, for any thread count. count = 0 does nothing.
+ * hemilight_sample_irradiance gives for that point, for any thread count. count = 0 checks the
+ * other arguments and does nothing (the arrays may then be NULL: "Arrays and counts" at the top).
  * Errors (nothing written to out): INVALID_ARGUMENT for a NULL scene, or NULL arrays with count > 0,
- * count over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0, and any bad point, named by
- * its index ("point 17: normal (0, 0, 0) has no direction"); OUT_OF_MEMORY. Cost: count hemicubes
+ * count over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0, and any point that
+ * hemilight_sample_irradiance refuses, named by its index ("point 17: normal (0, 0, 0) has no
+ * direction", "point 3: the irradiance overflows float"); OUT_OF_MEMORY. Cost: count hemicubes
  * over the threads, plus the tables per thread; about 100 bytes per point of temporary memory. */
 HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight_scene* scene, const float* positions,
                                                                  const float* normals, size_t count, int resolution,
@@ -331,9 +353,11 @@ HEMILIGHT_API hemilight_status hemilight_sample_irradiance_batch(const hemilight
  * A probe inside closed geometry sees back faces; hemilight_sample_probes_with_backfaces reports
  * the solid-angle fraction of its sphere that does (near 1 inside; drop probes above ~0.1).
  * Errors (nothing written): INVALID_ARGUMENT for a NULL scene, NULL arrays with count > 0, count
- * over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0 and a non-finite position, named by
- * its index ("point 7: position (0, nan, 1) is not finite"); OUT_OF_MEMORY.
- * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 does nothing.
+ * over 2^31 - 1, N odd or outside [2, 4096], thread_count < 0, a position not finite or beyond 1e18
+ * in magnitude or a probe that overflows float, named by its index ("point 7: position (0, nan, 1)
+ * is not finite or beyond 1e18"); OUT_OF_MEMORY.
+ * Deterministic: bitwise the same for any thread_count (0 = all cores). count = 0 checks the other
+ * arguments and does nothing (the arrays may then be NULL: "Arrays and counts" at the top).
  * Cost: 2 hemicubes and their projections per probe plus the lights' shadow rays (Cornell box,
  * N = 64: ~7k probes/s per core, 14k on two; docs/probes.md); tables of 36 N^2 floats per N,
  * kept between calls within the table budget (hemilight_set_table_budget). */
@@ -390,10 +414,11 @@ typedef struct hemilight_cache_options {
   /* ---- what an engine tunes ---- */
   int resolution;         /* hemicube N, even, 2..4096 (default 64) */
   float error_threshold;  /* Ward's a, [0.001, 1]: larger = fewer hemicubes, more error (default 0.2) */
-  float min_radius, max_radius; /* record radius limits in scene units; 0 = automatic (defaults):
-                                   min = (median point spacing) / a, max = 0.2 x the points' extent */
+  float min_radius, max_radius; /* record radius limits in scene units, each finite and >= 0, min <=
+                                   max when both are set; 0 = automatic (defaults): min = (median
+                                   point spacing) / a, max = 0.2 x the points' extent */
   int use_gradients;      /* 0 or 1: interpolate with rotation and translation gradients (default 1) */
-  int thread_count;       /* 0 = all cores (default 0) */
+  int thread_count;       /* >= 0; 0 = all cores (default 0) */
   hemilight_progress_fn progress; /* may be NULL (default NULL) */
   void* progress_user;    /* passed to progress */
   hemilight_cache_weight weight;  /* since 0.5: interpolation weight (default HEMILIGHT_CACHE_WEIGHT_WARD) */
@@ -405,7 +430,7 @@ typedef struct hemilight_cache_options {
   int shrink_disagreeing;         /* 0 or 1: shrink neighbours whose gradients disagree (default 1) */
   int refine_disagreement;        /* 0 or 1: points whose covering records disagree by more than a stay
                                      open (default 1) */
-  float second_opinion;           /* >= 0, 0 = off: a single covering record's first-order term must stay
+  float second_opinion;           /* finite, >= 0, 0 = off: a single covering record's first-order term must stay
                                      under second_opinion x a (default 0.25) */
   float nearby_opinion;           /* [0, 16], 0 = off: nearby records that do not cover a singly covered
                                      point must agree with it, within this many finest spacings (default 2) */
@@ -466,9 +491,10 @@ static inline void hemilight_cache_stats_init(hemilight_cache_stats* stats) {
  * hemicube sees mostly back faces) are filled from valid records around them.
  * irradiance_rgb receives 3 * count floats; stats may be NULL.
  * Errors (nothing written): INVALID_ARGUMENT for NULL scene/positions/normals/options/output,
- * count 0, NaN/Inf positions, points spanning more than 1e18 units (their squared distances must
- * fit in float), non-unit normals, options or struct_size out of range (the message names the
- * field); CANCELLED when the progress callback returned 0. */
+ * count 0, positions NaN/Inf or beyond 1e18 in magnitude, points spanning more than 1e18 units
+ * (their squared distances must fit in float), non-unit normals, options or struct_size (options,
+ * stats) out of range (the message names the field), a result that overflows float; CANCELLED
+ * when the progress callback returned 0. */
 HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene* scene, const float* positions,
                                                           const float* normals, size_t count,
                                                           const hemilight_cache_options* options,
@@ -478,7 +504,7 @@ HEMILIGHT_API hemilight_status hemilight_cache_irradiance(const hemilight_scene*
 
 /* Per-triangle material of a baked mesh. */
 typedef struct hemilight_bake_material {
-  float emission[3]; /* emitted radiance (RGB), each >= 0 and finite */
+  float emission[3]; /* emitted radiance (RGB), each in [0, 1e30] */
   float albedo[3];   /* diffuse reflectance (RGB), each in [0, 1] */
   int two_sided;     /* 0: seen from behind a triangle occludes but is black; 1: both sides look like the front */
 } hemilight_bake_material;
@@ -486,8 +512,9 @@ typedef struct hemilight_bake_material {
 /* One mesh of the scene to bake. All meshes share one lightmap (one UV space). Front faces wind
  * counter-clockwise (normal (v1 - v0) x (v2 - v0)). */
 typedef struct hemilight_bake_mesh {
-  const float* positions;    /* 3 * vertex_count floats, finite */
-  const float* normals;      /* 3 * vertex_count floats (shading normals, any length > 0), or NULL: face normals */
+  const float* positions;    /* 3 * vertex_count floats, finite, at most 1e18 in magnitude */
+  const float* normals;      /* 3 * vertex_count floats (shading normals, finite, any length; where they
+                                interpolate to zero the face normal is used), or NULL: face normals */
   const float* lightmap_uvs; /* 2 * vertex_count floats (u, v), each in [0, 1] */
   size_t vertex_count;
   const uint32_t* indices;   /* 3 * triangle_count vertex indices of this mesh (< vertex_count) */
@@ -508,13 +535,13 @@ typedef struct hemilight_bake_options {
   float min_coverage;      /* texels covered less than this fraction get no sample, [0, 1] (default 0.01) */
   int dilation;            /* rings of dilation around charts, >= 0, or -1 to fill every texel (default 16) */
   int use_cache;           /* 1: irradiance cache; 0: a hemicube at every texel (reference, slow) (default 1) */
-  int thread_count;        /* 0 = all cores (default 0) */
-  float sky_radiance[3];   /* constant radiance seen where nothing is hit, each >= 0 (default 0) */
+  int thread_count;        /* >= 0; 0 = all cores (default 0) */
+  float sky_radiance[3];   /* constant radiance seen where nothing is hit, each in [0, 1e30] (default 0) */
   hemilight_progress_fn progress; /* fraction of the whole bake, never decreasing; 0 cancels (default NULL) */
   void* progress_user;
   /* Optional environment sky (default NULL, 0): six faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z),
    * environment_size x environment_size RGB floats each, face-major (the layout of
-   * hemilight_scene_with_environment), finite and >= 0, read during the call only. Where a hemicube
+   * hemilight_scene_with_environment), each in [0, 1e30], read during the call only. Where a hemicube
    * texel hits nothing it sees the map's radiance along its world direction (seamless bilinear)
    * instead of sky_radiance. environment_size: 1..6688 with a map, 0 without. */
   const float* environment_rgb;
@@ -594,12 +621,14 @@ static inline void hemilight_bake_stats_init(hemilight_bake_stats* stats) {
  * outside [0, 1] clamped, triangles with 3D area but no UV area occlude without texels (unless
  * options->strict); the statistics count each.
  * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
- * NULL options/irradiance_rgb, capacities too small, options out of range (the message names the
- * field), NULL arrays with nonzero counts, NaN/Inf positions, normals or UVs, UVs more than 0.001
- * outside [0, 1], indices out of range, with options->strict a triangle with 3D area but zero UV
- * area ("meshes[1]: triangle 0 (indices[0..2]) has zero area ..."), invalid materials, no texel
- * covered, an environment map with a bad size or a negative or non-finite value (named by index);
- * OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress returned 0.
+ * NULL options/irradiance_rgb, capacities too small, options or struct_size (options, stats) out
+ * of range (the message names the field), NULL arrays with nonzero counts, NaN/Inf positions,
+ * normals or UVs, positions beyond 1e18 in magnitude, UVs more than 0.001 outside [0, 1], indices
+ * out of range, with options->strict a triangle with 3D area but zero UV area ("meshes[1]:
+ * triangle 0 (indices[0..2]) has zero area ..."), invalid materials, no texel covered, an
+ * environment map with a bad size or a value negative, non-finite or above 1e30 (named by index),
+ * a result that overflows float; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when
+ * progress returned 0.
  * Cost: see hemilight_cache_irradiance, once per bounce. */
 HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
                                                        const hemilight_bake_options* options, float* irradiance_rgb,
@@ -693,7 +722,7 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_filter_cosine_power(const float
 /* Irradiance E(n) = integral of L max(0, n.w) dw per output texel (a uniform map of radiance L
  * gives pi L). use_sh = 0: the cosine-lobe filter (quadrature over the input mip of 16 x 16);
  * use_sh = 1: the 9-coefficient SH fast path (exact for radiance in SH bands 0-2, otherwise SH
- * truncation error). Errors as hemilight_cubemap_filter_cosine_power. */
+ * truncation error). Errors as hemilight_cubemap_filter_cosine_power, and use_sh not 0 or 1. */
 HEMILIGHT_API hemilight_status hemilight_cubemap_filter_irradiance(const float* input, int input_size,
                                                                    hemilight_edge_fixup fixup, int output_size,
                                                                    int use_sh, float* output);
@@ -718,7 +747,9 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_filter_mip_chain(const float* i
  * direction with hemilight_cubemap_fixup_lookup(direction, size, lod) (lod < 0 is read as the
  * fixed-size form and samples level 0): use it for STRETCH-filtered maps. Errors:
  * INVALID_ARGUMENT for NULL pointers, size outside [1, 6688], level_count outside
- * [1, levels of size], NaN/Inf direction or lod, a zero direction, an unknown sampling. */
+ * [1, levels of size], NaN/Inf direction or lod, a zero direction, an unknown sampling,
+ * apply_fixup not 0 or 1, a sample that is not finite (a chain holding NaN, Inf or values near the
+ * float limit). */
 HEMILIGHT_API hemilight_status hemilight_cubemap_sample(const float* chain, int size, int level_count,
                                                         const float direction[3], float lod,
                                                         hemilight_cube_sampling sampling, int apply_fixup,
@@ -792,13 +823,16 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
  * what hemilight_bake_lightmap gives.
  * Errors (nothing written; the message names the function and the mesh, page or placement by
  * index, and the index within it): INVALID_ARGUMENT for NULL scene/options, a bad struct_size,
- * mesh_count or page_count 0, NULL meshes/placements/pages, a page size out of range, a NULL
- * irradiance_rgb or a capacity too small, an albedo or emission value out of range
- * ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or non-finite
- * scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9] (vertex 4,
- * v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in its page
- * (without: counted, as hemilight_bake_lightmap does), everything hemilight_bake_lightmap rejects
- * in the meshes and options, no texel sampled in any page; OUT_OF_MEMORY, CANCELLED as there.
+ * mesh_count or page_count 0, NULL meshes/placements/pages, an unknown occluder_radiance, a page
+ * size out of range, a NULL irradiance_rgb or a capacity too small, an albedo or emission value
+ * out of range ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or
+ * non-finite scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9]
+ * (vertex 4, v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in
+ * its page (without: counted, as hemilight_bake_lightmap does), everything hemilight_bake_lightmap
+ * rejects in the meshes and options, no texel sampled in any page, a result that overflows float;
+ * OUT_OF_MEMORY, CANCELLED as there, and OUT_OF_MEMORY when the pages' atlas (the widest page x
+ * the sum of the heights and two guard rows between pages) passes 2^28 texels (checked before it
+ * is allocated).
  * Cost: as hemilight_bake_lightmap over the sum of the pages' texels. */
 HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
                                                     hemilight_bake_stats* stats);

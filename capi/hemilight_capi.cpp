@@ -103,11 +103,17 @@ hemilight_status hemilight_exr_load_rgb(const char* path, float* rgb, size_t cap
   return guarded(fn, [&] {
     if (!path) return invalid(fn, "path is NULL");
     if (!rgb) return invalid(fn, "rgb is NULL");
-    const hemilight::image img = hemilight::read_exr(path, 3);
-    if (img.pixels.size() > capacity)
+    const auto too_small = [&](int w, int h) {
       return invalid(fn, "capacity " + std::to_string(capacity) + " floats is too small for '" + path + "' (" +
-                             std::to_string(img.width) + " x " + std::to_string(img.height) + " x 3 = " +
-                             std::to_string(img.pixels.size()) + " floats)");
+                             std::to_string(w) + " x " + std::to_string(h) + " x 3 = " +
+                             std::to_string(3 * std::size_t(w) * std::size_t(h)) + " floats)");
+    };
+    // The size from the header before any pixel is decoded: a short capacity is refused without
+    // decoding the image into a temporary (a 377-byte RLE file can claim 16.5M x 2 pixels).
+    const hemilight::exr_header_info info = hemilight::read_exr_header(path);
+    if (3 * std::size_t(info.width) * std::size_t(info.height) > capacity) return too_small(info.width, info.height);
+    const hemilight::image img = hemilight::read_exr(path, 3);
+    if (img.pixels.size() > capacity) return too_small(img.width, img.height);  // the file changed since its header was read
     std::copy(img.pixels.begin(), img.pixels.end(), rgb);
     if (width) *width = img.width;
     if (height) *height = img.height;
@@ -137,11 +143,17 @@ hemilight_status hemilight_exr_load_cubemap_rgb(const char* path, float* faces, 
   return guarded(fn, [&] {
     if (!path) return invalid(fn, "path is NULL");
     if (!faces) return invalid(fn, "faces is NULL");
+    const auto too_small = [&](int s) {
+      return invalid(fn, "capacity " + std::to_string(capacity) + " floats is too small for '" + path + "' (6 x " +
+                             std::to_string(s) + " x " + std::to_string(s) + " x 3 = " +
+                             std::to_string(18 * std::size_t(s) * std::size_t(s)) + " floats)");
+    };
+    // The size from the header before any pixel is decoded (as hemilight_exr_load_rgb); a file
+    // that is no cube map fails in read_exr_cubemap, from its header too.
+    const hemilight::exr_header_info info = hemilight::read_exr_header(path);
+    if (info.cube && 18 * std::size_t(info.width) * std::size_t(info.width) > capacity) return too_small(info.width);
     const hemilight::cube_image cube = hemilight::read_exr_cubemap(path, 3);
-    if (cube.pixels.size() > capacity)
-      return invalid(fn, "capacity " + std::to_string(capacity) + " floats is too small for '" + path +
-                             "' (6 x " + std::to_string(cube.size) + " x " + std::to_string(cube.size) + " x 3 = " +
-                             std::to_string(cube.pixels.size()) + " floats)");
+    if (cube.pixels.size() > capacity) return too_small(cube.size);  // the file changed since its header was read
     std::copy(cube.pixels.begin(), cube.pixels.end(), faces);
     if (size) *size = cube.size;
     return HEMILIGHT_OK;

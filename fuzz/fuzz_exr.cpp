@@ -2,7 +2,9 @@
 // and hemilight_exr_load_cubemap_rgb (seeded with small files of every compression OpenEXR
 // writes: fuzz/corpus/exr). Checks the contract: finite outputs on OK (a file may hold NaN or
 // Inf pixels: those are passed on as stored, so only sizes are checked here), untouched ones on
-// failure, and no allocation beyond what the file can hold (ASan's allocation limit).
+// failure, and no allocation beyond what the file can hold (ASan's allocation limit; run.sh --ci
+// gives this harness -malloc_limit_mb=64). Images over 2^16 pixels are loaded into a buffer of 48
+// floats: the loaders must refuse them from the header, before decoding anything.
 #include "fuzz_input.hpp"
 
 #include <cstdio>
@@ -31,6 +33,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const hemilight_status sc = hemilight_exr_load_cubemap_rgb(path.c_str(), rgb.data(), rgb.size() - 1, &s);
       fuzz::check_untouched(sc, rgb.data(), rgb.size() * sizeof(float));
     }
+  } else if (st == HEMILIGHT_OK) {
+    float small[48];
+    fuzz::fill(small, sizeof small);
+    if (hemilight_exr_load_rgb(path.c_str(), small, 48, nullptr, nullptr) == HEMILIGHT_OK)
+      fuzz::violated("exr_load_rgb accepted a capacity of 48 floats for an image over 2^16 pixels");
+    fuzz::check_untouched(HEMILIGHT_ERROR_INVALID_ARGUMENT, small, sizeof small);
+    int s = -7;
+    if (hemilight_exr_load_cubemap_rgb(path.c_str(), small, 48, &s) == HEMILIGHT_OK)
+      fuzz::violated("exr_load_cubemap_rgb accepted a capacity of 48 floats for an image over 2^16 pixels");
+    fuzz::check_untouched(HEMILIGHT_ERROR_INVALID_ARGUMENT, small, sizeof small);
+    if (s != -7) fuzz::violated("exr_load_cubemap_rgb wrote its size although it failed");
   }
   return 0;
 }

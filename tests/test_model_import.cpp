@@ -4,13 +4,17 @@
 // scene that reaches the baker: world-space positions, the lightmap UVs of TEXCOORD_1 in glTF's
 // convention, instances on their own pages, materials and the per-texel albedo averaged over
 // each lightmap texel's footprint, and the errors for a missing texture and missing lightmap UVs.
+#include "model_export.hpp"
 #include "model_import.hpp"
+
+#include "hemilight/levels.hpp"
 
 #include "test_support.hpp"
 
 #include <catch2/catch.hpp>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -319,4 +323,57 @@ TEST_CASE("Preview: the default camera sees a closed room from inside and camera
   CHECK_FALSE(preview::parse_camera("1,2,3,4,5", parsed));
   CHECK_FALSE(preview::parse_camera("model.gltf", parsed));
   test::require_error([&] { preview::render(in, radiance, cam, 8); }, status::invalid_argument, "size 8 is not in [16, 4096]");
+}
+
+TEST_CASE("Model export: a stand-in level written as glb reads back with the same triangles, lightmap UVs and albedos",
+          "[model_import][levels]") {
+  // The arena at its default size, degenerate triangles included (hemilight_make_level's path).
+  const level l = make_level("arena");
+  const std::string dir = std::string(HEMILIGHT_TEST_TMPDIR) + "/export_level";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/arena.glb";
+  model_export::write_glb(l.mesh, path);
+  const model_import::model m = model_import::import_model(path);
+  // One mesh per distinct albedo, in order of first use, each with its triangles in order.
+  std::vector<glm::vec3> albedos;
+  std::vector<std::size_t> of(l.mesh.triangle_count());
+  for (std::size_t t = 0; t < l.mesh.triangle_count(); ++t) {
+    const glm::vec3 a = l.mesh.materials[t].albedo;
+    const auto it = std::find(albedos.begin(), albedos.end(), a);
+    of[t] = static_cast<std::size_t>(it - albedos.begin());
+    if (it == albedos.end()) albedos.push_back(a);
+  }
+  REQUIRE(m.meshes.size() == albedos.size());
+  CHECK(m.pages == 1);
+  std::size_t triangles = 0, moved = 0, degenerate = 0;
+  float uv_error = 0.0f;
+  for (std::size_t k = 0; k < m.meshes.size(); ++k) {
+    const model_import::mesh& me = m.meshes[k];
+    INFO(me.name);
+    CHECK(m.materials[me.material].base_color == albedos[k]);
+    REQUIRE(me.lightmap_uvs.size() == me.positions.size());
+    std::size_t f = 0;
+    for (std::size_t t = 0; t < l.mesh.triangle_count(); ++t) {
+      if (of[t] != k) continue;
+      REQUIRE(3 * f + 2 < me.indices.size());
+      glm::dvec3 p[3];
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::uint32_t mine = l.mesh.indices[3 * t + c], theirs = me.indices[3 * f + c];
+        moved += l.mesh.positions[mine] != me.positions[theirs];  // exact: float32 in the file, identity node
+        uv_error = std::max(uv_error, glm::length(l.mesh.lightmap_uvs[mine] - me.lightmap_uvs[theirs]));
+        p[c] = glm::dvec3(me.positions[theirs]);
+      }
+      const double longest = std::max({glm::dot(p[1] - p[0], p[1] - p[0]), glm::dot(p[2] - p[1], p[2] - p[1]), glm::dot(p[0] - p[2], p[0] - p[2])});
+      degenerate += 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0])) <= 1e-10 * longest;
+      ++f;
+    }
+    CHECK(3 * f == me.indices.size());
+    triangles += f;
+  }
+  CHECK(triangles == l.mesh.triangle_count());
+  CHECK(moved == 0);
+  CHECK(degenerate == l.degenerate_triangles);
+  // The writer stores 1 - v for assimp, which writes 1 - that; the importer flips twice more: each
+  // 1 - x rounds by at most 2^-25 (3e-8) for x < 0.5 and is exact above.
+  CHECK(uv_error <= 1e-7f);
 }

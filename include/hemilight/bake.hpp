@@ -265,6 +265,8 @@ struct scene_bake_result {
 /// whole bake's stats, bake_lightmap's rules for degenerate triangles and clamped UVs apply); bad
 /// geometry as bake_lightmap reports it (except that raw UVs may lie outside [0, 1]); no texel
 /// sampled in any page; bad options as bake_lightmap. cancelled: the progress callback.
+/// out_of_memory: the pages' atlas (the widest page x the sum of the heights and two guard rows
+/// between pages) over max_image_pixels (2^28 texels), refused before it is allocated.
 /// Cost: as bake_lightmap over the sum of the pages' texels, plus copies of the vertices.
 scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& options);
 

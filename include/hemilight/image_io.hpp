@@ -92,7 +92,8 @@ void write_exr(const std::string& path, const image& img, exr_pixel_type type = 
 /// Reads an OpenEXR ENVMAP_CUBE file (width w, height 6 w, envmap attribute = cube) into GL face
 /// order. A file without the envmap attribute is accepted when its height is exactly 6x its width.
 /// Channels as read_exr. Throws error(unsupported) for an envmap of another kind (latlong) or a
-/// height that is not 6x the width, and as read_exr otherwise.
+/// height that is not 6x the width (both from the header, before any pixel is decoded), and as
+/// read_exr otherwise.
 cube_image read_exr_cubemap(const std::string& path, int channels = 0);
 
 /// Writes a cube map as an OpenEXR ENVMAP_CUBE file. Errors as write_exr.

@@ -188,6 +188,7 @@ struct raster_statistics {
   std::size_t edge_hard_texels = 0;    ///< edge coverage: texels such an edge may cross (exact there)
   std::size_t nodes_occluded = 0;      ///< occlusion culling: nodes skipped as hidden on every face they touch
   std::size_t triangles_occluded = 0;  ///< occlusion culling: the triangles below those nodes
+  std::size_t face_triangles_occluded = 0;  ///< occlusion culling: big (triangle, face) pairs found hidden before their spans
   std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
 };
 

@@ -64,6 +64,13 @@ scene_atlas make_atlas(const std::vector<lightmap_page>& pages, std::size_t occl
   }
   const std::size_t occluder_y = rows;
   rows += 2 * strips;
+  // Every image of the bake has the atlas's size (at most max_image_pixels, as image::make says):
+  // refused here, before the atlas's masks, coverage and textures are allocated.
+  if (rows > max_image_pixels / std::size_t(width))
+    throw error(status::out_of_memory, "bake_scene: the pages' atlas would be " + std::to_string(width) + " x " +
+                                           std::to_string(rows) +
+                                           " texels (the widest page x the sum of the heights and two guard rows between "
+                                           "pages), over the limit of 2^28");
   if (rows > std::size_t(std::numeric_limits<int>::max() / 2))
     throw_invalid_argument("bake_scene: the pages' atlas would have " + std::to_string(rows) + " rows: too many");
   bake_layout& l = a.layout;

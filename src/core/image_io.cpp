@@ -9,7 +9,9 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfMultiPartInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfPartType.h>
 #include <ImfStandardAttributes.h>
 #include <Imath/half.h>
 
@@ -19,6 +21,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <system_error>
 
 namespace hemilight {
@@ -101,15 +104,23 @@ void check_header_sizes(const std::string& path, const char* function) {
   }
 }
 
-raw_read read_raw(const std::string& path, int channels, const char* function, bool pixels = true) {
+// cube: the image must be a cube map (w x 6w, no latlong envmap attribute), checked from the
+// header before any pixel is decoded.
+raw_read read_raw(const std::string& path, int channels, const char* function, bool pixels = true, bool cube = false) {
   check_channels_arg(channels, function, true);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(status::io, function, path, "no such file");
   if (std::filesystem::is_directory(path, ec)) fail(status::io, function, path, "is a directory, not an EXR file");
   check_header_sizes(path, function);
   try {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& header = file.header();
+    // The header and the offset table through MultiPartInputFile, which allocates no line buffers:
+    // InputFile's decompressors take up to 2.5 scanlines up front (248 MB of address space for a
+    // 377-byte RLE file claiming 16,514,819 x 2 pixels). InputFile is opened to decode, once every
+    // check passed, and for deep data (which it flattens) as before.
+    Imf::MultiPartInputFile parts(path.c_str());
+    const Imf::Header& header = parts.header(0);
+    std::unique_ptr<Imf::InputFile> file;
+    if (header.hasType() && Imf::isDeepData(header.type())) file = std::make_unique<Imf::InputFile>(path.c_str());
     const Imath::Box2i dw = header.dataWindow();
     const long long w = static_cast<long long>(dw.max.x) - dw.min.x + 1;
     const long long h = static_cast<long long>(dw.max.y) - dw.min.y + 1;
@@ -134,12 +145,20 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
     out.height = static_cast<int>(h);
     const std::size_t count = checked_pixel_count(w, h, 1, function);
     // Before anything is allocated: a header claiming a huge image in a short file stops here.
-    if (!file.isComplete()) fail(status::io, function, path, "file is truncated (not all scanlines are present)");
+    if (!(file ? file->isComplete() : parts.partComplete(0)))
+      fail(status::io, function, path, "file is truncated (not all scanlines are present)");
     if (Imf::hasEnvmap(header)) {
       out.has_envmap = true;
       out.envmap = Imf::envmap(header);
     }
+    if (cube && out.has_envmap && out.envmap != Imf::ENVMAP_CUBE)
+      fail(status::unsupported, function, path, "envmap attribute is latlong, not cube");
+    if (cube && h != 6 * w)
+      fail(status::unsupported, function, path,
+           "a cube map must be w x 6w pixels; this file is " + std::to_string(w) + " x " + std::to_string(h));
     if (!pixels) return out;
+    if (!file) file = std::make_unique<Imf::InputFile>(path.c_str());
+    if (file->header().dataWindow() != dw) fail(status::io, function, path, "the file changed while it was read");
     out.pixels.assign(count * static_cast<std::size_t>(out.channels), 0.0f);
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * static_cast<std::size_t>(out.channels);
@@ -147,8 +166,8 @@ raw_read read_raw(const std::string& path, int channels, const char* function, b
     const char* names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < out.channels; ++c)
       fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, out.pixels.data() + c, dw, xs, ys, 1, 1, c == 3 ? 1.0 : 0.0));
-    file.setFrameBuffer(fb);
-    file.readPixels(dw.min.y, dw.max.y);
+    file->setFrameBuffer(fb);
+    file->readPixels(dw.min.y, dw.max.y);
     return out;
   } catch (const error&) {
     throw;
@@ -303,13 +322,9 @@ void write_exr(const std::string& path, const image& img, exr_pixel_type type) {
 }
 
 cube_image read_exr_cubemap(const std::string& path, int channels) {
-  raw_read raw = read_raw(path, channels, "read_exr_cubemap");
-  if (raw.has_envmap && raw.envmap != Imf::ENVMAP_CUBE)
-    fail(status::unsupported, "read_exr_cubemap", path, "envmap attribute is latlong, not cube");
-  if (static_cast<long long>(raw.height) != 6LL * raw.width)
-    fail(status::unsupported, "read_exr_cubemap", path,
-         "a cube map must be w x 6w pixels; this file is " + std::to_string(raw.width) + " x " +
-             std::to_string(raw.height));
+  // The shape is checked from the header (read_raw's cube): a file that is no cube map fails
+  // before its pixels are decoded.
+  raw_read raw = read_raw(path, channels, "read_exr_cubemap", true, true);
   cube_image cube;
   cube.size = raw.width;
   cube.channels = raw.channels;

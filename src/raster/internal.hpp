@@ -264,7 +264,10 @@ class alignas(64) rasterizer_impl {
                           node_rects& rects);
   void occlusion_drawn(unsigned mask, const node_rects& rects);
   void occlusion_freeze();
-  bool hidden_in_tile(int face, int tx, int ty, const node_rects& rects, float nearest);
+  bool hidden_in_tile(int face, int tx, int ty, int x0, int x1, int y0, int y1, float nearest);
+  bool rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest);
+  bool plane_hidden(int face, const texel_box& box, const face_setup& fs);  // a triangle's box, its plane
+  bool culling_ = false;  // a traversal with occlusion tests is drawing (draw_fixed tests big triangles too)
   template <mode M>
   void traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull);
   void redraw_prepare();

@@ -10,6 +10,7 @@
 // stale as the buffer fills (their least depth only grows, so a stale value is conservative) and
 // are refreshed when a test reads them after a leaf was drawn over them.
 #include "internal.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -68,31 +69,200 @@ bool raster_detail::rasterizer_impl::ties_decide_order() const {
   return false;
 }
 
-bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, const node_rects& r, float nearest) {
+namespace {
+
+// The least of the texels [x0, x1] (within one tile: x1 - x0 < 8) of rows y0..y1 of a face's
+// depths d (rows of `width` texels; reading eight texels from x0 stays inside the buffer, which is
+// padded by eight).
+float least_in_rows(const float* d, int width, int x0, int x1, int y0, int y1) noexcept {
+#if HEMILIGHT_RASTER_SSE2
+  // Lanes outside [x0, x1] read +inf.
+  const __m128 inf = _mm_set1_ps(INFINITY);
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3), count = _mm_set1_epi32(x1 - x0 + 1);
+  const __m128 keep_lo = _mm_castsi128_ps(_mm_cmpgt_epi32(count, lane));
+  const __m128 keep_hi = _mm_castsi128_ps(_mm_cmpgt_epi32(count, _mm_add_epi32(lane, _mm_set1_epi32(4))));
+  __m128 least = inf;
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x0;
+    const __m128 a = _mm_or_ps(_mm_and_ps(keep_lo, _mm_loadu_ps(row)), _mm_andnot_ps(keep_lo, inf));
+    const __m128 b = _mm_or_ps(_mm_and_ps(keep_hi, _mm_loadu_ps(row + 4)), _mm_andnot_ps(keep_hi, inf));
+    least = _mm_min_ps(least, _mm_min_ps(a, b));
+  }
+  least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(1, 0, 3, 2)));
+  least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(least);
+#else
+  float least = INFINITY;
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+    for (int x = x0; x <= x1; ++x) least = std::min(least, row[x]);
+  }
+  return least;
+#endif
+}
+
+// What face f sees of a box given by its eight corners in the local frame: a lower bound w_near
+// of w over the part in the face's pyramid, and the bounds of the projection (u/w, v/w) of the
+// box's part at w >= w_near; bounded = false when w_near does not pass the near plane.
+struct face_projection {
+  bool bounded = false;
+  float w_near = 0.0f, u0 = 0.0f, u1 = 0.0f, v0 = 0.0f, v1 = 0.0f;
+};
+
+// to_clip's (u, v, w) per face: (x, y, z), (y, z, x), (-y, z, -x), (-x, z, y), (x, z, -y).
+face_projection project_box(const float* lx, const float* ly, const float* lz, int f, float near) noexcept {
+  face_projection p;
+  const float* cu = f == 0 ? lx : f == 1 ? ly : f == 2 ? ly : lx;
+  const float* cv = f == 0 ? ly : lz;
+  const float* cw = f == 0 ? lz : f <= 2 ? lx : ly;
+  const float su = f == 2 || f == 3 ? -1.0f : 1.0f, sw = f == 2 || f == 4 ? -1.0f : 1.0f;
+  float u[8], v[8], w[8];
+  float u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY, w_min = INFINITY;
+  for (int k = 0; k < 8; ++k) {
+    u[k] = su * cu[k];
+    v[k] = cv[k];
+    w[k] = sw * cw[k];
+    u_lo = std::min(u_lo, u[k]);
+    u_hi = std::max(u_hi, u[k]);
+    v_lo = std::min(v_lo, v[k]);
+    v_hi = std::max(v_hi, v[k]);
+    w_min = std::min(w_min, w[k]);
+  }
+  // What the face sees of the box lies in its pyramid |u|, |v| <= w (v >= 0 on the side faces):
+  // there w >= |u| and w >= |v|, so w_near below bounds w over that part even when the box
+  // reaches behind the face (a box beside the point, or across its tangent plane).
+  const auto from_zero = [](float a, float b) { return a > 0.0f ? a : b < 0.0f ? -b : 0.0f; };
+  const float v_from_zero = f == 0 ? from_zero(v_lo, v_hi) : std::max(v_lo, 0.0f);
+  const float w_near = std::max(std::max(w_min, from_zero(u_lo, u_hi)), v_from_zero) * (1.0f - 1e-6f);
+  if (!(w_near > near)) return p;
+  // The projection of the box's part at w >= w_near: its corners there and the points where its
+  // edges cross w = w_near (the vertices of a convex polytope; u/w takes its extremes at them).
+  float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+  const auto extend = [&](float pu, float pv) {
+    u0 = std::min(u0, pu);
+    u1 = std::max(u1, pu);
+    v0 = std::min(v0, pv);
+    v1 = std::max(v1, pv);
+  };
+  for (int k = 0; k < 8; ++k)
+    if (w[k] >= w_near) extend(u[k] / w[k], v[k] / w[k]);
+  if (w_min < w_near)
+    for (int k = 0; k < 8; ++k)
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        const int j = k | bit;
+        if (j == k || (w[k] >= w_near) == (w[j] >= w_near)) continue;
+        const float t = (w_near - w[k]) / (w[j] - w[k]);
+        extend((u[k] + t * (u[j] - u[k])) / w_near, (v[k] + t * (v[j] - v[k])) / w_near);
+      }
+  p.bounded = true;
+  p.w_near = w_near;
+  p.u0 = u0;
+  p.u1 = u1;
+  p.v0 = v0;
+  p.v1 = v1;
+  return p;
+}
+
+#if HEMILIGHT_RASTER_AVX2
+HEMILIGHT_TARGET_AVX2 inline float reduce_min(__m256 a) noexcept {
+  __m128 m = _mm_min_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+  m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  return _mm_cvtss_f32(_mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+
+HEMILIGHT_TARGET_AVX2 inline float reduce_max(__m256 a) noexcept {
+  __m128 m = _mm_max_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  return _mm_cvtss_f32(_mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+
+// project_box with the eight corners in the lanes of one register per coordinate: the same
+// operations on the same values, so the same bounds.
+HEMILIGHT_TARGET_AVX2 face_projection project_box_avx2(const float* lx, const float* ly, const float* lz, int f,
+                                                       float near) noexcept {
+  face_projection p;
+  const __m256 x = _mm256_loadu_ps(lx), y = _mm256_loadu_ps(ly), z = _mm256_loadu_ps(lz);
+  const __m256 sign = _mm256_set1_ps(-0.0f);
+  const __m256 u = f == 0 || f == 4 ? x : f == 1 ? y : f == 2 ? _mm256_xor_ps(y, sign) : _mm256_xor_ps(x, sign);
+  const __m256 v = f == 0 ? y : z;
+  const __m256 w = f == 0 ? z : f == 1 ? x : f == 2 ? _mm256_xor_ps(x, sign) : f == 3 ? y : _mm256_xor_ps(y, sign);
+  const float u_lo = reduce_min(u), u_hi = reduce_max(u), v_lo = reduce_min(v), v_hi = reduce_max(v), w_min = reduce_min(w);
+  const auto from_zero = [](float a, float b) { return a > 0.0f ? a : b < 0.0f ? -b : 0.0f; };
+  const float v_from_zero = f == 0 ? from_zero(v_lo, v_hi) : std::max(v_lo, 0.0f);
+  const float w_near = std::max(std::max(w_min, from_zero(u_lo, u_hi)), v_from_zero) * (1.0f - 1e-6f);
+  if (!(w_near > near)) return p;
+  const __m256 wn = _mm256_set1_ps(w_near), inf = _mm256_set1_ps(INFINITY), ninf = _mm256_set1_ps(-INFINITY);
+  // Corners at w >= w_near.
+  const __m256 in = _mm256_cmp_ps(w, wn, _CMP_GE_OQ);
+  const __m256 pu = _mm256_div_ps(u, w), pv = _mm256_div_ps(v, w);
+  __m256 lo_u = _mm256_blendv_ps(inf, pu, in), hi_u = _mm256_blendv_ps(ninf, pu, in);
+  __m256 lo_v = _mm256_blendv_ps(inf, pv, in), hi_v = _mm256_blendv_ps(ninf, pv, in);
+  if (w_min < w_near) {
+    // Edges crossing w = w_near: corner k and k ^ bit for bit = 1, 2, 4 (each edge twice).
+    const __m256i partners[3] = {_mm256_setr_epi32(1, 0, 3, 2, 5, 4, 7, 6), _mm256_setr_epi32(2, 3, 0, 1, 6, 7, 4, 5),
+                                 _mm256_setr_epi32(4, 5, 6, 7, 0, 1, 2, 3)};
+    for (const __m256i& partner : partners) {
+      const __m256 wj = _mm256_permutevar8x32_ps(w, partner), uj = _mm256_permutevar8x32_ps(u, partner),
+                   vj = _mm256_permutevar8x32_ps(v, partner);
+      const __m256 cross = _mm256_xor_ps(in, _mm256_cmp_ps(wj, wn, _CMP_GE_OQ));
+      const __m256 t = _mm256_div_ps(_mm256_sub_ps(wn, w), _mm256_sub_ps(wj, w));
+      const __m256 cu = _mm256_div_ps(_mm256_add_ps(u, _mm256_mul_ps(t, _mm256_sub_ps(uj, u))), wn);
+      const __m256 cv = _mm256_div_ps(_mm256_add_ps(v, _mm256_mul_ps(t, _mm256_sub_ps(vj, v))), wn);
+      lo_u = _mm256_min_ps(lo_u, _mm256_blendv_ps(inf, cu, cross));
+      hi_u = _mm256_max_ps(hi_u, _mm256_blendv_ps(ninf, cu, cross));
+      lo_v = _mm256_min_ps(lo_v, _mm256_blendv_ps(inf, cv, cross));
+      hi_v = _mm256_max_ps(hi_v, _mm256_blendv_ps(ninf, cv, cross));
+    }
+  }
+  p.bounded = true;
+  p.w_near = w_near;
+  p.u0 = reduce_min(lo_u);
+  p.u1 = reduce_max(hi_u);
+  p.v0 = reduce_min(lo_v);
+  p.v1 = reduce_max(hi_v);
+  return p;
+}
+#endif
+
+}  // namespace
+
+bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, int rx0, int rx1, int ry0, int ry1,
+                                                    float nearest) {
   const std::size_t t = tile_offset_[face] + static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) +
                         static_cast<std::size_t>(tx);
-  if (!tile_dirty_[t] && nearest < tile_depth_[t]) return true;
-  // The texels of the rectangle in the tile, until one is as near as the node may be (or empty).
   const int rows = face == 0 ? n_ : n_ / 2;
   const int tile_x0 = tx << tile_bits, tile_y0 = ty << tile_bits;
   const int tile_x1 = std::min(tile_x0 + tile_size, n_) - 1, tile_y1 = std::min(tile_y0 + tile_size, rows) - 1;
-  const int x0 = std::max(r.x0[face], tile_x0), x1 = std::min(r.x1[face], tile_x1);
-  const int y0 = std::max(r.y0[face], tile_y0), y1 = std::min(r.y1[face], tile_y1);
   const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(face));
-  float least = INFINITY;
-  for (int y = y0; y <= y1; ++y) {
-    const float* row = d + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_);
-    for (int x = x0; x <= x1; ++x) {
-      if (!(nearest < row[x])) return false;
-      least = std::min(least, row[x]);
-    }
-  }
-  // Every texel read: when that was the whole tile, its least depth is known again.
-  if (tile_dirty_[t] && x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) {
-    tile_depth_[t] = least;
+  if (tile_dirty_[t]) {
+    tile_depth_[t] = least_in_rows(d, n_, tile_x0, tile_x1, tile_y0, tile_y1);
     tile_dirty_[t] = 0;
   }
+  if (nearest < tile_depth_[t]) return true;
+  // The tile holds a texel as near as `nearest` (or an empty one): is it in the rectangle?
+  const int x0 = std::max(rx0, tile_x0), x1 = std::min(rx1, tile_x1);
+  const int y0 = std::max(ry0, tile_y0), y1 = std::min(ry1, tile_y1);
+  if (x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) return false;
+  return nearest < least_in_rows(d, n_, x0, x1, y0, y1);
+}
+
+bool raster_detail::rasterizer_impl::rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest) {
+  // Hidden when `nearest` is below the depth of every texel of the rectangle, read per tile from
+  // the tile's least depth where it is known and high enough.
+  for (int ty = y0 >> tile_bits; ty <= (y1 >> tile_bits); ++ty)
+    for (int tx = x0 >> tile_bits; tx <= (x1 >> tile_bits); ++tx)
+      if (!hidden_in_tile(face, tx, ty, x0, x1, y0, y1, nearest)) return false;
   return true;
+}
+
+bool raster_detail::rasterizer_impl::plane_hidden(int face, const texel_box& box, const face_setup& fs) {
+  // The plane's depth is affine in the texel indices: its largest over the box is at a corner.
+  const double xs[2] = {static_cast<double>(box.x_begin), static_cast<double>(box.x_end)};
+  double nearest = 0.0;
+  for (const std::int64_t y : {box.y_begin, box.y_end})
+    for (const double x : xs) nearest = std::max(nearest, fs.z00 + fs.dzdy * static_cast<double>(y) + double(fs.dzdx) * x);
+  return rect_hidden(face, static_cast<int>(box.x_begin), static_cast<int>(box.x_end), static_cast<int>(box.y_begin),
+                     static_cast<int>(box.y_end), static_cast<float>(nearest * depth_margin));
 }
 
 unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position,
@@ -118,35 +288,21 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     // near plane (its projection is unbounded), else the bounds of its corners' projections (a
     // ratio over a box with positive denominators takes its extremes at the corners). to_clip's
     // (u, v, w) per face: (x, y, z), (y, z, x), (-y, z, -x), (-x, z, y), (x, z, -y).
-    const float* cu = f == 0 ? lx : f == 1 ? ly : f == 2 ? ly : lx;
-    const float* cv = f == 0 ? ly : lz;
-    const float* cw = f == 0 ? lz : f <= 2 ? lx : ly;
-    const float su = f == 2 || f == 3 ? -1.0f : 1.0f, sw = f == 2 || f == 4 ? -1.0f : 1.0f;
-    float w[8], pu[8], pv[8];
-    float w_min = INFINITY;
-    for (int k = 0; k < 8; ++k) {
-      w[k] = sw * cw[k];
-      w_min = std::min(w_min, w[k]);
-    }
-    if (!(w_min > near_)) {
+    face_projection p;
+#if HEMILIGHT_RASTER_AVX2
+    if (avx2_)
+      p = project_box_avx2(lx, ly, lz, f, near_);
+    else
+#endif
+      p = project_box(lx, ly, lz, f, near_);
+    if (!p.bounded) {
       rects.x0[f] = 0;
       rects.x1[f] = n_ - 1;
       rects.y0[f] = 0;
       rects.y1[f] = rows - 1;
       continue;  // its nearest depth is 1/near: nothing drawn can hide it
     }
-    for (int k = 0; k < 8; ++k) {
-      const float inv = 1.0f / w[k];
-      pu[k] = su * cu[k] * inv;
-      pv[k] = cv[k] * inv;
-    }
-    float u0 = pu[0], u1 = pu[0], v0 = pv[0], v1 = pv[0];
-    for (int k = 1; k < 8; ++k) {
-      u0 = std::min(u0, pu[k]);
-      u1 = std::max(u1, pu[k]);
-      v0 = std::min(v0, pv[k]);
-      v1 = std::max(v1, pv[k]);
-    }
+    const float w_near = p.w_near, u0 = p.u0, u1 = p.u1, v0 = p.v0, v1 = p.v1;
     // Texel centres at (x + 1/2) for x = (u + 1) N / 2; side faces' rows start at v = 0.
     const float v_offset = f == 0 ? 1.0f : 0.0f;
     const float fx0 = (u0 + 1.0f) * half - 0.5f, fx1 = (u1 + 1.0f) * half - 0.5f;
@@ -170,11 +326,7 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     rects.y1[f] = y1;
     // Hidden when its nearest depth, with the margin, is below the depth of every texel of its
     // rectangle, read per tile from the tile's least depth where it is known and high enough.
-    const float nearest = depth_margin / w_min;
-    bool hidden = true;
-    for (int ty = y0 >> tile_bits; hidden && ty <= (y1 >> tile_bits); ++ty)
-      for (int tx = x0 >> tile_bits; hidden && tx <= (x1 >> tile_bits); ++tx) hidden = hidden_in_tile(f, tx, ty, rects, nearest);
-    if (hidden) mask &= ~(1u << f);
+    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_near)) mask &= ~(1u << f);
   }
   return mask;
 }

@@ -301,6 +301,7 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   for (std::size_t i = nodes.size(); i-- > 0;)
     subtree_triangles_[i] = nodes[i].count ? nodes[i].count
                                            : subtree_triangles_[nodes[i].first] + subtree_triangles_[nodes[i].first + 1];
+
   const glm::vec3 sky = scene_->sky_radiance();
   shades_.clear();
   shades_.reserve(2 + scene_->emissions().size());
@@ -492,13 +493,16 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     // ties). Either way the buffer is the one the unculled reference order gives, bit for bit.
     occlusion_prepare();
     tie_sink_ = &ties_;
+    culling_ = true;
     traverse<M>(position, basis, true, true);
     tie_sink_ = nullptr;
-    if (!ties_decide_order()) return;
-    ++stats_.occlusion_redraws;
-    occlusion_freeze();
-    redraw_prepare();
-    traverse<M>(position, basis, false, true);
+    if (ties_decide_order()) {
+      ++stats_.occlusion_redraws;
+      occlusion_freeze();
+      redraw_prepare();
+      traverse<M>(position, basis, false, true);
+    }
+    culling_ = false;
     return;
   }
   traverse<M>(position, basis, false, false);
@@ -1025,8 +1029,13 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   // 3. The box of texel centres; the draw and its depth plane once it covers one.
   const texel_box box = centres_in_bounds(t, n, rows);
   if (box.x_begin > box.x_end || box.y_begin > box.y_end) return;
-  if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
   fs.prepare(face, texel_step_, first_centre_, rec);
+  // 3b. With occlusion culling, a big or clipped triangle hidden over its whole box is dropped.
+  if (M == mode::depth && culling_ && plane_hidden(face, box, fs)) {
+    ++stats_.face_triangles_occluded;
+    return;
+  }
+  if (draw == 0) draw = commit_record(rec.plane, tri, &rec, basis);
   const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
   const face_target target{depth_.data() + face_offset, ids_.data() + face_offset,
                            M == mode::count ? counts_->data() + face_offset : nullptr, tie_sink_};
