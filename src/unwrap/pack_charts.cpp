@@ -1,6 +1,6 @@
-// Steps 4 and 5 of the unwrapper (unwrap_internal.hpp): orient_charts (smallest bounding
-// rectangles), split_large_charts, pack_charts (a skyline packer per page, quarter turns allowed;
-// for a target size, a bisection on the density) and page_uv.
+// Steps 4 and 6 of the unwrapper (unwrap_internal.hpp): orient_charts (smallest bounding
+// rectangles), pack_charts (a skyline packer per page, quarter turns allowed; for a target size,
+// a bisection on the density) and page_uv.
 #include "unwrap_internal.hpp"
 
 #include "hemilight/error.hpp"
@@ -9,7 +9,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <utility>
 
 namespace hemilight::unwrap_detail {
 
@@ -69,8 +68,8 @@ glm::dvec2 smallest_rectangle_direction(const std::vector<glm::dvec2>& h) {
   return best_d;
 }
 
-// Turns a chart's UVs so that its smallest bounding rectangle is axis-aligned with its corner at
-// the origin, wider than tall (a quarter turn keeps the orientation); returns the extent.
+}  // namespace
+
 glm::dvec2 orient_chart(glm::dvec2* uv, std::size_t count) {
   const glm::dvec2 d = smallest_rectangle_direction(convex_hull(std::vector<glm::dvec2>(uv, uv + count)));
   glm::dvec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
@@ -87,6 +86,8 @@ glm::dvec2 orient_chart(glm::dvec2* uv, std::size_t count) {
   }
   return turn ? glm::dvec2(extent.y, extent.x) : extent;
 }
+
+namespace {
 
 // A skyline of one page's bin: segments (x, top y, width) left to right.
 class skyline {
@@ -223,6 +224,12 @@ placement pack_to_size(const chart_uvs& uvs, const std::vector<std::uint32_t>& o
 
 }  // namespace
 
+double estimate_density(const chart_uvs& uvs, const unwrap_options& o, double fill) {
+  double area = 0.0;
+  for (const glm::dvec2& e : uvs.extent) area += e.x * e.y;
+  return double(o.page_size - o.padding) * std::sqrt(fill / std::max(area, 1e-300));
+}
+
 void orient_charts(chart_uvs& uvs) {
   const std::size_t C = uvs.first.size() - 1;
   uvs.extent.resize(C);
@@ -245,93 +252,6 @@ glm::vec2 page_uv(const chart_uvs& uvs, const placement& p, std::size_t c, std::
   const glm::dvec2 local = p.turned[c] ? glm::dvec2(uvs.extent[c].y - q.y, q.x) : q;
   const glm::dvec2 t = (p.origin[c] + local * p.density) / double(page_size);
   return glm::clamp(glm::vec2(t), 0.0f, 1.0f);
-}
-
-namespace {
-
-// A chart being split: its triangles, vertices (welded, increasing) and oriented UVs.
-struct piece {
-  std::vector<std::uint32_t> tris, vertex;
-  std::vector<glm::dvec2> uv;
-  glm::dvec2 extent{0.0};
-};
-
-// The part of `from` made of `tris`: its vertices and their UVs, re-oriented.
-piece sub_piece(const mesh_view& m, const welded_mesh& w, const piece& from, std::vector<std::uint32_t> tris) {
-  piece out;
-  out.tris = std::move(tris);
-  for (std::uint32_t t : out.tris)
-    for (int k = 0; k < 3; ++k) out.vertex.push_back(w.welded(m, t, k));
-  std::sort(out.vertex.begin(), out.vertex.end());
-  out.vertex.erase(std::unique(out.vertex.begin(), out.vertex.end()), out.vertex.end());
-  for (std::uint32_t v : out.vertex)
-    out.uv.push_back(from.uv[std::size_t(std::lower_bound(from.vertex.begin(), from.vertex.end(), v) - from.vertex.begin())]);
-  out.extent = orient_chart(out.uv.data(), out.uv.size());
-  return out;
-}
-
-// Splits `p` across its longer side (u: oriented charts are wider than tall) at the middle, or at
-// the median triangle when the middle leaves one side empty, until every piece is at most
-// `limit` long; appends the pieces to `out`.
-void split_piece(const mesh_view& m, const welded_mesh& w, piece p, double limit, double density, std::vector<piece>& out) {
-  if (std::max(p.extent.x, p.extent.y) <= limit) {
-    out.push_back(std::move(p));
-    return;
-  }
-  if (p.tris.size() == 1)
-    throw_invalid_argument("unwrap_lightmap: triangle " + std::to_string(p.tris[0]) + " is " + std::to_string(p.extent.x * density) +
-                           " texels across at texels_per_unit " + std::to_string(density) +
-                           ", more than a page holds: lower texels_per_unit or raise page_size");
-  const auto centre_u = [&](std::uint32_t t) {
-    double u = 0.0;
-    for (int k = 0; k < 3; ++k)
-      u += p.uv[std::size_t(std::lower_bound(p.vertex.begin(), p.vertex.end(), w.welded(m, t, k)) - p.vertex.begin())].x;
-    return u / 3.0;
-  };
-  std::vector<std::pair<double, std::uint32_t>> by_u;
-  for (std::uint32_t t : p.tris) by_u.emplace_back(centre_u(t), t);
-  std::sort(by_u.begin(), by_u.end());
-  std::size_t cut = std::size_t(std::lower_bound(by_u.begin(), by_u.end(), std::make_pair(0.5 * p.extent.x, std::uint32_t(0))) - by_u.begin());
-  if (cut == 0 || cut == by_u.size()) cut = by_u.size() / 2;
-  std::vector<std::uint32_t> a, b;
-  for (std::size_t i = 0; i < by_u.size(); ++i) (i < cut ? a : b).push_back(by_u[i].second);
-  std::sort(a.begin(), a.end());
-  std::sort(b.begin(), b.end());
-  split_piece(m, w, sub_piece(m, w, p, std::move(a)), limit, density, out);
-  split_piece(m, w, sub_piece(m, w, p, std::move(b)), limit, density, out);
-}
-
-}  // namespace
-
-void split_large_charts(const mesh_view& m, const welded_mesh& w, chart_set& charts, chart_uvs& uvs, double limit, double density) {
-  const std::size_t C = charts.size();
-  bool any = false;
-  for (std::size_t c = 0; c < C && !any; ++c) any = std::max(uvs.extent[c].x, uvs.extent[c].y) > limit;
-  if (!any) return;
-  chart_set out_charts;
-  out_charts.triangle_chart.assign(m.triangle_count, none);
-  out_charts.triangle_region = charts.triangle_region;
-  chart_uvs out_uvs;
-  out_uvs.first.assign(1, 0);
-  const auto append = [&](const piece& pc, bool planar, const glm::dvec3& n) {
-    out_charts.add(pc.tris, planar, n);
-    out_uvs.vertex.insert(out_uvs.vertex.end(), pc.vertex.begin(), pc.vertex.end());
-    out_uvs.uv.insert(out_uvs.uv.end(), pc.uv.begin(), pc.uv.end());
-    out_uvs.first.push_back(std::uint32_t(out_uvs.vertex.size()));
-    out_uvs.extent.push_back(pc.extent);
-  };
-  for (std::size_t c = 0; c < C; ++c) {
-    piece whole;
-    whole.tris.assign(charts.triangles.begin() + std::ptrdiff_t(charts.first[c]), charts.triangles.begin() + std::ptrdiff_t(charts.first[c + 1]));
-    whole.vertex.assign(uvs.vertex.begin() + std::ptrdiff_t(uvs.first[c]), uvs.vertex.begin() + std::ptrdiff_t(uvs.first[c + 1]));
-    whole.uv.assign(uvs.uv.begin() + std::ptrdiff_t(uvs.first[c]), uvs.uv.begin() + std::ptrdiff_t(uvs.first[c + 1]));
-    whole.extent = uvs.extent[c];
-    std::vector<piece> pieces;
-    split_piece(m, w, std::move(whole), limit, density, pieces);
-    for (const piece& pc : pieces) append(pc, charts.planar[c] != 0, charts.normal[c]);
-  }
-  charts = std::move(out_charts);
-  uvs = std::move(out_uvs);
 }
 
 }  // namespace hemilight::unwrap_detail

@@ -1,6 +1,6 @@
 // The unwrapper's steps (internal, not installed): unwrap_lightmap (unwrap.hpp) runs
-//   weld_and_link -> grow_charts -> parameterize_charts -> orient_charts -> pack_charts
-//   -> emit_vertices -> measure_unwrap
+//   weld_and_link -> grow_charts -> parameterize_charts -> orient_charts -> split_sparse_charts
+//   [-> split_large_charts] -> pack_charts -> emit_vertices -> measure_unwrap
 // Each step reads what the ones before it made and adds its own arrays.
 #pragma once
 
@@ -83,17 +83,26 @@ struct chart_uvs {
 // factorisation per curved chart, charts spread over `thread_count` threads.
 chart_uvs parameterize_charts(const mesh_view& m, const welded_mesh& w, chart_set& charts, int thread_count);
 
-// Turns every chart to its smallest-area bounding rectangle (over its convex hull's edges) and
-// moves it to the origin; sets extent. Cost: O(n log n + h^2) per chart of n vertices, hull h.
+// Turns a chart's UVs so that its smallest-area bounding rectangle (over its convex hull's edges,
+// by rotating calipers) is axis-aligned with its corner at the origin, wider than tall (a quarter
+// turn keeps the orientation); returns the extent. Cost: O(n log n) for n vertices.
+glm::dvec2 orient_chart(glm::dvec2* uv, std::size_t count);
+// orient_chart for every chart; sets extent.
 void orient_charts(chart_uvs& uvs);
 
-// Splits every oriented chart longer than `limit` (scene units) across its longer side until all
-// fit (the pieces keep their UVs and are re-oriented); a single triangle longer than that throws
-// error(invalid_argument) naming it and its size at `density`. Cost: O(n log n) per round for a
-// chart of n triangles.
+// Step 5: charts cut across their longer side (the pieces keep their UVs and are re-oriented).
+// split_sparse_charts cuts charts that fill little of their rectangle when the halves' rectangles
+// at `density` (texels per scene unit), grown by `padding`, take less room (split_charts.cpp's
+// constants); split_large_charts cuts charts longer than `limit` (scene units) until all fit, and
+// throws error(invalid_argument) for a single triangle longer than that, naming it and its size at
+// `density`. Cost: O(n log n) per cut of a chart of n triangles.
+void split_sparse_charts(const mesh_view& m, const welded_mesh& w, chart_set& charts, chart_uvs& uvs, double density, int padding);
+// The density at which the charts' rectangles would fill `fill` of one page (an estimate of the
+// density a target size ends at). Cost: O(C).
+double estimate_density(const chart_uvs& uvs, const unwrap_options& o, double fill);
 void split_large_charts(const mesh_view& m, const welded_mesh& w, chart_set& charts, chart_uvs& uvs, double limit, double density);
 
-// Step 5: where every chart goes: its page and the texel offset of its rectangle's corner, turned
+// Step 6: where every chart goes: its page and the texel offset of its rectangle's corner, turned
 // by 90 degrees or not. Density: options.texels_per_unit, or the largest that fits one page.
 struct placement {
   std::vector<std::uint32_t> page;  // per chart
@@ -108,12 +117,12 @@ placement pack_charts(const chart_uvs& uvs, const unwrap_options& o);
 // The UV in [0, 1] of chart c's vertex i (an index into uvs' arrays) after packing.
 glm::vec2 page_uv(const chart_uvs& uvs, const placement& p, std::size_t c, std::size_t i, int page_size);
 
-// Step 6: the output vertices (unwrap_result's vertex_source, uvs, indices, triangle_page,
+// Step 7: the output vertices (unwrap_result's vertex_source, uvs, indices, triangle_page,
 // triangle_chart). Cost: O(T).
 void emit_vertices(const mesh_view& m, const welded_mesh& w, const chart_set& charts, const chart_uvs& uvs,
                    const placement& p, int page_size, unwrap_result& out);
 
-// Step 7: stretch, seams and UV area of the result (unwrap_stats). Cost: O(T).
+// Step 8: stretch, seams and UV area of the result (unwrap_stats). Cost: O(T).
 void measure_unwrap(const mesh_view& m, const welded_mesh& w, const placement& p, int page_size, unwrap_result& out);
 
 }  // namespace hemilight::unwrap_detail

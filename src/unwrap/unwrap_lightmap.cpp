@@ -62,6 +62,10 @@ unwrap_result unwrap_lightmap(const glm::vec3* positions, std::size_t vertex_cou
   chart_set charts = grow_charts(m, w, double(o.max_chart_angle));
   chart_uvs uvs = parameterize_charts(m, w, charts, o.thread_count);
   orient_charts(uvs);
+  // The density decides which cuts pay: the one asked for, or an estimate of the one a target
+  // size ends at (the charts' rectangles filling 70% of the page).
+  const double density = o.texels_per_unit > 0.0f ? double(o.texels_per_unit) : estimate_density(uvs, o, 0.7);
+  split_sparse_charts(m, w, charts, uvs, density, o.padding);
   if (o.texels_per_unit > 0.0f)
     split_large_charts(m, w, charts, uvs, double(o.page_size - 2 * o.padding) / double(o.texels_per_unit), double(o.texels_per_unit));
   placement p;
