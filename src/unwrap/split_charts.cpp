@@ -80,7 +80,7 @@ struct split_rule {
 // to `out`; returns their cost.
 double split_piece(const mesh_view& m, const welded_mesh& w, piece p, const split_rule& rule, int depth, std::vector<piece>& out) {
   const double whole = rule.cost(p);
-  if (depth == 0 || p.tris.size() < 2 || !rule.consider(p)) {
+  if (depth == 0 || !rule.consider(p) || p.tris.size() < 2) {
     out.push_back(std::move(p));
     return whole;
   }
