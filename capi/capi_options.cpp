@@ -365,3 +365,79 @@ extern "C" void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* 
   hemilight::capi::init_sized(scene, struct_size, hemilight::capi::default_bake_scene_desc(),
                               hemilight::capi::bake_scene_desc_fields);
 }
+
+// ---- hemilight_unwrap_options and hemilight_unwrap_stats (growable like the options above) -------
+
+namespace hemilight::capi {
+namespace {
+
+#define HEMILIGHT_SPAN(T, f) span { offsetof(T, f), sizeof(static_cast<T*>(nullptr)->f) }
+const span unwrap_options_fields[] = {
+    HEMILIGHT_SPAN(hemilight_unwrap_options, struct_size), HEMILIGHT_SPAN(hemilight_unwrap_options, texels_per_unit),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, page_size), HEMILIGHT_SPAN(hemilight_unwrap_options, padding),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, max_chart_angle), HEMILIGHT_SPAN(hemilight_unwrap_options, max_pages),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, thread_count)};
+const span unwrap_stats_fields[] = {
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, struct_size), HEMILIGHT_SPAN(hemilight_unwrap_stats, charts),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, planar_charts), HEMILIGHT_SPAN(hemilight_unwrap_stats, degenerate_triangles),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, pages), HEMILIGHT_SPAN(hemilight_unwrap_stats, texels_per_unit),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, uv_area_fraction), HEMILIGHT_SPAN(hemilight_unwrap_stats, stretch_l2),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, stretch_linf), HEMILIGHT_SPAN(hemilight_unwrap_stats, seam_texels),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, seconds)};
+#undef HEMILIGHT_SPAN
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_unwrap_options) == 32, "hemilight_unwrap_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_unwrap_stats) == 80, "hemilight_unwrap_stats changed: see above");
+
+}  // namespace
+
+hemilight_unwrap_options default_unwrap_options() {
+  hemilight_unwrap_options o = zeroed<hemilight_unwrap_options>();
+  const unwrap_options d;
+  o.struct_size = sizeof o;
+  o.texels_per_unit = d.texels_per_unit;
+  o.page_size = d.page_size;
+  o.padding = d.padding;
+  o.max_chart_angle = d.max_chart_angle;
+  o.max_pages = d.max_pages;
+  o.thread_count = d.thread_count;
+  return o;
+}
+
+std::string read_sized(const hemilight_unwrap_options* in, hemilight_unwrap_options& out) {
+  return read(in, out, unwrap_options_fields, "hemilight_unwrap_options_init");
+}
+
+unwrap_options to_cpp(const hemilight_unwrap_options& c) {
+  unwrap_options o;
+  o.texels_per_unit = c.texels_per_unit;
+  o.page_size = c.page_size;
+  o.padding = c.padding;
+  o.max_chart_angle = c.max_chart_angle;
+  o.max_pages = c.max_pages;
+  o.thread_count = c.thread_count;
+  return o;
+}
+
+std::string check_sized(const hemilight_unwrap_stats* stats) {
+  return size_problem("stats", "hemilight_unwrap_stats_init", stats->struct_size, sizeof *stats);
+}
+
+void write_sized(const hemilight_unwrap_stats& from, hemilight_unwrap_stats* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(unwrap_stats_fields, &from, out, size);
+  out->struct_size = size;
+}
+
+}  // namespace hemilight::capi
+
+extern "C" {
+
+void hemilight_unwrap_options_init_sized(hemilight_unwrap_options* options, size_t struct_size) {
+  hemilight::capi::init_sized(options, struct_size, hemilight::capi::default_unwrap_options(), hemilight::capi::unwrap_options_fields);
+}
+
+void hemilight_unwrap_stats_init_sized(hemilight_unwrap_stats* stats, size_t struct_size) {
+  hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_unwrap_stats>(), hemilight::capi::unwrap_stats_fields);
+}
+
+}  // extern "C"

@@ -32,7 +32,8 @@
  *
  * Structs that grow (what stays compatible)
  *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
- *     hemilight_bake_stats and hemilight_bake_scene_desc begin with size_t struct_size. Their _init functions are inline (below)
+ *     hemilight_bake_stats, hemilight_bake_scene_desc, hemilight_unwrap_options and
+ *     hemilight_unwrap_stats begin with size_t struct_size. Their _init functions are inline (below)
  *     and record the sizeof the program was compiled with; call one before use.
  *   - A later minor version only appends fields to them, each new field starting at or after the
  *     previous version's sizeof. The library reads the fields that lie within the caller's
@@ -879,6 +880,81 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_irradiance(const float* input, 
                                                             hemilight_edge_fixup fixup, int output_size,
                                                             const hemilight_cubemap_irradiance_options* options,
                                                             float* output);
+/* ---- lightmap UVs -------------------------------------------------------------------------------
+ * hemilight_generate_lightmap_uvs gives a mesh lightmap UVs (include/hemilight/unwrap.hpp,
+ * docs/unwrap.md): vertices at the same position welded, charts grown by normal deviation (planar
+ * ones projected, curved ones flattened by least-squares conformal maps), packed with padding
+ * into square pages at a texel density or into one page. The result is new vertex arrays: each
+ * output vertex copies an input vertex (vertex_source: copy its position, normal, other UVs) and has
+ * its UV in its page; triangles keep their order. Deterministic: the same bytes for any thread
+ * count. */
+
+/* Unwrap options; fill with hemilight_unwrap_options_init (see "Structs that grow" at the top). */
+typedef struct hemilight_unwrap_options {
+  size_t struct_size;     /* set by hemilight_unwrap_options_init */
+  float texels_per_unit;  /* texel density (texels per scene unit), finite, >= 0; 0: the largest density at
+                             which every chart fits one page (default 0) */
+  int page_size;          /* width and height of each page in texels, 16..8192 (default 1024) */
+  int padding;            /* empty texels between charts and at the border, 0..64 and below page_size / 4
+                             (default 2) */
+  float max_chart_angle;  /* degrees, 1..89: most a triangle's normal may deviate from its chart's mean
+                             normal (default 60) */
+  int max_pages;          /* with texels_per_unit > 0: most pages the charts may need, 1..4096 (default 64) */
+  int thread_count;       /* 0 = all cores (default 0); results do not depend on it */
+} hemilight_unwrap_options;
+
+/* As hemilight_cache_options_init_sized, for unwrap options. */
+HEMILIGHT_API void hemilight_unwrap_options_init_sized(hemilight_unwrap_options* options, size_t struct_size);
+static inline void hemilight_unwrap_options_init(hemilight_unwrap_options* options) {
+  hemilight_unwrap_options_init_sized(options, sizeof *options);
+}
+
+typedef struct hemilight_unwrap_stats {
+  size_t struct_size;           /* set by hemilight_unwrap_stats_init */
+  size_t charts;                /* charts packed */
+  size_t planar_charts;         /* of them, projected onto their plane */
+  size_t degenerate_triangles;  /* triangles without area: in no chart, their UVs without area */
+  int pages;                    /* pages used (1 with texels_per_unit = 0) */
+  float texels_per_unit;        /* the density of every chart (the one found, for a target size) */
+  double uv_area_fraction;      /* the triangles' UV area over the pages' area */
+  double stretch_l2;            /* Sander et al.'s L2 stretch (>= 1; 1 for an isometry) */
+  double stretch_linf;          /* Sander et al.'s L-infinity stretch */
+  double seam_texels;           /* UV length in texels, both sides, of the edges between charts */
+  double seconds;               /* wall time */
+} hemilight_unwrap_stats;
+
+/* As hemilight_cache_stats_init, for unwrap statistics. */
+HEMILIGHT_API void hemilight_unwrap_stats_init_sized(hemilight_unwrap_stats* stats, size_t struct_size);
+static inline void hemilight_unwrap_stats_init(hemilight_unwrap_stats* stats) {
+  hemilight_unwrap_stats_init_sized(stats, sizeof *stats);
+}
+
+/* Lightmap UVs for a mesh (positions: 3 * vertex_count floats, finite; indices: 3 * triangle_count,
+ * each < vertex_count; front faces counter-clockwise). options may be NULL (the defaults).
+ * Outputs (written only on success):
+ *   vertex_source   vertex_capacity uint32: per output vertex, the input vertex it copies
+ *   uvs             2 * vertex_capacity floats: per output vertex, (u, v) in [0, 1] of its page
+ *                   (texel (x, y) of a page of size S has its centre at ((x + 0.5) / S, (y + 0.5) / S))
+ *   out_indices     3 * triangle_count uint32, into the output vertices
+ *   triangle_page   NULL, or triangle_count uint32: each triangle's page
+ *   *vertex_count_out  the number of output vertices, at most 3 * triangle_count
+ * vertex_capacity must be at least 3 * triangle_count (the bound, checked before any work).
+ * triangle_count 0: *vertex_count_out = 0, nothing else written (the arrays may be NULL).
+ * stats may be NULL.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL positions/indices with nonzero counts, NULL
+ * vertex_source/uvs/out_indices/vertex_count_out, vertex_capacity below 3 * triangle_count,
+ * NaN/Inf or beyond 1e18 positions, indices out of range, options or a struct_size out of range
+ * (the message names the field), charts that do not fit one page even at one texel each
+ * (texels_per_unit 0), charts that need more than max_pages pages, a triangle larger than a page at
+ * texels_per_unit; OUT_OF_MEMORY for more than (2^31 - 1) / 3 triangles.
+ * Cost: O(V + T log T) plus a sparse factorisation per curved chart (about a second per million
+ * triangles on two cores; docs/unwrap.md); memory about 400 bytes per triangle. */
+HEMILIGHT_API hemilight_status hemilight_generate_lightmap_uvs(const float* positions, size_t vertex_count, const uint32_t* indices,
+                                                               size_t triangle_count, const hemilight_unwrap_options* options,
+                                                               uint32_t* vertex_source, float* uvs, size_t vertex_capacity,
+                                                               uint32_t* out_indices, uint32_t* triangle_page, size_t* vertex_count_out,
+                                                               hemilight_unwrap_stats* stats);
+
 /* ---- memory kept between calls -----------------------------------------------------------------
  * Tables that depend only on a resolution (hemicube weights, integrator weights, SH9 and HL2 cone
  * weights, cube-map face tables) are built on first use and kept in one process-wide cache of the

@@ -279,3 +279,54 @@ TEST_CASE("C ABI options: cube-map irradiance options reach the C++ side, defaul
   CHECK(read.input_size == d.irradiance_input_size);
   CHECK(read.thread_count == d.thread_count);
 }
+
+TEST_CASE("C ABI options: every unwrap option reaches the C++ side, defaults are the C++ defaults, older layouts too", "[capi]") {
+  const unwrap_options d;
+  const unwrap_options def = capi::to_cpp(capi::default_unwrap_options());
+  CHECK(def.texels_per_unit == d.texels_per_unit);
+  CHECK(def.page_size == d.page_size);
+  CHECK(def.padding == d.padding);
+  CHECK(def.max_chart_angle == d.max_chart_angle);
+  CHECK(def.max_pages == d.max_pages);
+  CHECK(def.thread_count == d.thread_count);
+  hemilight_unwrap_options c = capi::default_unwrap_options();
+  c.texels_per_unit = 12.5f;
+  c.page_size = 512;
+  c.padding = 3;
+  c.max_chart_angle = 45.0f;
+  c.max_pages = 9;
+  c.thread_count = 2;
+  const unwrap_options o = capi::to_cpp(c);
+  CHECK(o.texels_per_unit == 12.5f);
+  CHECK(o.page_size == 512);
+  CHECK(o.padding == 3);
+  CHECK(o.max_chart_angle == 45.0f);
+  CHECK(o.max_pages == 9);
+  CHECK(o.thread_count == 2);
+  // An older, shorter layout (up to max_chart_angle): the rest takes the defaults.
+  c.struct_size = offsetof(hemilight_unwrap_options, max_pages);
+  hemilight_unwrap_options read = capi::default_unwrap_options();
+  REQUIRE(capi::read_sized(&c, read).empty());
+  CHECK(read.max_chart_angle == 45.0f);
+  CHECK(read.max_pages == d.max_pages);
+  CHECK(read.thread_count == d.thread_count);
+  c.struct_size = sizeof c + 8;
+  CHECK_THAT(capi::read_sized(&c, read), Catch::Contains("built against a newer hemilight.h"));
+  // Statistics: only the fields within struct_size are written.
+  hemilight_unwrap_stats from{};
+  from.struct_size = sizeof from;
+  from.charts = 7;
+  from.pages = 2;
+  from.seam_texels = 3.5;
+  from.seconds = 0.25;
+  hemilight_unwrap_stats to;
+  std::memset(&to, 0x5a, sizeof to);
+  to.struct_size = offsetof(hemilight_unwrap_stats, seam_texels);
+  REQUIRE(capi::check_sized(&to).empty());
+  capi::write_sized(from, &to);
+  CHECK(to.charts == 7);
+  CHECK(to.pages == 2);
+  hemilight_unwrap_stats untouched;
+  std::memset(&untouched, 0x5a, sizeof untouched);
+  CHECK(std::memcmp(&to.seam_texels, &untouched.seam_texels, sizeof to - offsetof(hemilight_unwrap_stats, seam_texels)) == 0);
+}
