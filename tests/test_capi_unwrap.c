@@ -88,6 +88,22 @@ int main(void) {
   CHECK(hemilight_generate_lightmap_uvs(positions, V, NULL, 0, NULL, NULL, NULL, 0, NULL, NULL, &n2, NULL) == HEMILIGHT_OK);
   CHECK(n2 == 0);
 
+  /* Coordinates up to 1e18 in magnitude (max_coordinate) are taken; beyond, refused by name. */
+  {
+    float big[9] = {1e18f, 0, 0, 0, 1e18f, 0, 0, 0, 0};
+    const uint32_t tri[3] = {0, 1, 2};
+    uint32_t src[3], idx3[3];
+    float uv3[6];
+    hemilight_unwrap_options_init(&o);
+    CHECK(hemilight_generate_lightmap_uvs(big, 3, tri, 1, &o, src, uv3, 3, idx3, NULL, &n2, NULL) == HEMILIGHT_OK);
+    CHECK(n2 == 3 && fabs(uv_area2(uv3, idx3, 0)) > 0.0);
+    big[4] = 1.5e18f;
+    CHECK_FAILS(hemilight_generate_lightmap_uvs(big, 3, tri, 1, &o, src, uv3, 3, idx3, NULL, &n2, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+                "positions[4] (vertex 1)");
+    o.page_size = 64;
+    o.thread_count = 2;
+  }
+
   /* Bad input: one clear message each, nothing written. */
   memset(source2, 0x5a, sizeof source2);
   n2 = 7;

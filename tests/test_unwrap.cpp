@@ -267,6 +267,14 @@ TEST_CASE("unwrap: curved and boxy meshes keep winding, padding and one density 
     }
     if (ru.stats.planar_charts == ru.stats.charts) CHECK(hi / lo < 1.0 + 1e-3);
   }
+  // A crowded page: 151 charts in 64² with 3 texels of padding (at most 15 x 15 slots of 1 + 3
+  // texels in 61): most charts are one texel; they keep their UV area, winding and padding.
+  unwrap_options crowded;
+  crowded.page_size = 64;
+  crowded.padding = 3;
+  const unwrap_result rc = of(many_boxes(30)).unwrap(crowded);
+  CHECK(rc.stats.texels_per_unit > 0.0f);
+  check_layout(of(many_boxes(30)), rc, crowded.page_size, crowded.padding);
   // Boxes: every face of every box is a planar chart of its own (90 degrees apart).
   const unwrap_result boxes = of(many_boxes(30)).unwrap(o);
   CHECK(boxes.stats.charts == 30 * 5 + 1);

@@ -146,8 +146,8 @@ class skyline {
   std::vector<segment> nodes_;
 };
 
-// A chart's rectangle in texels at `density`: at least 1 x 1.
-int texels(double extent, double density) { return std::max(1, int(std::ceil(extent * density - 1e-9))); }
+// A chart's rectangle in texels at `density`: at least 1 x 1 (and at most 2^30, far past any page).
+int texels(double extent, double density) { return std::max(1, int(std::min(std::ceil(extent * density - 1e-9), 1073741824.0))); }
 
 // Packs the charts in `order` at `density` into pages of one bin each (bin: page_size - padding,
 // rectangles grown by padding). With max_pages 1, returns false when one does not fit.
@@ -198,16 +198,20 @@ std::vector<std::uint32_t> packing_order(const chart_uvs& uvs) {
   return order;
 }
 
-// The largest density (16 bisection steps below the area bound) at which the charts fit one page.
+// The largest density (16 bisection steps between the density at which every chart is one texel
+// and the area bound) at which the charts fit one page.
 placement pack_to_size(const chart_uvs& uvs, const std::vector<std::uint32_t>& order, const unwrap_options& o) {
+  double longest = 0.0;
+  for (const glm::dvec2& e : uvs.extent) longest = std::max({longest, e.x, e.y});
+  const double one_texel = 1.0 / std::max(longest, 1e-300);  // every chart within 1 x 1 texels, with its area
   placement best;
-  if (!pack_at(uvs, order, 0.0, o, 1, best))
+  if (!pack_at(uvs, order, one_texel, o, 1, best))
     throw_invalid_argument("unwrap_lightmap: the " + std::to_string(uvs.extent.size()) + " charts do not fit one page of " +
                            std::to_string(o.page_size) + " x " + std::to_string(o.page_size) + " texels even at one texel each (padding " +
                            std::to_string(o.padding) + "): use a larger page_size, or texels_per_unit > 0 to spill into several pages");
   double area = 0.0;
   for (const glm::dvec2& e : uvs.extent) area += e.x * e.y;
-  double lo = 0.0, hi = double(o.page_size - o.padding) / std::sqrt(std::max(area, 1e-300));
+  double lo = one_texel, hi = std::max(one_texel, double(o.page_size - o.padding) / std::sqrt(std::max(area, 1e-300)));
   placement trial;
   if (pack_at(uvs, order, hi, o, 1, trial)) return trial;
   for (int step = 0; step < 16; ++step) {
