@@ -948,7 +948,7 @@ static inline void hemilight_unwrap_stats_init(hemilight_unwrap_stats* stats) {
  * (texels_per_unit 0), charts that need more than max_pages pages, a triangle larger than a page at
  * texels_per_unit; OUT_OF_MEMORY for more than (2^31 - 1) / 3 triangles.
  * Cost: O(V + T log T) plus a sparse factorisation per curved chart (about a second per million
- * triangles on two cores; docs/unwrap.md); memory about 400 bytes per triangle. */
+ * triangles on two cores; docs/unwrap.md); memory up to about 350 bytes per triangle at its peak. */
 HEMILIGHT_API hemilight_status hemilight_generate_lightmap_uvs(const float* positions, size_t vertex_count, const uint32_t* indices,
                                                                size_t triangle_count, const hemilight_unwrap_options* options,
                                                                uint32_t* vertex_source, float* uvs, size_t vertex_capacity,

@@ -92,7 +92,8 @@ struct unwrap_result {
 /// max_scene_elements / 3 triangles or vertices over max_scene_elements.
 /// Cost: O(V + T log T) for welding and charts, one sparse Cholesky factorisation per curved chart
 /// (over the threads), O(C log C + C S) for packing C charts on a skyline of S segments (repeated
-/// about 16 times to find the density for a target size). Memory: about 400 bytes per triangle.
+/// about 16 times to find the density for a target size). Memory: up to about 350 bytes per
+/// triangle at its peak (docs/unwrap.md).
 unwrap_result unwrap_lightmap(const glm::vec3* positions, std::size_t vertex_count, const std::uint32_t* indices,
                               std::size_t triangle_count, const unwrap_options& options);
 
