@@ -59,8 +59,9 @@ static void build_table(benchmark::State& state) {
 }
 BENCHMARK(build_table)->Arg(64)->Arg(256)->Unit(benchmark::kMillisecond);
 
-// The target: render + integrate with gradients (great arc) at N = 64 on the Cornell box,
-// one core, at the 128 points of bench::cornell_floor_and_back_wall (bench_points.hpp), cycled.
+// Render + integrate with gradients (great arc) at N = 64 on the Cornell box, one core, at the 128
+// points of bench::cornell_floor_and_back_wall (bench_points.hpp), cycled: the target is 20k
+// hemicubes/s (docs/integration.md).
 static void render_and_integrate_cornell(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const scene_mesh mesh = cornell_box();

@@ -53,9 +53,9 @@ inline sample_points surface_points(const scene_mesh& m, std::size_t count, floa
   return out;
 }
 
-/// The points of the render + integrate target (bench_integrate): an 8 x 8 grid on the
-/// Cornell box's floor (1 mm above it, normal +y) interleaved with one on its back wall (normal
-/// -z), 128 points.
+/// The points of the render + integrate target, 20k hemicubes/s (bench_integrate): an 8 x 8 grid
+/// on the Cornell box's floor (1 mm above it, normal +y) interleaved with one on its back wall
+/// (normal -z), 128 points.
 inline sample_points cornell_floor_and_back_wall() {
   sample_points out;
   for (int k = 0; k < 64; ++k) {

@@ -1,9 +1,9 @@
-"""Charts of the irradiance cache (issue 5): RMS relative error against the fraction of points
+"""Charts of the irradiance cache (docs/cache.md): RMS relative error against the fraction of points
 given a hemicube, one column per scene, curves per hemicube resolution N (solid: with gradients,
 dashed: without). Top row: error against the converged reference (the cache's total error), with
 the per-point reference's own error at each N as a dotted horizontal line in the same colour.
 Bottom row: error against a hemicube at every point with the same N (the interpolation error
-alone). The grey boxes are the issue's targets (<= 1% RMS at <= 10% of the points; previews:
+alone). The grey boxes are the cache's targets (<= 1% RMS at <= 10% of the points; previews:
 <= 3% at <= 3%).
 
   plot_cache.py DIR      draws DIR/cache.png from DIR/cache_sweep.csv (bash benchmarks/run.sh cache)

@@ -1,6 +1,6 @@
 """Charts of exact edge coverage against point sampling (docs/bench/edge.png, from
 edge_accuracy.csv and edge_cost.csv written by sweep_edge): worst |relative error| of E against
-Lambert's formula per polygon family and N; the issue's rectangle (signed error); and the cost,
+Lambert's formula per polygon family and N; the rectangle's signed error; and the cost,
 as the median of the paired rounds' time ratios per scene and N, with worst error against time
 per hemicube on the Cornell box. Also prints the tables docs/raster.md quotes."""
 import sys
@@ -41,10 +41,10 @@ ax.legend(fontsize=6)
 
 ax = axes[1]
 for mode, style in (("point", "s--"), ("edge", "o-")):
-    pts = sorted((r["N"], r["rel_err"]) for r in acc if r["family"] == "issue_rectangle" and r["mode"] == mode)
+    pts = sorted((r["N"], r["rel_err"]) for r in acc if r["family"] == "rectangle" and r["mode"] == mode)
     ax.semilogx([p[0] for p in pts], [100 * p[1] for p in pts], style, label=mode)
 ax.axhline(0, color="k", lw=0.6)
-ax.set_title("issue rectangle [-0.5,0.5]x[0.3,0.9], z = 1 (E = 0.285808)", fontsize=8)
+ax.set_title("rectangle [-0.5,0.5]x[0.3,0.9], z = 1 (E = 0.285808)", fontsize=8)
 ax.set_xlabel("hemicube resolution N")
 ax.set_ylabel("signed error (%)")
 ax.grid(True, which="both", alpha=0.3)

@@ -10,6 +10,8 @@
 #                                     ward_continuous, first order (docs/cache.md; 15-30 min; not run by default)
 #   bash benchmarks/run.sh cache_second_order the cache's second-order term against first order, with
 #                                     both weights (docs/cache.md; ~25 min; not run by default)
+#   bash benchmarks/run.sh cache_levels       the cache on the stand-in levels: hemicube share, error against
+#                                     converged, radius counters, before and after (docs/cache.md; ~1.5 h; not by default)
 #   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 #   bash benchmarks/run.sh unwrap             the lightmap unwrapper: utilisation, stretch, seams, time, and bakes on its
@@ -34,6 +36,7 @@ if [ ${#names[@]} -eq 0 ]; then
     [ -x "$f" ] || continue
     n=$(basename "$f"); n=${n#bench_}; n=${n#sweep_}
     [ "$n" = bake_scaling ] && continue  # long (a 1M-triangle bake, 4096^2 lightmaps): only when named
+    [ "$n" = cache_levels ] && continue  # long (bakes of the levels up to 1024²): only when named
     [[ " ${names[*]-} " == *" $n "* ]] || names+=("$n")
   done
 fi
@@ -95,6 +98,23 @@ for n in "${names[@]}"; do
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
     continue
   fi
+  if [ "$n" = cache_levels ]; then
+    # The cache on the stand-in levels (docs/cache.md, "Levels"): hemicube share, error against a
+    # converged reference (N = 256, 2 rolls, every 37th texel; every 97th at 1024²), the radius
+    # counters, before (--legacy) and now; at 256² and 512² also the bake without the cache (time
+    # ratio). ~1.5 h on 2 cores; the converged references are kept in build-bench/cache_levels_truth.
+    echo "== sweep_cache_levels"
+    csv=docs/bench/cache_levels.csv truth="$build/cache_levels_truth"
+    rm -f "$csv"; mkdir -p "$truth"
+    for v in legacy default; do
+      flags=(--append --truth-cache "$truth" --variant "$v"); [ "$v" = legacy ] && flags+=(--legacy)
+      "$build/benchmarks/sweep_cache_levels" "$csv" "${flags[@]}" --levels arena,keep --sizes 256,512 --no-cache-sizes 256,512
+      "$build/benchmarks/sweep_cache_levels" "$csv" "${flags[@]}" --levels arena,keep --sizes 1024 --stride 97
+    done
+    "$build/benchmarks/sweep_cache_levels" "$csv" --append --truth-cache "$truth" --levels city_block,terrain_town --sizes 512
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache_levels.py docs/bench
+    continue
+  fi
   if [ "$n" = cache_resolution ]; then
     echo "== sweep_cache (resolution study)"
     csv=docs/bench/cache_resolution.csv truth="$build/cache_truth" a=0.05,0.1,0.2,0.3,0.5
@@ -107,13 +127,13 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_cache" "$csv" "${common[@]}" --scenes sky --n 64,128 \
       --converged 512 --stride 7 --check 1024 --check-stride 4
     # the hexagon room ceiling and the Cornell box on the default 128 x 128 grid (fractions depend on
-    # the grid), with gradients, with and without the second opinion (cache_options::second_opinion);
+    # the grid), with gradients, with and without cache_options::expert.lone_record_change_limit;
     # ~1.5 h more on 2 shared cores (the per-point references at N = 512 dominate: 65,536 hemicubes)
     k128=docs/bench/cache_resolution_k128.csv
     rm -f "$k128"
-    for so in 0.25 0; do
+    for lc in 0.25 0; do
       kc=(--append --grid 128 --gradients yes --truth-cache "$truth" --rolls 4 --converged 1024 --check 2048 --second-order no
-          --second-opinion "$so" --variant "second_opinion=$so")
+          --lone-record-change-limit "$lc" --variant "lone_record_change_limit=$lc")
       "$build/benchmarks/sweep_cache" "$k128" "${kc[@]}" --a 0.1,0.2,0.3,0.5,0.7,1.0 --scenes hexagon --n 256,512 \
         --stride 28 --check-stride 4
       "$build/benchmarks/sweep_cache" "$k128" "${kc[@]}" --a 0.1,0.2,0.3,0.5,0.7,1.0 --scenes cornell --n 256,512 \

@@ -1,4 +1,4 @@
-// Speed against accuracy of the irradiance cache (issue 5's benchmark).
+// Speed against accuracy of the irradiance cache (docs/cache.md, "Measured").
 //
 //   usage: sweep_cache out.csv [grid] [options]
 //     --grid K            points per side of each surface (default 128; also the 2nd positional argument)
@@ -19,12 +19,16 @@
 //     --append            append rows to out.csv (header only if the file is empty)
 //     --gradients LIST    any of yes,no (default yes,no)
 //     --threads T         worker threads (default 0 = all cores)
-//     --second-opinion F  cache_options::second_opinion (default: the option's default; 0 = off)
-//     --nearby-opinion F  cache_options::nearby_opinion (default: the option's default; 0 = off)
-//     --sole-reach F      cache_options::sole_record_reach (default: the option's default; 1 = off)
+//     --lone-record-change-limit F     cache_options::expert.lone_record_change_limit (default: the
+//                                      option's default; 0 = off)
+//     --lone-record-neighbour-reach F  cache_options::expert.lone_record_neighbour_reach (default: the
+//                                      option's default; 0 = off)
+//     --lone-record-reach F            cache_options::expert.lone_record_reach (default: the option's
+//                                      default; 1 = off)
 //     --weight W          cache_options::weight: ward, ward_continuous or tabellion_lamorlette
 //                         (default: the option's default)
 //     --second-order yes|no  cache_options::second_order (default: the option's default, yes)
+//     --space-finest yes|no  cache_expert_options::space_finest_seeds (default: the option's default)
 //     --worst K           print the K points of largest error against the per-point reference
 //     --extrapolate-wall-depth yes|no  integrate_options::extrapolate_wall_depth of the cache's hemicubes
 //     --record-regions    Cornell box: print where the records are (floor / walls, dark or lit, the
@@ -168,12 +172,13 @@ int main(int argc, char** argv) {
   std::vector<bool> gradient_modes{true, false};
   std::string variant = "default";
   int worst_k = 0;
-  float second_opinion = cache_options{}.expert.lone_record_change_limit;
-  float nearby_opinion = cache_options{}.expert.lone_record_neighbour_reach;
-  float sole_reach = cache_options{}.expert.lone_record_reach;
+  float lone_record_change_limit = cache_options{}.expert.lone_record_change_limit;
+  float lone_record_neighbour_reach = cache_options{}.expert.lone_record_neighbour_reach;
+  float lone_record_reach = cache_options{}.expert.lone_record_reach;
   cache_weight weight = cache_options{}.weight;
   bool extrapolate_wall_depth = integrate_options{}.extrapolate_wall_depth;
   bool second_order = cache_options{}.second_order;
+  bool space_finest = cache_options{}.expert.space_finest_seeds;
   bool record_regions = false;
   std::vector<int> resolutions{64};
   std::vector<float> thresholds{0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f, 0.5f};
@@ -208,24 +213,26 @@ int main(int argc, char** argv) {
       variant = value();
       if (variant.find_first_of(",\"\n") != std::string::npos) usage("--variant must not contain commas, quotes or newlines (it is a CSV field)");
     }
-    else if (arg == "--second-opinion") {
+    else if (arg == "--lone-record-change-limit") {
       const std::string v = value();
-      second_opinion = std::strtof(v.c_str(), nullptr);
-      if (!(second_opinion >= 0.0f && second_opinion < 1e6f)) usage(("bad --second-opinion '" + v + "'").c_str());
-    } else if (arg == "--nearby-opinion") {
+      lone_record_change_limit = std::strtof(v.c_str(), nullptr);
+      if (!(lone_record_change_limit >= 0.0f && lone_record_change_limit < 1e6f))
+        usage(("bad --lone-record-change-limit '" + v + "'").c_str());
+    } else if (arg == "--lone-record-neighbour-reach") {
       const std::string v = value();
-      nearby_opinion = std::strtof(v.c_str(), nullptr);
-      if (!(nearby_opinion >= 0.0f && nearby_opinion <= 16.0f)) usage(("bad --nearby-opinion '" + v + "'").c_str());
+      lone_record_neighbour_reach = std::strtof(v.c_str(), nullptr);
+      if (!(lone_record_neighbour_reach >= 0.0f && lone_record_neighbour_reach <= 16.0f))
+        usage(("bad --lone-record-neighbour-reach '" + v + "'").c_str());
     } else if (arg == "--weight") {
       const std::string v = value();
       if (v == "ward") weight = cache_weight::ward;
       else if (v == "ward_continuous") weight = cache_weight::ward_continuous;
       else if (v == "tabellion_lamorlette") weight = cache_weight::tabellion_lamorlette;
       else usage(("bad --weight '" + v + "' (ward, ward_continuous, tabellion_lamorlette)").c_str());
-    } else if (arg == "--sole-reach") {
+    } else if (arg == "--lone-record-reach") {
       const std::string v = value();
-      sole_reach = std::strtof(v.c_str(), nullptr);
-      if (!(sole_reach > 0.0f && sole_reach <= 1.0f)) usage(("bad --sole-reach '" + v + "'").c_str());
+      lone_record_reach = std::strtof(v.c_str(), nullptr);
+      if (!(lone_record_reach > 0.0f && lone_record_reach <= 1.0f)) usage(("bad --lone-record-reach '" + v + "'").c_str());
     } else if (arg == "--extrapolate-wall-depth") {
       const std::string v = value();
       if (v != "yes" && v != "no") usage(("bad --extrapolate-wall-depth '" + v + "' (yes, no)").c_str());
@@ -234,6 +241,10 @@ int main(int argc, char** argv) {
       const std::string v = value();
       if (v != "yes" && v != "no") usage(("bad --second-order '" + v + "' (yes, no)").c_str());
       second_order = v == "yes";
+    } else if (arg == "--space-finest") {
+      const std::string v = value();
+      if (v != "yes" && v != "no") usage(("bad --space-finest '" + v + "' (yes, no)").c_str());
+      space_finest = v == "yes";
     } else if (arg == "--record-regions") {
       record_regions = true;
     } else if (arg == "--worst") worst_k = to_int(value(), "worst");
@@ -411,11 +422,12 @@ int main(int argc, char** argv) {
           cache_options o;
           o.error_threshold = a;
           o.use_gradients = gradients;
-          o.expert.lone_record_change_limit = second_opinion;
-          o.expert.lone_record_neighbour_reach = nearby_opinion;
-          o.expert.lone_record_reach = sole_reach;
+          o.expert.lone_record_change_limit = lone_record_change_limit;
+          o.expert.lone_record_neighbour_reach = lone_record_neighbour_reach;
+          o.expert.lone_record_reach = lone_record_reach;
           o.weight = weight;
           o.second_order = second_order;
+          o.expert.space_finest_seeds = space_finest;
           cache_run run;
           run.thread_count = threads;
           const double load = loadavg();

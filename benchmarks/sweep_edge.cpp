@@ -4,9 +4,10 @@
 // Accuracy: each polygon (radiance 1, two-sided, sky 0) is rendered by the rasterizer and
 // integrated (hemicube_integrator); E is compared with Lambert's formula for the polygon clipped
 // to the point's upper hemisphere (computed here in double, independent of the library).
-// Families: the rectangle of issue 23 (and stretched across the top/side face boundary),
-// rectangles aligned with the texel grid at random positions, rotated rectangles, slivers (thin
-// triangles), polygons straddling a top/side face boundary, and walls straddling the horizon.
+// Families: the rectangle of docs/raster.md's figures (and it stretched across the top/side face
+// boundary), rectangles aligned with the texel grid at random positions, rotated rectangles,
+// slivers (thin triangles), polygons straddling a top/side face boundary, and walls straddling the
+// horizon.
 // Cost: hemicubes per second (render + integrate, N = 32, 64, 128) on the reference scenes at
 // 256 surface points each, point sampling and edge coverage alternated in paired rounds; the CSV
 // has every round, the chart the medians of the per-round ratios.
@@ -67,13 +68,13 @@ std::vector<dvec3> rectangle(const dvec3& centre, const dvec3& u, const dvec3& v
 std::vector<polygon_case> cases() {
   std::vector<polygon_case> out;
   const dvec3 eye(0.05, -0.02, 0.0);
-  // The issue's rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1 seen from (0.05, -0.02, 0); stretched to y = 1.3.
-  const auto issue = [&](double y1) {
+  // The rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1 seen from (0.05, -0.02, 0); stretched to y = 1.3.
+  const auto rectangle_to = [&](double y1) {
     return std::vector<dvec3>{dvec3(-0.5, 0.3, 1) - eye, dvec3(0.5, 0.3, 1) - eye, dvec3(0.5, y1, 1) - eye,
                               dvec3(-0.5, y1, 1) - eye};
   };
-  out.push_back({"issue_rectangle", 0, issue(0.9)});
-  out.push_back({"issue_stretched", 0, issue(1.3)});
+  out.push_back({"rectangle", 0, rectangle_to(0.9)});
+  out.push_back({"rectangle_stretched", 0, rectangle_to(1.3)});
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.0, 1.0);
   const int count = 24;

@@ -1,7 +1,7 @@
 // What exact edge coverage (raster_options::edge_coverage) buys downstream: cost on the reference
 // scenes, the irradiance cache's error at a fixed hemicube budget, and the hemicube resolution N at
-// which per-point hemicubes reach 1% relative RMS, point sampling against edge coverage (issue 23,
-// "Measure", the downstream part; docs/raster.md, "Exact edge coverage").
+// which per-point hemicubes reach 1% relative RMS, point sampling against edge coverage
+// (docs/raster.md, "Exact edge coverage").
 //
 //   usage: sweep_edge_downstream out.csv [options]
 //     --parts LIST        any of cost,n,cache,silhouette (default all four)

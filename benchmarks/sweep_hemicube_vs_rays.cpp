@@ -1,5 +1,5 @@
 // Error against time: hemicubes (rasterizer + integrator) beside cosine-weighted ray casting with
-// Embree, for the same points and scenes (issue 4's chart).
+// Embree, for the same points and scenes (docs/integration.md, "Hemicubes against rays").
 //   usage: sweep_hemicube_vs_rays out.csv
 // Scenes: the closed-form scenes of tests/integrate_scenes.hpp (exact irradiance E). Points: 64
 // positions jittered by up to 1 cm around each scene's point (the closed form holds for each). For each method

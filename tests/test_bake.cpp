@@ -904,7 +904,7 @@ TEST_CASE("A post on a slab under the sky keeps its contact shadow: floor texels
     const double mb = sum_bake[b] / double(count[b]), mr = sum_ref[b] / double(count[b]);
     INFO("ring " << bins[b] << "-" << bins[b + 1] << " m: " << count[b] << " texels, bake " << mb << ", N = 256 " << mr);
     REQUIRE(count[b] > 10);
-    // The contact shadow survives: each ring's mean within 2% of the reference (the issue's bound).
+    // The contact shadow survives: each ring's mean within 2% of the reference.
     CHECK(std::fabs(mb / mr - 1.0) < 0.02);
   }
   // ... and it is a shadow: the ring at the post is darker than 0.4 m away (the post hides a

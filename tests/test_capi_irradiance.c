@@ -478,10 +478,10 @@ static void test_lights(void) {
   hemilight_scene_release(empty);
 }
 
-/* Exact edge coverage (hemilight_cache_options.edge_coverage) on the emitter of the issue that
- * asked for it: the rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1, radiance 1, facing down, seen from
- * (0.05, -0.02, 0) with normal +z. Reference: Lambert's formula (lambert above), E = 0.285808. One
- * point through the cache is one hemicube at that point. */
+/* Exact edge coverage (hemilight_cache_options.edge_coverage) on the emitter of docs/raster.md's
+ * edge-coverage figures: the rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1, radiance 1, facing down,
+ * seen from (0.05, -0.02, 0) with normal +z. Reference: Lambert's formula (lambert above),
+ * E = 0.285808. One point through the cache is one hemicube at that point. */
 static void test_edge_coverage(void) {
   const float zero_sky[3] = {0.0f, 0.0f, 0.0f};
   const float pos[] = {-0.5f, 0.3f, 1.0f, 0.5f, 0.3f, 1.0f, 0.5f, 0.9f, 1.0f, -0.5f, 0.9f, 1.0f};
@@ -496,7 +496,7 @@ static void test_edge_coverage(void) {
   double e_ref;
 
   e_ref = lambert(v, 4, pd, nd);
-  CHECK(fabs(e_ref - 0.285808) < 1e-6); /* the issue's figure (checks lambert here) */
+  CHECK(fabs(e_ref - 0.285808) < 1e-6); /* its E to six digits (checks lambert here) */
   CHECK(hemilight_scene_create(pos, 4, idx, 2, rad, zero_sky, &rect) == HEMILIGHT_OK);
   hemilight_cache_options_init(&o);
   CHECK(o.edge_coverage == 0); /* off by default */
@@ -541,8 +541,8 @@ static double rect_solid_angle(double x0, double x1, double y0, double y1, doubl
 }
 
 /* hemilight_scene_with_edge_coverage: the point entries (no options struct) with exact edge
- * coverage. The issue's rectangle emitter against Lambert's formula (irradiance) and the closed-form
- * solid angle (a probe's constant SH coefficient). */
+ * coverage. The rectangle emitter of test_edge_coverage against Lambert's formula (irradiance) and
+ * the closed-form solid angle (a probe's constant SH coefficient). */
 static void test_scene_edge_coverage(void) {
   const float zero_sky[3] = {0.0f, 0.0f, 0.0f};
   const float pos[] = {-0.5f, 0.3f, 1.0f, 0.5f, 0.3f, 1.0f, 0.5f, 0.9f, 1.0f, -0.5f, 0.9f, 1.0f};

@@ -62,7 +62,7 @@ TEST_CASE("rectangle solid angle: a full cube face is 4 pi / 6", "[geometry]") {
 }
 
 TEST_CASE("hemicube weights: solid angles sum to 2 pi and projected solid angles to pi", "[geometry]") {
-  // Tolerance 1e-6 relative (the bound): the weights are exact in double and rounded to
+  // Tolerance 1e-6 relative (docs/conventions.md): the weights are exact in double and rounded to
   // float (relative error 6e-8 each); summed in double the rounding errors largely cancel.
   for (int n : {2, 4, 16, 64, 256, 1024}) {
     const auto table = hemicube_table::get(n);

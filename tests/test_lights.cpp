@@ -111,7 +111,7 @@ TEST_CASE("lights: a hard point light over a plane is I cos / d^2", "[lights]") 
       const glm::dvec3 p(x, y, 0.0), d = glm::dvec3(l.position) - p;
       const double expected = 5.0 * (d.z / glm::length(d)) / glm::dot(d, d);
       const light_sample ls = direct_light(*s, set, 0, glm::vec3(p), {0, 0, 1});
-      // 1e-3 (the issue's bound for hard lights); float evaluation is good to ~1e-6.
+      // 1e-3 (the tolerance for hard lights); float evaluation is good to ~1e-6.
       CHECK(rel(ls.irradiance.x, expected) < 1e-3);
       CHECK(rel(ls.irradiance.y, 0.5 * expected) < 1e-3);
       CHECK(ls.visibility == 1.0f);
@@ -176,15 +176,15 @@ TEST_CASE("lights: the sun, hard and with an angular radius, against E cos and c
       const bool straddles = radius > 0.0f && std::fabs(elevation) < double(radius);
       if (!straddles) {
         // Fully above (or below) the horizon the disc gives exactly E cos theta: 1e-3 for the
-        // hard sun (the issue's bound), 1e-3 too with a radius (the closed form is exact there).
+        // hard sun (as for every hard light), 1e-3 too with a radius (the closed form is exact there).
         const double expected = 3.0 * std::max(0.0, std::sin(elevation));
         if (expected == 0.0)
           CHECK(ls.irradiance.x == 0.0f);
         else
           CHECK(rel(ls.irradiance.x, expected) < 1e-3);
       } else {
-        // Across the horizon: the cone quadrature, radiance E / (pi sin^2 a); 1% (the issue's
-        // bound for lights with a radius; the quadrature is good to ~1e-5).
+        // Across the horizon: the cone quadrature, radiance E / (pi sin^2 a); 1% (the
+        // tolerance for lights with a radius; the quadrature is good to ~1e-5).
         const double l_sun = 3.0 / (pi * std::sin(radius) * std::sin(radius));
         const double expected = l_sun * cone_quadrature(to_sun, double(radius));
         CHECK(rel(ls.irradiance.x, expected) < 1e-2);
@@ -214,7 +214,7 @@ TEST_CASE("lights: a sphere light equals the point above the horizon and the con
         continue;
       }
       if (axis.z >= std::sin(a)) CHECK(rel(e, 2.0 * axis.z / (d * d)) < 1e-3);  // fully above: the point's I cos / d^2
-      CHECK(rel(e, expected) < 1e-2);  // 1%: the issue's bound with a radius
+      CHECK(rel(e, expected) < 1e-2);  // 1%: the tolerance for lights with a radius
     }
   // Inside the sphere: the limit of a half-space of radiance I / (pi r^2), E = pi L (1 + cos) / 2.
   const float inside = direct_light(*s, set, 0, {0.1f, 0.0f, 0.0f}, {0, 0, 1}).irradiance.x;
@@ -334,7 +334,7 @@ TEST_CASE("lights: a RECT's penumbra under a half-plane occluder matches Lambert
     const double err = (ls.irradiance.x - exact) / full;
     const double err_ref = (direct_light(*s, set, 0, p, {0, 0, 1}, reference).irradiance.x - exact) / full;
     INFO("x0 " << x0 << ": " << ls.irradiance.x << " exact " << exact << " full " << full);
-    // 2% of the unoccluded irradiance at every point (the issue's bound): 64 samples of a (0, 6, 2)
+    // 2% of the unoccluded irradiance at every point (docs/lights.md): 64 samples of a (0, 6, 2)
     // net cut by a straight edge err by at most ~8 strata x 1/64 x (their weight spread) / 2.
     CHECK(std::fabs(err) < 0.02);
     worst = std::max(worst, std::fabs(err));

@@ -114,7 +114,7 @@ TEST_CASE("probes: an emissive quad against quadrature of L Y_k over its area", 
   o.resolution = 128;
   const glm::vec3 origin(0.0f);
   const probe_result r = sample_probes(s, &origin, 1, o);
-  // The issue's bound: 1% of c0 at N = 128 (the emitter's outline cuts texels).
+  // The bound docs/probes.md states: 1% of c0 at N = 128 (the emitter's outline cuts texels).
   for (std::size_t k = 0; k < 9; ++k) {
     INFO("k = " << k << ": " << r.probes[0][k].x << " against " << ref[k]);
     CHECK(std::fabs(r.probes[0][k].x - ref[k]) < 0.01 * ref[0]);
@@ -123,8 +123,8 @@ TEST_CASE("probes: an emissive quad against quadrature of L Y_k over its area", 
 }
 
 TEST_CASE("probes: exact edge coverage removes the edge aliasing of an emitter's coefficients", "[probes]") {
-  // The rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1, radiance 1, facing down, probed from
-  // (0.05, -0.02, 0) (the emitter of the edge-coverage option's issue) at N = 16 to 128, with and without
+  // The rectangle [-0.5, 0.5] x [0.3, 0.9] at z = 1 of docs/raster.md's edge-coverage figures,
+  // radiance 1, facing down, probed from (0.05, -0.02, 0) at N = 16 to 128, with and without
   // probe_options::edge_coverage. Reference: quad_sh9.
   const glm::dvec3 eye(0.05, -0.02, 0.0);
   const glm::dvec3 a(-0.5, 0.3, 1.0), u(1.0, 0.0, 0.0), v(0.0, 0.6, 0.0);

@@ -25,6 +25,28 @@
 
 namespace hemilight {
 
+/// What set a record's final radius: the last limit that lowered it (cache_record::limit,
+/// cache_stats::records_by_limit). docs/cache.md, "Radii".
+enum class radius_limit : std::uint8_t {
+  split_sphere,  ///< the hemicube's harmonic mean distance (nothing lowered it)
+  max_radius,    ///< clamped to max_radius (or the split sphere was infinite: nothing seen)
+  gradient,      ///< R <= E / |g_t| (cache_expert_options::limit_radius_by_gradient)
+  contact,       ///< limited to the sample's nearest hit (a record seeing back faces: a contact)
+  neighbour,     ///< neighbour clamping R_i <= R_j + d (cache_expert_options::limit_radius_by_neighbours)
+  disagreement,  ///< shrunk because it and a neighbour predict each other worse than a
+};
+inline constexpr std::size_t radius_limit_count = 6;
+
+/// Why a point was open (not covered) when it was given a hemicube (cache_stats::hemicubes_by_reason).
+enum class open_reason : std::uint8_t {
+  uncovered,          ///< no record's weight passes 1/a there (or none is on its side)
+  records_disagree,   ///< the covering records' predictions span more than a (refine_where_records_disagree)
+  lone_change,        ///< one record covers it and its first-order term is too large (lone_record_change_limit)
+  lone_reach,         ///< one record covers it, near the rim of its reach (lone_record_reach)
+  nearby_disagrees,   ///< one record covers it and a record nearby predicts otherwise (lone_record_neighbour_reach)
+};
+inline constexpr std::size_t open_reason_count = 5;
+
 /// One cache record (all vectors world space).
 struct cache_record {
   glm::vec3 position{0.0f};
@@ -33,6 +55,9 @@ struct cache_record {
   std::array<glm::vec3, 3> rotation_gradient{};
   std::array<glm::vec3, 3> translation_gradient{};
   float radius = 0.0f;          ///< validity radius R_i (scene units) after all limits
+  /// The last limit that lowered the radius (when it went below the record's smallest radius,
+  /// the radius is that smallest radius and this says what pushed it there).
+  radius_limit limit = radius_limit::split_sphere;
   float harmonic_distance = 0;  ///< the hemicube's split-sphere distance before any limit
   /// The sample's irradiance_sample::backface_fraction (at most invalid_backface_fraction, or it
   /// would not be a record). A record whose value passes a tenth of invalid_backface_fraction
@@ -90,6 +115,15 @@ struct cache_expert_options {
   /// ... and counts as covered only where that record's Ward weight >= 1 / (lone_record_reach x a)
   /// (ignored with the Tabellion-Lamorlette weight). In (0, 1]; 1 = off.
   float lone_record_reach = 0.99f;
+  /// At the finest spacing, seeds are picked as in the coarser rounds (at least the spacing apart
+  /// among points of similar normal), round after round until no point is open; false: every open
+  /// point becomes a seed at once.
+  bool space_finest_seeds = true;
+  /// Neighbour clamping between records of any normals; false: only between records whose
+  /// normals are similar (n_i . n_j > 0.9), as the disagreement shrink.
+  bool clamp_across_normals = true;
+  /// With cache_run::inside_test given, a seed the test calls inside geometry gets no hemicube.
+  bool pretest_inside = true;
 };
 
 /// Options of the irradiance cache (what it computes; how one call runs is cache_run). Lengths
@@ -101,6 +135,11 @@ struct cache_options {
   /// min_radius = (median spacing of the points) / a, max_radius = 0.2 x the diagonal of the
   /// points' bounding box (raised to min_radius if smaller).
   float min_radius = 0.0f, max_radius = 0.0f;
+  /// With the automatic min_radius and cache_run::point_spacing given: min_radius =
+  /// max(min_radius_spacings, 1 / a) x (median of point_spacing). A record at min_radius then
+  /// reaches (a R) a x min_radius_spacings point spacings, and at least one: two texels at the
+  /// default a = 0.2, one at a <= 0.1. Finite, in [1, 1000].
+  float min_radius_spacings = 10.0f;
   bool use_gradients = true;  ///< interpolate with g_r and g_t
   cache_weight weight = cache_weight::ward;
   /// Second-order interpolation (needs use_gradients): each record gets a Hessian fitted from its
@@ -132,6 +171,18 @@ struct cache_run {
   /// inside geometry (e.g. invalid in an earlier call over the same points and scene): no
   /// hemicube, reported invalid. nullptr = none.
   const std::uint8_t* known_inside = nullptr;
+  /// Optional, count entries (not owned, read during the call): per point, the spacing of the
+  /// points around it on its own surface (scene units, finite, > 0; the baker passes each texel's
+  /// world size). With it the automatic min_radius is cache_options::min_radius_spacings (at least
+  /// 1 / a) x their median instead of the median distance between nearest points / a, which thin parts (points close
+  /// together in 3D across surfaces) pull far below the spacing on the surfaces. nullptr = none.
+  const float* point_spacing = nullptr;
+  /// Optional: a test cheaper than a hemicube (the baker: a few rays) of a seed before its
+  /// hemicube; true = the point is surely inside geometry: no hemicube, the point is invalid (as an
+  /// invalid sample's own point, presuming nothing around it). Called from the workers with the
+  /// worker's index; must be deterministic and safe to call from different workers at once.
+  /// Used with cache_expert_options::pretest_inside. Empty = none.
+  std::function<bool(int worker, const glm::vec3& position, const glm::vec3& normal)> inside_test;
 };
 
 /// What one placement round of cache_irradiance did (cache_stats::round_details).
@@ -165,6 +216,28 @@ struct cache_stats {
   double placement_seconds = 0.0, render_seconds = 0.0, interpolation_seconds = 0.0;
   float min_radius = 0.0f, max_radius = 0.0f;  ///< the radii used (after automatic defaults)
   std::vector<cache_round_stats> round_details;  ///< per round, including those that rendered nothing (coverage only)
+  /// What limits the records' radii (docs/cache.md, "What limits the radii"): records by the last
+  /// limit that lowered their radius (cache_record::limit; index: radius_limit), and of them those
+  /// whose final radius is their smallest allowed radius (raised to it, or clamped down to it).
+  std::array<std::size_t, radius_limit_count> records_by_limit{};
+  std::array<std::size_t, radius_limit_count> records_at_min_radius_by_limit{};
+  std::size_t records_at_min_radius = 0;  ///< the sum of records_at_min_radius_by_limit
+  /// Of the neighbour clamps (R_i <= R_j + d) that lowered a radius, those by a record whose
+  /// normal differs (n_i . n_j <= 0.9).
+  std::size_t neighbour_clamps = 0, neighbour_clamps_across_normals = 0;
+  /// Medians over the records of the final radius and of the split-sphere (harmonic mean) distance.
+  float median_radius = 0.0f, median_harmonic_distance = 0.0f;
+  /// Hemicubes by why their point was open when it became a seed (index: open_reason); sums to hemicubes.
+  std::array<std::size_t, open_reason_count> hemicubes_by_reason{};
+  /// Of invalid_points: the invalid samples' own points, the points presumed inside by an invalid
+  /// sample nearby (no hemicube), and those cache_run::known_inside gave.
+  std::size_t presumed_inside_points = 0, known_inside_points = 0;
+  /// Invalid samples by how much of their hemicube saw back faces: at most half (at the rim of a
+  /// solid, or where a thin part passes through), more than half (deep inside).
+  std::size_t invalid_samples_partly = 0, invalid_samples_deep = 0;
+  /// Seeds given to cache_run::inside_test, and of them those it called inside (no hemicube; they
+  /// count in invalid_points, not in hemicubes or invalid_samples).
+  std::size_t inside_tests = 0, inside_by_test = 0;
   /// Records visited per coverage query, over all rounds: bucket 0 counts queries that visited
   /// none, bucket k >= 1 those that visited [2^(k-1), 2^k) records, the last bucket everything above.
   static constexpr std::size_t histogram_buckets = 16;

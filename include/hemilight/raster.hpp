@@ -2,71 +2,25 @@
 //
 // hemicube_rasterizer::render() draws the five faces of the hemicube of geometry.hpp at a point
 // with a frame into a hemicube_buffer (hemicube.hpp): per texel the outgoing radiance seen through
-// the texel centre, the Euclidean distance to it along the texel's centre direction, and flags.
+// the texel centre, the Euclidean distance to it along the centre's direction, and flags.
 //
-// Pipeline (per hemicube, all in the point's local frame, normal = +z):
-//   1. Culling: the scene's BVH is traversed once; a node is dropped when it lies entirely below
-//      the tangent plane (z <= 0), outside all five face frusta, or (small, far nodes) between
-//      the texel centres of every face it touches; each surviving node keeps the mask of faces
-//      it can touch. Each triangle is moved to the local frame once. The culling is
-//      conservative: it never changes a rendered texel. There is no occlusion culling: the cost
-//      follows the triangles above the tangent plane that are not too small to matter at N.
-//   2. Visibility, per face: homogeneous clipping against the near plane w >= near (w is the
-//      distance along the face's forward axis) and a guard band |u|, |v| <= 1000 w; projection;
-//      snapping to fixed point with 8 sub-texel bits; 64-bit integer edge functions with a
-//      tie-breaking rule (an edge owns the texel centres exactly on it iff it runs upwards, or
-//      horizontally towards -x): triangles sharing an edge leave no gap and cover no texel twice.
-//      Depth is 1/w, exact for the triangle's 3D plane (not interpolated from clipped vertices),
-//      resolved per texel (nearest wins; equal depths keep the first triangle drawn).
-//      Side faces only rasterize their rows (the z >= 0 half).
-//   3. Resolve, per texel: the texel-centre ray is intersected with the plane of the triangle
-//      that won, giving the Euclidean distance (not the projected depth) and, for a radiance
-//      texture, perspective-correct UVs. Front faces (and two-sided triangles from either side)
-//      give the texture's bilinear value at that UV, or the triangle's emission, and flag
-//      texel_hit_front (0); one-sided triangles seen from behind occlude but give radiance 0 and
-//      texel_back_face; texels that see nothing give the sky's radiance, +inf and texel_miss.
-//      The distance is |D| / (1/w) with D = a + u c + v r the texel centre's direction on the
-//      face and 1/w the triangle's plane evaluated there: the ray-plane intersection, accurate
-//      to ~1e-6 relative except at grazing incidence (|cos| < 1e-3), where it degrades like
-//      1e-7 / |cos|. A texel covered by a triangle seen almost exactly edge-on can get a huge
-//      (up to ~1e38) but finite distance; it is still flagged as a hit.
-//
-// Precision. Clip-space vertices are finite floats; after guard-band clipping every projected
-// coordinate is within 1001 N/2 texels of the face, i.e. |X| < 1001 * 2048 * 256 < 2^29 in
-// fixed point (computed in double, so still 1/256 texel) for every valid N, so edge-function
-// terms stay below 2^60 and are exact in 64-bit integers. Watertightness (every texel centre inside a closed mesh around the point
-// is covered exactly once) therefore holds for every N <= 4096 and every finite geometry, as long
-// as the geometry is further than the near distance from the point along each face's axis.
-// Clipped vertices on a shared edge are computed from the edge's endpoints in a canonical order,
-// so two triangles sharing an edge clip it to bit-identical points. Texel centres closer than
-// 1/512 texel to an edge are decided by the snapped (not the exact) edge.
-//
-// Near plane: geometry with w < near on a face is clipped away, i.e. everything inside the cube
-// of half-size `near` around the point is invisible. Default: 1e-4 times the scene's bounding-box
-// diagonal (1e-4 scene units for an empty or single-point scene): far below any geometric detail,
-// far above float noise of the local coordinates for scenes not more than ~100 sizes from the
-// origin. A point lying on a surface does not see that surface (it is at z = 0, no texel centre
-// is there).
-//
-// Threads: the scene is shared and immutable; a hemicube_rasterizer owns its scratch memory and is
-// used by one thread at a time. N threads = N rasterizers, no locks.
-//
-// SIMD. Two kernel sets, both bit-identical to the scalar reference path (tested):
-//   - AVX2 (picked at run time where the CPU has it; GCC/Clang on x86-64): each triangle is set
-//     up in vector registers (its three vertices and its normal moved to the local frame in one
-//     register per axis, the face tests, clip codes and the double-precision projection of the
-//     three vertices at once, the edge functions of small triangles in 32-bit lanes) with the
-//     same float and integer operations as the scalar path; triangles up to 120
-//     texels across are scanned over their box eight texels at a time with 32-bit edge values,
-//     the coverage mask going straight into the depth test; longer spans are depth-tested eight
-//     texels at a time; the resolve writes runs of texels that see the same shade (found through
-//     a per-render shade key, so the two triangles of a quad make one run) as broadcast stores.
-//     Where the CPU has AVX-512 (F, VL, BW, DQ) the set-up runs as an AVX-512 build of the same
-//     code (32 registers; raster_options::diagnostics.avx512).
-//   - SSE2 (every x86-64): the same for triangles up to 32 texels across, four texels at a time.
-// raster_options::diagnostics.simd = false selects the scalar reference path;
-// raster_options::diagnostics.avx2 = false keeps the SSE2 kernels on an AVX2 machine. (The culling outcodes use SSE2 unconditionally: the
-// same exact float comparisons, four per instruction.) Other targets use the scalar path.
+// Contract (docs/raster.md, "How a render works", has the pipeline and the precision argument):
+//   - Point sampling at texel centres, watertight: inside a closed mesh further than the near
+//     distance from the point, every texel centre is covered exactly once, for every N up to
+//     hemicube_max_resolution and every finite geometry. Equal depths keep the triangle the
+//     reference order (the scene's BVH, depth first) draws first.
+//   - Depth is 1/w of the triangle's plane at the texel centre; the distance is the ray-plane
+//     intersection along the centre's direction (~1e-6 relative; at grazing incidence |cos| <
+//     1e-3 it degrades like 1e-7 / |cos| and may be huge but finite).
+//   - Front faces (and two-sided triangles) give their emission or the radiance texture at the
+//     perspective-correct lightmap UV (texel_hit_front); one-sided triangles seen from behind
+//     occlude with radiance 0 (texel_back_face); texels that see nothing give the sky (+inf,
+//     texel_miss). Only the z >= 0 half of the side faces is drawn.
+//   - Near plane: everything within `near` of the point along a face's axis is invisible (default
+//     1e-4 of the scene's diagonal). A point on a surface does not see that surface.
+//   - Deterministic: every buffer is bitwise the same on every code path (scalar, SSE2, AVX2,
+//     AVX-512) and with or without occlusion culling, whatever the order of renders.
+//   - Threads: the scene is shared and immutable; a rasterizer is used by one thread at a time.
 #pragma once
 
 #include "hemilight/geometry.hpp"
@@ -124,35 +78,34 @@ struct raster_options {
   /// constructor throws error(invalid_argument) for an empty or inconsistent map.
   std::shared_ptr<const cubemap> sky = nullptr;
   /// Exact edge coverage (docs/raster.md, "Exact edge coverage"): a texel that a hard edge (a
-  /// mesh boundary, a change of material, a silhouette) may cross gets, from each triangle that
-  /// covers it in part, the exact area of the (projected, clipped) triangle within the texel as a
-  /// fraction of the texel, not the all-or-nothing sample at its centre; the triangles sharing a
-  /// texel are resolved front to back (each takes the smaller of its coverage and what is left;
-  /// the sky, or the triangle that covers the whole texel behind them, the rest), and the
-  /// texel's radiance is the blend. Every other texel (inside a triangle, or crossed only by
-  /// edges between triangles of one material facing the same way) is as without it. flags and
-  /// seen_triangle() keep their meaning (what the texel centre sees: bit-identical to a render
-  /// without the option); a blended texel's distance is to the plane of the nearest triangle
-  /// with a share of it (along the centre's direction), which is the centre's distance unless a
-  /// nearer triangle covers part of the texel. Deterministic bit for bit, the same on every SIMD
-  /// path. Cost at N = 64 (render + integration): 1.7x on tessellated rooms, 6x on the Cornell
-  /// box (material changes all around), 28x on a terrain seen from its own surface
-  /// (docs/raster.md); bind() sorts the scene's edges (O(E log E)). Off by default.
+  /// mesh boundary, a change of material, a silhouette) may cross gets the blend of the exact
+  /// covered fractions of the triangles in it, resolved front to back (the rest: the sky, or the
+  /// triangle behind them that covers it whole); every other texel is as without it. flags and
+  /// seen_triangle() keep their meaning (what the texel centre sees); a blended texel's distance
+  /// is to the plane of the nearest triangle with a share of it. Deterministic bit for bit on
+  /// every path. Cost: several times a render (docs/raster.md); bind() sorts the scene's edges
+  /// (O(E log E)). Off by default.
   bool edge_coverage = false;
+  /// Level of detail: a BVH node whose box spans under lod_texels hemicube texels (seen from
+  /// more than twice its half diagonal) is drawn from a simplified proxy of its triangles
+  /// (meshoptimizer, built once per scene on the first bind that asks for it) instead of its
+  /// triangles: far clusters cost a few triangles. It changes the buffers (docs/raster.md, "Level
+  /// of detail", measures the error against N and the threshold); 0 = exact, the default. Range
+  /// [0, 16]; ignored with edge_coverage.
+  float lod_texels = 0.0f;
 
   /// Diagnostic switches, for comparisons and tests only (not for tuning): every setting gives
   /// bit-identical buffers (tested), only the speed differs. The defaults pick the fastest kernels
   /// the CPU has; an engine leaves them alone.
   struct diagnostic_switches {
-    /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it; see the top of
-    /// this header). false selects the scalar reference path.
+    /// Use the SIMD kernels (SSE2 on every x86-64, AVX2 where the CPU has it). false selects the
+    /// scalar reference path.
     bool simd = true;
     /// With simd: use the AVX2 kernels (eight texels per step) where the CPU has AVX2 (checked
     /// at run time); false keeps the SSE2 ones, e.g. to test them on an AVX2 machine.
     bool avx2 = true;
-    /// With avx2: run the eight-lane set-up (the bulk of a render) as its AVX-512 build where the
-    /// CPU has AVX-512 F, VL, BW and DQ (checked at run time): the same 256-bit code with 32
-    /// registers, 5-10% faster on AMD Zen 5. false keeps the AVX2 build.
+    /// With avx2: run the eight-lane set-up as its AVX-512 build where the CPU has AVX-512 F, VL,
+    /// BW and DQ (checked at run time). false keeps the AVX2 build.
     bool avx512 = true;
     /// Occlusion culling: BVH nodes wholly behind what is already drawn are skipped (without edge
     /// coverage). false draws everything in view, the reference the culling is tested against.
@@ -190,6 +143,7 @@ struct raster_statistics {
   std::size_t triangles_occluded = 0;  ///< occlusion culling: the triangles below those nodes
   std::size_t face_triangles_occluded = 0;  ///< occlusion culling: big (triangle, face) pairs found hidden before their spans
   std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
+  std::size_t lod_nodes = 0;           ///< level of detail: nodes drawn from their proxies
 };
 
 namespace raster_detail {
@@ -199,11 +153,11 @@ class rasterizer_impl;  // src/raster/internal.hpp
 /// A per-thread hemicube renderer over a shared scene (see the top of this header).
 ///
 /// Memory: about 8 bytes per texel of scratch (visibility buffers) plus 16 bytes per texel of
-/// direction tables, plus 8 bytes per triangle drawn (~70 with a texture) and 16 bytes per distinct
-/// emission of the scene; kept between renders and grown on demand. With edge coverage, 16 bytes
-/// per scene edge that may be hard and per crease triangle, 12 more bytes per texel and 32 per
-/// partial (triangle, texel) fragment (~1,000 per hemicube of the Cornell box at N = 64, under
-/// 100 in tessellated rooms).
+/// direction tables, plus 8 bytes per triangle drawn (~70 with a texture), 16 bytes per distinct
+/// emission of the scene and 4 per BVH node; kept between renders and grown on demand. With
+/// occlusion culling, 4 more bytes per texel and 5 per tile of 8 x 8 texels. With edge coverage,
+/// 16 bytes per scene edge that may be hard and per crease triangle, 12 more bytes per texel and
+/// 32 per partial (triangle, texel) fragment.
 /// The state lives in a cache-line aligned block of its own (rasterizers of different threads
 /// kept side by side, e.g. a std::vector of them, share no line of it).
 class hemicube_rasterizer {
@@ -235,11 +189,11 @@ class hemicube_rasterizer {
   /// Errors (error(invalid_argument), `out` untouched): a non-finite position; a basis that is not
   /// orthonormal and right-handed to within 1e-3 (each length within 1e-3 of 1, pairwise dots
   /// below 1e-3, (t x b) . n > 0); N odd or outside [2, 4096]; an invalid texture.
-  /// Cost: O(visible BVH nodes + triangles above the tangent plane + covered texels + 3 N^2);
-  /// Cornell box at N = 64: about 25 us on one core of a 2020s server (AVX2); a closed room of
-  /// 1,000 small triangles, all in view: about 65 us (the cost is per triangle). With
+  /// Cost: O(BVH nodes visited + triangles drawn + covered texels + 3 N^2): the triangles drawn
+  /// are those above the tangent plane, not too small to matter at N, and (with occlusion
+  /// culling) not hidden behind nearer ones; docs/raster.md has the measured figures. With
   /// raster_options::edge_coverage add O(hard edges + the hard texels of the triangles touching
-  /// them): 1.5-15x in all at N = 64 (see the option).
+  /// them).
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture = nullptr);
 
@@ -251,8 +205,10 @@ class hemicube_rasterizer {
                        std::vector<std::uint32_t>& counts);
 
   /// After render(): the scene triangle (scene_desc numbering) seen through a texel, or
-  /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). A debugging and
-  /// testing aid; the buffer itself does not carry triangle numbers.
+  /// no_triangle for a miss (after render_coverage(): no_triangle everywhere). Where triangles of
+  /// one shade meet at exactly the same depth (coplanar overlaps) and occlusion culling drew the
+  /// render, it may name another of them than the reference order's first (the buffer is the same
+  /// either way). A debugging and testing aid; the buffer itself does not carry triangle numbers.
   /// Precondition: texel < 3 N^2 of the last render, and not moved from since (asserted).
   std::uint32_t seen_triangle(std::size_t texel) const noexcept;
 

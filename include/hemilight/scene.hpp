@@ -31,8 +31,8 @@
 namespace hemilight {
 
 namespace detail {
-struct lazy_slot;   // data derived from the scene on first use: rays.hpp's Embree scene (src/scene/scene_access.hpp)
-struct ray_access;
+struct lazy_slot;   // data derived from the scene on first use by the modules above it (src/scene/scene_access.hpp)
+struct derived_access;
 struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene/scene_access.hpp)
 }  // namespace detail
 
@@ -207,8 +207,8 @@ class scene {
   friend struct detail::scene_access;
   std::vector<bvh_node> nodes_;
   // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
-  friend struct detail::ray_access;
-  std::shared_ptr<detail::lazy_slot> rays_;
+  friend struct detail::derived_access;
+  std::shared_ptr<detail::lazy_slot> derived_[3];
 };
 
 }  // namespace hemilight

@@ -49,6 +49,7 @@ sample_points place_samples(const sparse_samples& s, const scene& sc, const bake
     out.owner.push_back(s.owner[n]);
     out.tangents.push_back(s.tangent[n]);
     out.bitangents.push_back(s.bitangent[n]);
+    out.spacing.push_back(s.texel_world_size[n] > 0.0f && std::isfinite(s.texel_world_size[n]) ? s.texel_world_size[n] : offset);
   }
   r.stats.sampled_texels = out.texel_of.size();
   if (out.texel_of.empty())
@@ -131,6 +132,39 @@ image pass_radiance_texture(const scene& sc, const sample_points& pts, const std
   for (const auto& g : layout.guards)
     std::memcpy(texture.pixels.data() + 3 * g.first, texture.pixels.data() + 3 * g.second, 3 * sizeof(float));
   return texture;
+}
+
+// The cache's cheap inside test of its seeds (cache_run::inside_test): rays in 16 fixed directions
+// spread evenly over the projected solid angle of the point's hemisphere (a golden-angle spiral);
+// the point is inside when 8 or more of them hit back faces (the hemicube's backface fraction,
+// estimated: a point seeing at most invalid_backface_fraction = 10% of back faces has about one
+// chance in 10^4 to be called inside); it stops as soon as the answer is known.
+std::function<bool(int, const glm::vec3&, const glm::vec3&)> rays_inside_test(const std::shared_ptr<const scene>& sc) {
+  constexpr int rays = 16, needed = 8;
+  std::array<glm::vec3, rays> local;
+  for (int k = 0; k < rays; ++k) {
+    const float u = (float(k) + 0.5f) / float(rays), r = std::sqrt(u), phi = 2.39996323f * float(k);
+    local[std::size_t(k)] = glm::vec3(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u)));
+  }
+  prepare_rays(*sc);
+  const float t_max = 4.0f * std::max(sc->size(), 1e-6f);
+  // The rays start at the hemicube's near distance, which hides nearer geometry from hemicubes.
+  const float near = default_near_distance(*sc);
+  return [sc, local, t_max, near](int, const glm::vec3& p, const glm::vec3& n) {
+    const frame f = make_frame(n);
+    int back = 0, other = 0;
+    for (const glm::vec3& l : local) {
+      ray_hit hit;
+      const glm::vec3 d = f.to_world(l);
+      if (intersect(*sc, p + near * d, d, t_max, hit) && !hit.front_face)
+        ++back;
+      else
+        ++other;
+      if (back >= needed) return true;
+      if (other > rays - needed) return false;
+    }
+    return false;
+  };
 }
 
 // One pass through the cache (bake_options::use_cache).
@@ -265,6 +299,8 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   const bool directional = o.output_sh_l1 || o.output_hl2;
   cache_run run;
   run.thread_count = o.thread_count;
+  run.point_spacing = pts.spacing.data();
+  if (o.use_cache) run.inside_test = rays_inside_test(sc);
   bounce_values out;
   out.valid.assign(count, 1);
   std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass

@@ -27,6 +27,7 @@ struct sample_points {
   std::vector<glm::vec3> positions, normals;
   std::vector<std::uint32_t> owner;      // the texel's owner triangle (its material)
   std::vector<glm::vec3> tangents, bitangents;  // the texel's lightmap tangent frame (with normals)
+  std::vector<float> spacing;            // the texel's world size (the cache's cache_run::point_spacing)
 };
 
 // A 2 x 2 block of texels of a scene bake's atlas that holds the radiance of the occluder-only

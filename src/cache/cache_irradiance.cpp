@@ -33,6 +33,9 @@ constexpr double candidates_per_spacing = 3.0;
 // their memory (docs/cache.md: the time and memory of both).
 constexpr std::size_t max_listed_points = 1024;
 constexpr std::size_t list_entries_per_point = 8;
+// render_seeds marks a seed that cache_run::inside_test called inside with this backface
+// fraction (no hemicube; a sampler never returns more than 1).
+constexpr float tested_inside = 2.0f;
 
 // A seed of pick_seeds: where it is and its normal.
 struct seed {
@@ -214,6 +217,11 @@ class placement {
     const auto t_final = std::chrono::steady_clock::now();
     interpolate_all(result);
     stats_.invalid_points = count_invalid(result);
+    for (std::size_t i = 0; i < count_; ++i) {
+      stats_.presumed_inside_points += presumed_[i] && !own_invalid_[i] ? 1u : 0u;
+      stats_.known_inside_points += r_.known_inside && r_.known_inside[i] ? 1u : 0u;
+    }
+    count_limits();
     if (r_.fill_invalid) fill_invalid(result);
     stats_.interpolation_seconds = seconds_since(t_final);
     for (const cache_round_stats& r : stats_.round_details) stats_.render_seconds += r.render_seconds;
@@ -257,6 +265,11 @@ class placement {
     hi_ = hi;
     diagonal_ = glm::length(hi - lo);
     const float a = o_.error_threshold;
+    if (o_.min_radius == 0.0f && r_.point_spacing) {
+      std::vector<float> given(r_.point_spacing, r_.point_spacing + count_);
+      std::nth_element(given.begin(), given.begin() + std::ptrdiff_t(count_ / 2), given.end());
+      o_.min_radius = std::max(o_.min_radius_spacings, 1.0f / a) * given[count_ / 2];
+    }
     if (o_.min_radius == 0.0f) {
       const float spacing = median_spacing(p_, count_, diagonal_, grid_of_points_);
       o_.min_radius = spacing > 0.0f ? spacing / a : std::max(diagonal_, 1e-3f) * 1e-3f;
@@ -277,7 +290,7 @@ class placement {
     list_budget_ = list_entries_per_point * count_;
     large_tree_.build(records_, o_, 1, &large_records_);
     record_cells_.reset(lo_, hi_, std::max(nearby_reach_, finest_), count_);
-    for (auto* v : {&covered_, &own_invalid_, &presumed_}) v->assign(count_, 0);
+    for (auto* v : {&covered_, &own_invalid_, &presumed_, &open_reason_}) v->assign(count_, 0);
     // Points the caller knows to be inside geometry (cache_options::known_inside) are invalid
     // from the start, as if their own sample had been: no hemicube, no coverage test.
     if (r_.known_inside)
@@ -321,7 +334,7 @@ class placement {
 
   // 1. Coverage of every candidate point whose answer can have changed (parallel, read-only on
   // the records): the dirty points (all of them at first; then those in the reach of a record
-  // added or shrunk since they were last checked, within nearby_opinion's reach of a new record,
+  // added or shrunk since they were last checked, within expert.lone_record_neighbour_reach's reach of a new record,
   // or newly presumed inside). Every other point, open or covered, sees the same records with the
   // same radii as when it was last checked, and its opinions come from the same records, so its
   // answer stands. Dirty points that are not yet candidates stay dirty until they are (at the
@@ -429,21 +442,34 @@ class placement {
     const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
     visited = detail.visited;
     bool ok = w > 0.0f;
-    if (ok && o_.expert.refine_where_records_disagree && !own) ok = spread <= a * std::max(luminance(value), floor_e_);
+    open_reason why = open_reason::uncovered;
+    if (ok && o_.expert.refine_where_records_disagree && !own) {
+      ok = spread <= a * std::max(luminance(value), floor_e_);
+      why = open_reason::records_disagree;
+    }
     // Second opinion: a point that only one record covers is not covered while that record's
-    // first-order term there exceeds second_opinion x a x max(E_i, floor): no other record can
+    // first-order term there exceeds expert.lone_record_change_limit x a x max(E_i, floor): no other record can
     // disagree with an extrapolation that may be wrong (an edge between two rows of points, a
     // second derivative the gradient does not see).
-    if (ok && o_.expert.lone_record_change_limit > 0.0f && !own && detail.records == 1) ok = detail.first_order <= o_.expert.lone_record_change_limit * a;
-    // Sole record reach: a point that one record covers must lie inside sole_record_reach of
-    // that record's reach (Ward: weight >= 1 / (sole_record_reach x a)), not on its rim.
-    if (ok && o_.expert.lone_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward)
+    if (ok && o_.expert.lone_record_change_limit > 0.0f && !own && detail.records == 1) {
+      ok = detail.first_order <= o_.expert.lone_record_change_limit * a;
+      why = open_reason::lone_change;
+    }
+    // Sole record reach: a point that one record covers must lie inside expert.lone_record_reach of
+    // that record's reach (Ward: weight >= 1 / (expert.lone_record_reach x a)), not on its rim.
+    if (ok && o_.expert.lone_record_reach < 1.0f && !own && detail.records == 1 && coverage_options_.weight == cache_weight::ward) {
       ok = detail.max_weight >= 1.0f / (o_.expert.lone_record_reach * a);
+      why = open_reason::lone_reach;
+    }
     // Nearby opinion: records near a point that one record covers, which do not cover it
     // themselves, must predict the same there within a (a hard shadow edge between two rows of
     // points is invisible to the covering record's gradient, not to a record beyond it).
-    if (ok && o_.expert.lone_record_neighbour_reach > 0.0f && !own && detail.records == 1) ok = nearby_records_agree(i, detail);
+    if (ok && o_.expert.lone_record_neighbour_reach > 0.0f && !own && detail.records == 1) {
+      ok = nearby_records_agree(i, detail);
+      why = open_reason::nearby_disagrees;
+    }
     covered_[i] = ok ? 1 : 0;
+    open_reason_[i] = static_cast<std::uint8_t>(why);
   }
 
   bool nearby_records_agree(std::size_t i, const coverage_detail& detail) const {
@@ -468,7 +494,7 @@ class placement {
   std::vector<std::size_t> pick_seeds() {
     std::vector<std::size_t> seeds;
     const bool finest = !(spacing_ > finest_);
-    if (finest) {
+    if (finest && !o_.expert.space_finest_seeds) {
       seeds.assign(open_list_.begin(), open_list_.begin() + std::ptrdiff_t(open_candidates()));
       return seeds;
     }
@@ -503,9 +529,17 @@ class placement {
     std::atomic<bool> cancel{false};
     std::atomic<std::size_t> done{0};
     const float covered_fraction = 1.0f - float(open_points) / float(count_);
+    const bool pretest = r_.inside_test && o_.expert.pretest_inside;
+    std::atomic<std::size_t> inside{0};
     parallel_for(seeds.size(), threads_, 1, [&](int worker, std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e && !cancel; ++k) {
-        samples[k] = sampler_(worker, p_[seeds[k]], n_[seeds[k]]);
+        if (pretest && r_.inside_test(worker, p_[seeds[k]], n_[seeds[k]])) {
+          samples[k].backface_fraction = tested_inside;  // no hemicube (append_records)
+          samples[k].min_distance = 0.0f;
+          ++inside;
+        } else {
+          samples[k] = sampler_(worker, p_[seeds[k]], n_[seeds[k]]);
+        }
         const std::size_t finished = ++done;
         // Worker 0 is the calling thread: the only one that calls progress.
         if (worker == 0 && r_.progress) {
@@ -515,7 +549,11 @@ class placement {
       }
     });
     if (cancel) throw error(status::cancelled, "cache_irradiance: cancelled by the progress callback");
-    stats_.hemicubes += seeds.size();
+    stats_.hemicubes += seeds.size() - inside;
+    if (pretest) {
+      stats_.inside_tests += seeds.size();
+      stats_.inside_by_test += inside;
+    }
     return samples;
   }
 
@@ -542,8 +580,14 @@ class placement {
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const std::size_t i = seeds[k];
       const sampler_result& s = samples[k];
+      if (s.backface_fraction == tested_inside) {  // cache_run::inside_test: no hemicube
+        own_invalid_[i] = 1;
+        continue;
+      }
+      ++stats_.hemicubes_by_reason[open_reason_[i]];
       if (s.backface_fraction > o_.invalid_backface_fraction) {
         ++stats_.invalid_samples;
+        ++(s.backface_fraction > 0.5f ? stats_.invalid_samples_deep : stats_.invalid_samples_partly);
         ++round.invalid_samples;
         own_invalid_[i] = 1;
         for (std::uint32_t j : presumed[k]) presumed_[j] = 1;  // final: never tested or seeded again
@@ -573,17 +617,24 @@ class placement {
       r.cone = s.cone;
     }
     float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o_.max_radius;
+    r.limit = std::isfinite(s.harmonic_mean_distance) ? radius_limit::split_sphere : radius_limit::max_radius;
     if (o_.expert.limit_radius_by_gradient) {
       const float gt = glm::length(0.2126f * s.translation_gradient[0] + 0.7152f * s.translation_gradient[1] +
                                    0.0722f * s.translation_gradient[2]);
       const float e = luminance(s.irradiance);
-      if (gt > 0.0f && e > 0.0f) radius = std::min(radius, e / gt);
+      if (gt > 0.0f && e > 0.0f && e / gt < radius) {
+        radius = e / gt;
+        r.limit = radius_limit::gradient;
+      }
     }
     // A record that saw back faces stands at a contact (where parts meet or intersect): its
     // reach stops short of the nearest geometry its hemicube saw, so it never covers points
     // across the contact (the ball of radius min_distance around it holds no geometry).
-    if (s.backface_fraction > contact_backface_ && std::isfinite(s.min_distance) && s.min_distance > 0.0f)
-      radius = std::min(radius, s.min_distance);
+    if (s.backface_fraction > contact_backface_ && std::isfinite(s.min_distance) && s.min_distance > 0.0f && s.min_distance < radius) {
+      radius = s.min_distance;
+      r.limit = radius_limit::contact;
+    }
+    if (radius > o_.max_radius) r.limit = radius_limit::max_radius;
     r.radius = std::clamp(radius, o_.min_radius, o_.max_radius);
     return r;
   }
@@ -627,6 +678,7 @@ class placement {
   struct neighbour_pair {
     std::uint32_t j;
     bool disagree;
+    bool similar;  // n_i . n_j > 0.9
     float d;
   };
 
@@ -654,7 +706,8 @@ class placement {
           if (std::size_t(key.index) == i) return;
           const float d = glm::length(mi.position - key.position);
           const bool moot = o_.expert.limit_radius_by_neighbours && ri + d <= 0.99f * (0.4f * d / a);
-          near.push_back({key.index, shrink && !moot && d > 0.0f && glm::dot(mi.normal, key.normal) > 0.9f, d});
+          const bool similar = glm::dot(mi.normal, key.normal) > 0.9f;
+          near.push_back({key.index, shrink && !moot && d > 0.0f && similar, similar, d});
         });
         std::sort(near.begin(), near.end(), [](const neighbour_pair& x, const neighbour_pair& y) { return x.j < y.j; });
         for (neighbour_pair& q : near) {
@@ -687,18 +740,55 @@ class placement {
       for (const neighbour_pair& q : candidates[i - first_new]) {
         float& rj = radius_[q.j];
         const float d = q.d;
-        if (o_.expert.limit_radius_by_neighbours) {
+        if (o_.expert.limit_radius_by_neighbours && (q.similar || o_.expert.clamp_across_normals)) {
+          if (rj + d < ri) note_clamp(i, q.j);
           ri = std::max(o_.min_radius, std::min(ri, rj + d));
-          if (clamp_older || q.j >= first_new) rj = std::max(o_.min_radius, std::min(rj, ri + d));
+          if (clamp_older || q.j >= first_new) {
+            if (ri + d < rj) note_clamp(q.j, std::uint32_t(i));
+            rj = std::max(o_.min_radius, std::min(rj, ri + d));
+          }
         }
         if (q.disagree) {
           // Shrink so that their coverage (a R each) leaves a gap between them: 0.4 d each.
           const float r_gap = std::max(o_.min_radius, 0.4f * d / a);
+          if (0.4f * d / a < ri) records_[i].limit = radius_limit::disagreement;
+          if (0.4f * d / a < rj) records_[q.j].limit = radius_limit::disagreement;
           ri = std::min(ri, r_gap);
           rj = std::min(rj, r_gap);
         }
       }
     }
+  }
+
+  // Record `lowered` was clamped by record `by` (clamp_radii): the limit and the counters.
+  void note_clamp(std::size_t lowered, std::uint32_t by) {
+    records_[lowered].limit = radius_limit::neighbour;
+    ++stats_.neighbour_clamps;
+    if (!(glm::dot(models_[lowered].normal, models_[by].normal) > 0.9f)) ++stats_.neighbour_clamps_across_normals;
+  }
+
+  // What limits the radii (cache_stats::records_by_limit and the rest), from the final records.
+  void count_limits() {
+    std::vector<float> radius, harmonic;
+    radius.reserve(records_.size());
+    harmonic.reserve(records_.size());
+    for (const cache_record& r : records_) {
+      const std::size_t k = static_cast<std::size_t>(r.limit);
+      ++stats_.records_by_limit[k];
+      if (r.radius <= o_.min_radius) {
+        ++stats_.records_at_min_radius_by_limit[k];
+        ++stats_.records_at_min_radius;
+      }
+      radius.push_back(r.radius);
+      harmonic.push_back(r.harmonic_distance);
+    }
+    const auto median = [](std::vector<float>& v) {
+      if (v.empty()) return 0.0f;
+      std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+      return v[v.size() / 2];
+    };
+    stats_.median_radius = median(radius);
+    stats_.median_harmonic_distance = median(harmonic);
   }
 
   // 6. Points whose coverage this round's records can have changed are re-checked in the next
@@ -715,7 +805,7 @@ class placement {
   float reach_of(std::size_t j) const { return o_.error_threshold * radius_of(j) * 1.0001f; }
 
   // 6a. The changed points (in a new record's sphere, or in the old sphere of a shrunk one, which
-  // holds its new one, or within nearby_opinion's reach of a new record) become dirty. Each
+  // holds its new one, or within expert.lone_record_neighbour_reach's reach of a new record) become dirty. Each
   // worker marks its own flags and lists what it marked (merged into dirty_list_ after: which
   // points are dirty does not depend on which worker marked what), and counts each new record's
   // points (listed_points_).
@@ -935,6 +1025,7 @@ class placement {
   std::vector<std::uint32_t> record_point_;  // per record: the point it was placed at
   point_grid grid_of_points_;
   std::vector<std::uint8_t> covered_, dirty_, own_invalid_, presumed_;
+  std::vector<std::uint8_t> open_reason_;  // per point: why its last coverage test left it open (open_reason)
   incremental_grid<seed> seed_cells_;  // pick_seeds: the round's seeds so far
   glm::vec3 lo_{0.0f}, hi_{0.0f};  // the points' bounding box
   std::size_t candidates_ = 0;                 // the round's candidates: points of rank below it
@@ -961,6 +1052,11 @@ cache_result cache_irradiance(const glm::vec3* positions, const glm::vec3* norma
   if (run.thread_count < 0)
     throw_invalid_argument("cache_irradiance: run.thread_count is " + std::to_string(run.thread_count) + "; it must be >= 0");
   if (!sampler) throw_invalid_argument("cache_irradiance: sampler is empty");
+  if (run.point_spacing)
+    for (std::size_t i = 0; i < count; ++i)
+      if (!(run.point_spacing[i] > 0.0f) || !std::isfinite(run.point_spacing[i]))
+        throw_invalid_argument("cache_irradiance: run.point_spacing[" + std::to_string(i) + "] is " +
+                               std::to_string(run.point_spacing[i]) + "; it must be finite and > 0");
   return placement(positions, normals, count, sampler, options, run).run();
 }
 

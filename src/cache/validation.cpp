@@ -21,6 +21,8 @@ void validate_cache_options(const cache_options& o, const std::string& who) {
   if (o.min_radius > 0.0f && o.max_radius > 0.0f && o.min_radius > o.max_radius)
     throw_invalid_argument(fn + "min_radius " + std::to_string(o.min_radius) + " is larger than max_radius " +
                            std::to_string(o.max_radius));
+  if (!(o.min_radius_spacings >= 1.0f && o.min_radius_spacings <= 1000.0f))
+    throw_invalid_argument(fn + "min_radius_spacings is " + std::to_string(o.min_radius_spacings) + "; it must be in [1, 1000]");
   const cache_expert_options& x = o.expert;
   if (!(x.lone_record_change_limit >= 0.0f) || !std::isfinite(x.lone_record_change_limit))
     throw_invalid_argument(fn + "expert.lone_record_change_limit is " + std::to_string(x.lone_record_change_limit) +

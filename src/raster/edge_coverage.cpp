@@ -3,6 +3,8 @@
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
 
+#include "../scene/scene_access.hpp"
+
 #include "hemilight/cubemap.hpp"
 
 #include <algorithm>
@@ -291,8 +293,14 @@ std::uint32_t bits_of(float f) noexcept {
 
 }  // namespace
 
-void raster_detail::rasterizer_impl::edge_find_candidates() {
-  const std::vector<scene::triangle>& tris = scene_->triangles();
+namespace {
+
+std::shared_ptr<edge_table> build_edge_table(const scene& s) {
+  constexpr std::uint32_t no_triangle = hemicube_rasterizer::no_triangle;
+  auto table = std::make_shared<edge_table>();
+  std::vector<edge_table::candidate>& candidates = table->candidates;
+  std::vector<glm::vec4>& planes = table->planes;
+  const std::vector<scene::triangle>& tris = s.triangles();
   // Step 1: every edge, keyed by its endpoints' bits in a canonical order.
   struct half_edge {
     std::uint32_t key[6];
@@ -331,16 +339,15 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
     return len > 0.0 ? nrm / len : glm::dvec3(0.0);
   };
   const auto same_material = [&](const scene::triangle& a, const scene::triangle& b) {
-    const material &ma = scene_->triangle_material(a.index), &mb = scene_->triangle_material(b.index);
+    const material &ma = s.triangle_material(a.index), &mb = s.triangle_material(b.index);
     return ma.emission == mb.emission && ma.albedo == mb.albedo && ma.two_sided == mb.two_sided;
   };
   std::vector<std::uint32_t> plane_of(tris.size(), no_triangle);
-  edge_planes_.clear();
   const auto plane_entry = [&](std::uint32_t i) {
     if (plane_of[i] == no_triangle) {
       const glm::dvec3 nrm = unit_normal(tris[i]);
-      plane_of[i] = static_cast<std::uint32_t>(edge_planes_.size());
-      edge_planes_.emplace_back(glm::vec3(nrm), static_cast<float>(glm::dot(nrm, glm::dvec3(tris[i].v0))));
+      plane_of[i] = static_cast<std::uint32_t>(planes.size());
+      planes.emplace_back(glm::vec3(nrm), static_cast<float>(glm::dot(nrm, glm::dvec3(tris[i].v0))));
     }
     return plane_of[i];
   };
@@ -348,7 +355,7 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
     std::size_t last = first + 1;
     while (last < edges.size() && std::equal(edges[first].key, edges[first].key + 6, edges[last].key)) ++last;
     const half_edge& a = edges[first];
-    edge_candidate c{a.triangle, a.k, no_triangle, no_triangle};
+    edge_table::candidate c{a.triangle, a.k, no_triangle, no_triangle};
     if (last - first == 2 && edges[first + 1].forward != a.forward) {
       const half_edge& b = edges[first + 1];
       const scene::triangle &ta = tris[a.triangle], &tb = tris[b.triangle];
@@ -363,10 +370,22 @@ void raster_detail::rasterizer_impl::edge_find_candidates() {
         c.plane_b = plane_entry(b.triangle);
       }
     }
-    edge_candidates_.push_back(c);
+    candidates.push_back(c);
     first = last;
   }
-  edge_facing_.assign(edge_planes_.size(), 0);
+  return table;
+}
+
+}  // namespace
+
+const raster_detail::edge_table& raster_detail::edge_table_of(const scene& s) {
+  detail::lazy_slot* slot = detail::derived_access::of(s, detail::derived_kind::raster_edges);
+  if (!slot->done.load(std::memory_order_acquire))
+    std::call_once(slot->once, [&] {
+      slot->value = build_edge_table(s);
+      slot->done.store(true, std::memory_order_release);
+    });
+  return *static_cast<const edge_table*>(slot->value.get());
 }
 
 // The slopes of each texel's weight density (edge_density_), once per resolution. The
@@ -399,15 +418,15 @@ void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, c
   // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
   const double px = position.x, py = position.y, pz = position.z;
   const double scale = std::fabs(px) + std::fabs(py) + std::fabs(pz);
-  for (std::size_t i = 0; i < edge_planes_.size(); ++i) {
-    const glm::vec4& q = edge_planes_[i];
+  for (std::size_t i = 0; i < edge_table_->planes.size(); ++i) {
+    const glm::vec4& q = edge_table_->planes[i];
     const double f = static_cast<double>(q.x) * px + static_cast<double>(q.y) * py + static_cast<double>(q.z) * pz -
                      static_cast<double>(q.w);
     const double band = 1e-5 * (scale + std::fabs(static_cast<double>(q.w)));
     edge_facing_[i] = static_cast<std::int8_t>(f > band ? 1 : (f < -band ? -1 : 0));
   }
   const std::vector<scene::triangle>& tris = scene_->triangles();
-  for (const edge_candidate& c : edge_candidates_) {
+  for (const edge_table::candidate& c : edge_table_->candidates) {
     bool silhouette = false;
     if (c.plane_a != no_triangle) {
       const std::int8_t fa = edge_facing_[c.plane_a], fb = edge_facing_[c.plane_b];

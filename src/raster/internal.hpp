@@ -76,6 +76,7 @@ struct draw_record {
   glm::vec3 grad_b1;     ///< barycentric b1 = grad_b1 . (q - v0)  (only with a texture)
   glm::vec3 grad_b2;     ///< barycentric b2 = grad_b2 . (q - v0)
   bool textured;         ///< UVs + texture: radiance comes from the texture
+  const std::uint32_t* vertices = nullptr;  ///< a LOD proxy's scene vertices (UVs); null: those of `index`
 };
 /// What the resolve pass copies to the texels of a draw: the sky, a back face, or the front of
 /// a triangle with one of the scene's emissions.
@@ -119,30 +120,52 @@ struct face_setup {
 
 struct simd_frame;  // the frame and position broadcast for the AVX2 set-up (kernels_avx2.hpp)
 
+// The edges of a scene that exact edge coverage may find hard in some view (edge_coverage.cpp):
+// mesh boundaries, material changes and creases (edges between two triangles of one material in
+// different planes, hard where one faces the point and the other not). Edges inside a plane of one
+// material are never hard and are left out. Built once per scene, kept with it.
+struct edge_table {
+  struct candidate {
+    std::uint32_t triangle;  // scene::triangles() position
+    std::uint32_t k;         // the edge: vertex k to vertex k + 1 (mod 3)
+    std::uint32_t plane_a;   // a crease's two triangles' entries in `planes`; no_triangle: always hard
+    std::uint32_t plane_b;
+  };
+  std::vector<candidate> candidates;
+  std::vector<glm::vec4> planes;  // unit normal, offset of the creases' triangles
+};
+
+// The edge table of `s`, built on the first call (thread-safe; O(T log T)).
+const edge_table& edge_table_of(const scene& s);
+
 // The texels where a fragment's depth equalled the depth already there (a tie, which the drawing
 // order decides), with that depth: occlusion culling's front-to-back pass checks after drawing
 // whether a tie still holds a texel's final depth. Ties are rare (coplanar overlapping triangles);
-// past `limit` entries only `overflow` is kept.
+// past `limit` entries (twice the hemicube's texels: set by the render) only `overflow` is kept.
 struct tie_log {
-  static constexpr std::size_t limit = 4096;
-  std::vector<std::pair<const float*, float>> at;
+  std::size_t limit = 0;
+  struct entry {
+    const float* depth;  // the texel's depth (in the rasterizer's depth buffer)
+    float z;             // the tied depth
+    std::uint32_t id;    // the texel id of the fragment that tied (and lost to the earlier one)
+  };
+  std::vector<entry> at;
   bool overflow = false;
   void clear() noexcept {
     at.clear();
     overflow = false;
   }
-  // Lanes `bits` of the group of texels at `depth` with depths `z` (a cold path).
-  __attribute__((noinline, cold)) void add(const float* depth, const float* z, unsigned bits) {
+  // Lanes `bits` of the group of texels at `depth` with depths `z`, all of draw `id` (a cold path).
+  __attribute__((noinline, cold)) void add(const float* depth, const float* z, std::uint32_t id, unsigned bits) {
     for (; bits; bits &= bits - 1) {
       const unsigned lane = static_cast<unsigned>(__builtin_ctz(bits));
       if (at.size() == limit) {
         overflow = true;
         return;
       }
-      at.emplace_back(depth + lane, z[lane]);
+      at.push_back({depth + lane, z[lane], id});
     }
   }
-  bool any() const noexcept { return overflow || !at.empty(); }
 };
 
 // The state and drawing code of a hemicube_rasterizer (raster.hpp): the public class holds one
@@ -174,7 +197,8 @@ class alignas(64) rasterizer_impl {
   template <mode M>
   void draw_all(const glm::vec3& position, const frame& basis);
   template <mode M>
-  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis);
+  void draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position, const frame& basis,
+                     const std::uint32_t* vertices = nullptr);
   template <mode M>
   void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
                    const scene::triangle& tri);
@@ -185,10 +209,10 @@ class alignas(64) rasterizer_impl {
                   const double* exact = nullptr);
   bool draw_hard_texels(int face, const fixed_triangle& t, face_setup& fs, draw_record& rec, std::uint32_t& draw,
                         const frame& basis, const scene::triangle& tri);
-  template <mode M>
+  template <mode M, bool log>
   void draw_leaf_avx2(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask, const simd_frame& sf,
                       const frame& basis);
-  template <mode M>  // the same, compiled for AVX-512 (leaf_avx.inl)
+  template <mode M, bool log>  // the same, compiled for AVX-512 (leaf_avx.inl)
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
@@ -204,20 +228,13 @@ class alignas(64) rasterizer_impl {
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
   // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
-  // silhouettes); only texels they may cross need exact coverage (edge.cpp, "Hard edges").
-  struct edge_candidate {
-    std::uint32_t triangle;   // scene_->triangles() position
-    std::uint32_t k;          // the edge: vertex k to vertex k + 1 (mod 3)
-    std::uint32_t plane_a;    // the two triangles' entries in edge_planes_ (a crease: hard where
-    std::uint32_t plane_b;    // one faces the point and the other not); no_triangle: always hard
-  };
-  void edge_find_candidates();
+  // silhouettes); only texels they may cross need exact coverage (edge_coverage.cpp, "Hard
+  // edges"). The scene's candidates are in edge_table_ (built once per scene).
   void edge_mark_hard(const glm::vec3& position, const frame& basis);
   void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
   bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
-  std::vector<edge_candidate> edge_candidates_;
-  std::vector<glm::vec4> edge_planes_;        // unit normal, offset of the creases' triangles
-  std::vector<std::int8_t> edge_facing_;      // per edge_planes_ entry in this view: +1, -1, 0 (edge-on)
+  const edge_table* edge_table_ = nullptr;    // the scene's edges that may be hard (with edge_)
+  std::vector<std::int8_t> edge_facing_;      // per edge_table_->planes entry in this view: +1, -1, 0 (edge-on)
   // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
   // a hard edge may cross texel c (words_per_row_ words a row).
   std::vector<std::uint64_t> hard_bits_;
@@ -260,18 +277,33 @@ class alignas(64) rasterizer_impl {
     std::int32_t x0[5], x1[5], y0[5], y1[5];  // per face, the texels whose centres the node may cover
   };
   void occlusion_prepare();
+  // The faces of `mask` on which the node (or a leaf's group) may cover a texel centre not hidden
+  // by the occluders; their texel rectangles go to `rects`. Hidden on all of them: counted in
+  // stats_ with its `triangles`.
   unsigned occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis,
-                          node_rects& rects);
+                          node_rects& rects, std::uint32_t triangles);
   void occlusion_drawn(unsigned mask, const node_rects& rects);
   void occlusion_freeze();
   bool hidden_in_tile(int face, int tx, int ty, int x0, int x1, int y0, int y1, float nearest);
   bool rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest);
   bool plane_hidden(int face, const texel_box& box, const face_setup& fs);  // a triangle's box, its plane
+  bool triangle_hidden(int face, const clip_vertex (&c)[3]);  // a triangle before clipping
+  bool texel_rect(int face, float u0, float u1, float v0, float v1, int& x0, int& x1, int& y0, int& y1) const;
   bool culling_ = false;  // a traversal with occlusion tests is drawing (draw_fixed tests big triangles too)
   template <mode M>
-  void traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull);
+  void traverse(const glm::vec3& position, const frame& basis, bool cull);
+  void traverse_front_to_back(const glm::vec3& position, const frame& basis);
+  template <mode M>
+  void draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis, const simd_frame& sf);
   void redraw_prepare();
-  bool ties_decide_order() const;  // a logged tie holds its texel's final depth (or the log overflowed)
+  // A logged tie holds its texel's final depth between fragments the buffer can tell apart (other
+  // shades, or a textured render), or the log overflowed.
+  bool ties_decide_order() const;
+  // Level of detail (raster_options::lod_texels; lod.cpp): a node spanning under lod_texels_
+  // texels is drawn from its proxy.
+  bool lod_draw(const bvh_node& node, std::uint32_t node_index, unsigned mask, const glm::vec3& position, const frame& basis);
+  const struct lod_proxies* lod_ = nullptr;
+  float lod_texels_ = 0.0f;
   bool occlusion_ = true;
   tie_log ties_;                               // the depth ties of this render's front-to-back pass
   tie_log* tie_sink_ = nullptr;                // &ties_ while that pass draws, else null (no logging)
@@ -309,12 +341,7 @@ class alignas(64) rasterizer_impl {
   // Texel ids (ids_): draw << key_bits_ | the draw's shade key, or the draw alone when they
   // do not fit in 31 bits (key_bits_ = 0; the resolve then looks keys up in draw_keys_).
   std::uint32_t key_bits_ = 0;
-  struct open_node {
-    float distance2;     // squared distance from the point to the node's box (best-first order)
-    std::uint32_t node;
-    unsigned faces;      // the faces the node may touch
-  };
-  std::vector<open_node> open_;  // the traversal's stack (reference order) or heap (front to back)
+  std::vector<std::uint64_t> stack_;  // the traversal's stack (reference order) or heap (front to back)
   raster_statistics stats_;
 };
 

@@ -52,18 +52,17 @@ HEMILIGHT_TARGET_AVX2 inline __m256 depth_test8(float* depth, std::uint32_t* ids
 // Depth test of texels [lo, hi] of one row (drow, irow: the row's depth and ids).
 // The depth test of span_avx2 with its constants given (zr: the row's depth, dz: its step per
 // texel, zmin = FLT_MIN, id: the record in every lane), shared with the span walk's functor.
-// Logs the tie lanes `tie` of the eight texels at depth (depths z), if any and if `ties` is not
-// null (renders without occlusion culling log nothing).
-HEMILIGHT_TARGET_AVX2 inline void log_ties8(tie_log* ties, const float* depth, __m256 z, __m256 tie) {
-  if (!ties) return;
+// Logs the tie lanes `tie` of the eight texels at depth (depths z), if any.
+HEMILIGHT_TARGET_AVX2 inline void log_ties8(tie_log* ties, const float* depth, __m256 z, __m256 tie, __m256 id) {
   if (const int bits = _mm256_movemask_ps(tie)) {
     alignas(32) float zl[8];
     _mm256_store_ps(zl, z);
-    ties->add(depth, zl, static_cast<unsigned>(bits));
+    ties->add(depth, zl, static_cast<std::uint32_t>(_mm256_cvtsi256_si32(_mm256_castps_si256(id))), static_cast<unsigned>(bits));
   }
 }
 
-// Ties go to `ties` (tie_log; may be null).
+// Ties go to `ties` (tie_log) when `log` (else `ties` is not read).
+template <bool log>
 HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(float* drow, std::uint32_t* irow,
                                                                                int lo, int hi, __m256 zr, __m256 dz,
                                                                                __m256 zmin, __m256 id,
@@ -72,19 +71,24 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void span_body_avx2(
   __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(lo), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
   for (int x = lo; x <= hi; x += 8, xi = _mm256_add_epi32(xi, eight)) {
     const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-    log_ties8(ties, drow + x, z, depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id));
+    const __m256 tie = depth_test8(drow + x, irow + x, z, _mm256_castsi256_ps(_mm256_cmpgt_epi32(end, xi)), id);
+    if (log) log_ties8(ties, drow + x, z, tie, id);
   }
 }
 
 HEMILIGHT_TARGET_AVX2 void span_avx2(float* drow, std::uint32_t* irow, int lo, int hi, float zrow, float dzdx,
                                      std::uint32_t draw, tie_log* ties) noexcept {
-  span_body_avx2(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN),
-                 _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw))), ties);
+  const __m256 id = _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(draw)));
+  if (ties)
+    span_body_avx2<true>(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN), id, ties);
+  else
+    span_body_avx2<false>(drow, irow, lo, hi, _mm256_set1_ps(zrow), _mm256_set1_ps(dzdx), _mm256_set1_ps(FLT_MIN), id, ties);
 }
 
 // The exact span walk's rows in depth mode (draw_fixed): walk_rows with span_avx2's depth test
 // inlined and its constants set up once per triangle instead of once per row. The same float
 // operations on the same values as span_avx2 and the scalar span, so the same bits.
+template <bool log>
 struct depth_spans_avx2 {
   float* depth;
   std::uint32_t* ids;
@@ -104,8 +108,8 @@ struct depth_spans_avx2 {
     ++spans;
     fragments += static_cast<std::size_t>(hi - lo + 1);
     const std::size_t row = static_cast<std::size_t>(y) * n;
-    span_body_avx2(depth + row, ids + row, lo, hi, _mm256_set1_ps(static_cast<float>(z00 + dzdy * y)), dz, zmin, id,
-                   ties);
+    span_body_avx2<log>(depth + row, ids + row, lo, hi, _mm256_set1_ps(static_cast<float>(z00 + dzdy * y)), dz, zmin, id,
+                        ties);
   }
 };
 
@@ -115,17 +119,25 @@ HEMILIGHT_TARGET_AVX2 __attribute__((flatten)) void walk_depth_avx2(
     int nl, int nr, const edge_walk* left, const edge_walk* right, std::int64_t y0, std::int64_t y1,
     std::int64_t x_begin, std::int64_t x_end, float* depth, std::uint32_t* ids, int n, double z00, double dzdy,
     float dzdx, std::uint32_t draw, raster_statistics& stats, tie_log* ties) noexcept {
-  depth_spans_avx2 span(depth, ids, n, z00, dzdy, dzdx, draw);
-  span.ties = ties;
-  walk_rows_of(nl, nr, left, right, y0, y1, x_begin, x_end, span);
-  stats.spans += span.spans;
-  stats.fragments += span.fragments;
+  const auto walk = [&](auto& span) HEMILIGHT_TARGET_AVX2 {
+    span.ties = ties;
+    walk_rows_of(nl, nr, left, right, y0, y1, x_begin, x_end, span);
+    stats.spans += span.spans;
+    stats.fragments += span.fragments;
+  };
+  if (ties) {
+    depth_spans_avx2<true> span(depth, ids, n, z00, dzdy, dzdx, draw);
+    walk(span);
+  } else {
+    depth_spans_avx2<false> span(depth, ids, n, z00, dzdy, dzdx, draw);
+    walk(span);
+  }
 }
 
 // The small-triangle path of small_triangle_sse2_impl, eight texels per step.
 // base, sx, sy: the 32-bit edge values at the box's first texel (x_begin, y_begin) and their
 // steps per texel in x and y (the caller checks they fit, see avx2_extent).
-template <bool count_mode>
+template <bool count_mode, bool log>
 HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_avx2_body(
     const std::int32_t* base, const std::int32_t* sx, const std::int32_t* sy, std::size_t stride, std::int64_t x_begin,
     std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n, float* depth, std::uint32_t* ids,
@@ -162,7 +174,8 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(n) + static_cast<std::size_t>(xb);
       const __m256 zr = _mm256_set1_ps(static_cast<float>(z00 + dzdy * static_cast<double>(y)));
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, zx), zmin);
-      log_ties8(ties, depth + i, z, depth_test8(depth + i, ids + i, z, mask, id));
+      const __m256 tie = depth_test8(depth + i, ids + i, z, mask, id);
+      if (log) log_ties8(ties, depth + i, z, tie, id);
     }
     return;
   }
@@ -186,7 +199,8 @@ HEMILIGHT_TARGET_AVX2 inline __attribute__((always_inline)) void small_triangle_
         continue;
       }
       const __m256 z = _mm256_max_ps(_mm256_add_ps(zr, _mm256_mul_ps(dz, _mm256_cvtepi32_ps(xi))), zmin);
-      log_ties8(ties, depth + i, z, depth_test8(depth + i, ids + i, z, mask, id));
+      const __m256 tie = depth_test8(depth + i, ids + i, z, mask, id);
+      if (log) log_ties8(ties, depth + i, z, tie, id);
     }
     row[0] = _mm256_add_epi32(row[0], dy[0]);
     row[1] = _mm256_add_epi32(row[1], dy[1]);
@@ -201,8 +215,12 @@ HEMILIGHT_TARGET_AVX2 void small_triangle_avx2_impl(const std::int32_t* base, co
                                                     std::int64_t y_begin, std::int64_t y_end, int n, float* depth,
                                                     std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
                                                     float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
-  small_triangle_avx2_body<count_mode>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
-                                       dzdy, dzdx, draw, ties);
+  if (ties)
+    small_triangle_avx2_body<count_mode, true>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                               dzdy, dzdx, draw, ties);
+  else
+    small_triangle_avx2_body<count_mode, false>(base, sx, sy, 1, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00,
+                                                dzdy, dzdx, draw, ties);
 }
 
 // The resolve of resolve_texels (below), eight texels per step; the last count % 8 (0 or 4)
@@ -337,4 +355,9 @@ HEMILIGHT_TARGET_AVX2 inline __m256 positive8(__m256 m) noexcept {
 
 }  // namespace hemilight
 
+#else
+namespace hemilight {
+// Without the AVX2 kernels the set-up's broadcast frame is never used: an empty stand-in.
+struct raster_detail::simd_frame {};
+}  // namespace hemilight
 #endif  // HEMILIGHT_RASTER_AVX2

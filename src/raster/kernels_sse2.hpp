@@ -19,14 +19,12 @@ using namespace raster_detail;
 
 namespace {
 
-// Logs the tie lanes `tie` of the four texels at depth (depths z), if any and if `ties` is not
-// null (renders without occlusion culling log nothing).
-inline void log_ties4(tie_log* ties, const float* depth, __m128 z, __m128 tie) {
-  if (!ties) return;
+// Logs the tie lanes `tie` of the four texels at depth (depths z), if any.
+inline void log_ties4(tie_log* ties, const float* depth, __m128 z, __m128 tie, std::uint32_t id) {
   if (const int bits = _mm_movemask_ps(tie)) {
     alignas(16) float zl[4];
     _mm_store_ps(zl, z);
-    ties->add(depth, zl, static_cast<unsigned>(bits));
+    ties->add(depth, zl, id, static_cast<unsigned>(bits));
   }
 }
 
@@ -36,8 +34,8 @@ constexpr std::int64_t simd_extent = 32 * sub_one;
 // Small triangles (draw_fixed, step 4b): the box scanned four texels per step with 32-bit edge
 // values, the coverage mask going straight into the depth test (or the counts). ex, ey, e0: the int64 edge functions (tie bias included) at texel (x, y):
 // E = ex x + ey y + e0; covered iff all three are >= 0.
-template <bool count_mode>
-void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3], const std::int64_t (&e0)[3],
+template <bool count_mode, bool log>
+void small_triangle_sse2_body(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3], const std::int64_t (&e0)[3],
                               std::int64_t x_begin, std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
                               float* depth, std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
                               float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
@@ -79,7 +77,7 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
           }
           float z = _mm_cvtss_f32(zr) + dzdx * static_cast<float>(x + k);
           z = z > FLT_MIN ? z : FLT_MIN;
-          if (ties && z == depth[i]) ties->add(depth + i, &z, 1u);
+          if (log && z == depth[i]) ties->add(depth + i, &z, draw, 1u);
           if (z > depth[i]) {
             depth[i] = z;
             ids[i] = draw;
@@ -97,7 +95,7 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
       const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
       const __m128 old = _mm_loadu_ps(depth + i);
       const __m128 closer = _mm_and_ps(_mm_cmpgt_ps(z, old), _mm_castsi128_ps(in));
-      log_ties4(ties, depth + i, z, _mm_and_ps(_mm_cmpeq_ps(z, old), _mm_castsi128_ps(in)));
+      if (log) log_ties4(ties, depth + i, z, _mm_and_ps(_mm_cmpeq_ps(z, old), _mm_castsi128_ps(in)), draw);
       _mm_storeu_ps(depth + i, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
       __m128i* ip = reinterpret_cast<__m128i*>(ids + i);
       const __m128i mask = _mm_castps_si128(closer);
@@ -107,6 +105,20 @@ void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&
     row[1] = _mm_add_epi32(row[1], dy1);
     row[2] = _mm_add_epi32(row[2], dy2);
   }
+}
+
+// small_triangle_sse2_body, logging ties when `ties` is not null.
+template <bool count_mode>
+void small_triangle_sse2_impl(const std::int64_t (&ex)[3], const std::int64_t (&ey)[3], const std::int64_t (&e0)[3],
+                              std::int64_t x_begin, std::int64_t x_end, std::int64_t y_begin, std::int64_t y_end, int n,
+                              float* depth, std::uint32_t* ids, std::uint32_t* counts, double z00, double dzdy,
+                              float dzdx, std::uint32_t draw, tie_log* ties) noexcept {
+  if (ties)
+    small_triangle_sse2_body<count_mode, true>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00, dzdy,
+                                               dzdx, draw, ties);
+  else
+    small_triangle_sse2_body<count_mode, false>(ex, ey, e0, x_begin, x_end, y_begin, y_end, n, depth, ids, counts, z00, dzdy,
+                                                dzdx, draw, ties);
 }
 
 // outcode() (rasterizer.cpp) of a local-frame point: the same twelve differences, four per
@@ -135,8 +147,9 @@ inline unsigned clip_codes_sse2(const clip_vertex& c, float gw, float near) noex
 // four at a time: the same operations in the same order as the scalar loop (span_writer), so the
 // results are bit-identical (tested). max(z, FLT_MIN) returns FLT_MIN for NaN, like the scalar
 // select. Returns the first texel not done (fewer than four are left from it to hi).
-inline int span_sse2(float* drow, std::uint32_t* irow, int x, int hi, float zrow, float dzdx,
-                     std::uint32_t draw, tie_log* ties) noexcept {
+template <bool log>
+inline int span_sse2_body(float* drow, std::uint32_t* irow, int x, int hi, float zrow, float dzdx,
+                          std::uint32_t draw, tie_log* ties) noexcept {
   const __m128 zr = _mm_set1_ps(zrow), dz = _mm_set1_ps(dzdx), zmin = _mm_set1_ps(FLT_MIN);
   const __m128i id = _mm_set1_epi32(static_cast<int>(draw)), lane = _mm_setr_epi32(0, 1, 2, 3);
   for (; x + 3 <= hi; x += 4) {
@@ -144,13 +157,19 @@ inline int span_sse2(float* drow, std::uint32_t* irow, int x, int hi, float zrow
     const __m128 z = _mm_max_ps(_mm_add_ps(zr, _mm_mul_ps(dz, xf)), zmin);
     const __m128 old = _mm_loadu_ps(drow + x);
     const __m128 closer = _mm_cmpgt_ps(z, old);
-    log_ties4(ties, drow + x, z, _mm_cmpeq_ps(z, old));
+    if (log) log_ties4(ties, drow + x, z, _mm_cmpeq_ps(z, old), draw);
     _mm_storeu_ps(drow + x, _mm_or_ps(_mm_and_ps(closer, z), _mm_andnot_ps(closer, old)));
     __m128i* ip = reinterpret_cast<__m128i*>(irow + x);
     const __m128i mask = _mm_castps_si128(closer);
     _mm_storeu_si128(ip, _mm_or_si128(_mm_and_si128(mask, id), _mm_andnot_si128(mask, _mm_loadu_si128(ip))));
   }
   return x;
+}
+
+inline int span_sse2(float* drow, std::uint32_t* irow, int x, int hi, float zrow, float dzdx, std::uint32_t draw,
+                     tie_log* ties) noexcept {
+  return ties ? span_sse2_body<true>(drow, irow, x, hi, zrow, dzdx, draw, ties)
+              : span_sse2_body<false>(drow, irow, x, hi, zrow, dzdx, draw, ties);
 }
 
 // resolve_texels (rasterizer.cpp) four texels at a time, from texel 0 while four are left: the

@@ -10,12 +10,14 @@
 // and tested against the five faces together; each triangle that survives then goes through
 // the face stage below, face by face, in leaf order within each face (the scalar path's order
 // for every texel).
-template <rasterizer_impl::mode M>
+// log: occlusion culling's front-to-back pass, whose depth tests log their ties (tie_sink_).
+template <rasterizer_impl::mode M, bool log>
 HEMILIGHT_LEAF_TARGET void raster_detail::rasterizer_impl::HEMILIGHT_LEAF_NAME(const scene::triangle* all, std::uint32_t first,
                                                                std::uint32_t count,
                                                                unsigned face_mask, const simd_frame& sf,
                                                                const frame& basis) {
   stats_.triangles_tested += count;
+  tie_log* const ties = log ? tie_sink_ : nullptr;  // read once: the stores below may alias it
   const scene::triangle* tris = all + first;
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), lane);
@@ -335,8 +337,8 @@ HEMILIGHT_LEAF_TARGET void raster_detail::rasterizer_impl::HEMILIGHT_LEAF_NAME(c
       }
       if ((empty | flat) & bit) continue;
       if (draw[j] == 0) draw[j] = commit_record(plane_of[j], tri, textured_ ? &record(j) : nullptr, basis);
-      small_triangle_avx2_body<M == mode::count>(&base[0][j], &sx[0][j], &sy[0][j], 8, xb[j], xe[j], yb[j], ye[j], n,
-                                                 depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j], tie_sink_);
+      small_triangle_avx2_body<M == mode::count, log>(&base[0][j], &sx[0][j], &sy[0][j], 8, xb[j], xe[j], yb[j], ye[j], n,
+                                                      depth, ids, counts, z00[j], dzdy[j], dzdx[j], draw[j], ties);
     }
   }
 }

@@ -64,8 +64,17 @@ void raster_detail::rasterizer_impl::redraw_prepare() {
 
 bool raster_detail::rasterizer_impl::ties_decide_order() const {
   if (ties_.overflow) return true;
-  for (const auto& [depth, z] : ties_.at)
-    if (*depth == z) return true;  // the tie holds the texel's final depth: the order chose its winner
+  // A tie decides nothing when the depth it tied at was beaten later, or when both fragments give
+  // the texel the same bits: the same shade (radiance and flags) and, without a texture, the
+  // distance comes from the texel's depth, which is the tied depth either way. (seen_triangle()
+  // may then name either triangle.)
+  const auto key = [&](std::uint32_t id) { return key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]; };
+  for (const tie_log::entry& e : ties_.at) {
+    if (*e.depth != e.z) continue;
+    if (textured_) return true;
+    const std::size_t texel = static_cast<std::size_t>(e.depth - depth_.data());
+    if (key(ids_[texel]) != key(e.id)) return true;
+  }
   return false;
 }
 
@@ -105,6 +114,7 @@ float least_in_rows(const float* d, int width, int x0, int x1, int y0, int y1) n
 // of w over the part in the face's pyramid, and the bounds of the projection (u/w, v/w) of the
 // box's part at w >= w_near; bounded = false when w_near does not pass the near plane.
 struct face_projection {
+  bool outside = false;  // the box is outside the face's pyramid: it covers none of its texels
   bool bounded = false;
   float w_near = 0.0f, u0 = 0.0f, u1 = 0.0f, v0 = 0.0f, v1 = 0.0f;
 };
@@ -127,6 +137,19 @@ face_projection project_box(const float* lx, const float* ly, const float* lz, i
     v_lo = std::min(v_lo, v[k]);
     v_hi = std::max(v_hi, v[k]);
     w_min = std::min(w_min, w[k]);
+  }
+  // Outside the face's pyramid (w >= near, |u| <= w, |v| <= w): every corner beyond one plane.
+  float out_w = -INFINITY, out_pu = -INFINITY, out_nu = -INFINITY, out_pv = -INFINITY, out_nv = -INFINITY;
+  for (int k = 0; k < 8; ++k) {
+    out_w = std::max(out_w, w[k]);
+    out_pu = std::max(out_pu, w[k] - u[k]);
+    out_nu = std::max(out_nu, w[k] + u[k]);
+    out_pv = std::max(out_pv, w[k] - v[k]);
+    out_nv = std::max(out_nv, w[k] + v[k]);
+  }
+  if (out_w < near || out_pu < 0.0f || out_nu < 0.0f || out_pv < 0.0f || out_nv < 0.0f) {
+    p.outside = true;
+    return p;
   }
   // What the face sees of the box lies in its pyramid |u|, |v| <= w (v >= 0 on the side faces):
   // there w >= |u| and w >= |v|, so w_near below bounds w over that part even when the box
@@ -187,6 +210,12 @@ HEMILIGHT_TARGET_AVX2 face_projection project_box_avx2(const float* lx, const fl
   const __m256 v = f == 0 ? y : z;
   const __m256 w = f == 0 ? z : f == 1 ? x : f == 2 ? _mm256_xor_ps(x, sign) : f == 3 ? y : _mm256_xor_ps(y, sign);
   const float u_lo = reduce_min(u), u_hi = reduce_max(u), v_lo = reduce_min(v), v_hi = reduce_max(v), w_min = reduce_min(w);
+  // Outside the face's pyramid (w >= near, |u| <= w, |v| <= w): every corner beyond one plane.
+  if (reduce_max(w) < near || reduce_max(_mm256_sub_ps(w, u)) < 0.0f || reduce_max(_mm256_add_ps(w, u)) < 0.0f ||
+      reduce_max(_mm256_sub_ps(w, v)) < 0.0f || reduce_max(_mm256_add_ps(w, v)) < 0.0f) {
+    p.outside = true;
+    return p;
+  }
   const auto from_zero = [](float a, float b) { return a > 0.0f ? a : b < 0.0f ? -b : 0.0f; };
   const float v_from_zero = f == 0 ? from_zero(v_lo, v_hi) : std::max(v_lo, 0.0f);
   const float w_near = std::max(std::max(w_min, from_zero(u_lo, u_hi)), v_from_zero) * (1.0f - 1e-6f);
@@ -224,6 +253,34 @@ HEMILIGHT_TARGET_AVX2 face_projection project_box_avx2(const float* lx, const fl
 }
 #endif
 
+// The corners of the box [lo, hi] (relative to the point) in the local frame (corner k takes x from
+// hi if k & 1, y if k & 2, z if k & 4), as frame::to_local computes them.
+void box_corners(const glm::vec3& lo, const glm::vec3& hi, const frame& basis, float* lx, float* ly, float* lz) noexcept {
+  for (int k = 0; k < 8; ++k) {
+    const float x = k & 1 ? hi.x : lo.x, y = k & 2 ? hi.y : lo.y, z = k & 4 ? hi.z : lo.z;
+    lx[k] = basis.t.x * x + basis.t.y * y + basis.t.z * z;
+    ly[k] = basis.b.x * x + basis.b.y * y + basis.b.z * z;
+    lz[k] = basis.n.x * x + basis.n.y * y + basis.n.z * z;
+  }
+}
+
+#if HEMILIGHT_RASTER_AVX2
+// box_corners, eight lanes at once (the same operations: the same bits).
+HEMILIGHT_TARGET_AVX2 void box_corners_avx2(const glm::vec3& lo, const glm::vec3& hi, const frame& basis, float* lx,
+                                            float* ly, float* lz) noexcept {
+  const __m256 x = _mm256_setr_ps(lo.x, hi.x, lo.x, hi.x, lo.x, hi.x, lo.x, hi.x);
+  const __m256 y = _mm256_setr_ps(lo.y, lo.y, hi.y, hi.y, lo.y, lo.y, hi.y, hi.y);
+  const __m256 z = _mm256_setr_ps(lo.z, lo.z, lo.z, lo.z, hi.z, hi.z, hi.z, hi.z);
+  const auto dot = [&](const glm::vec3& a) HEMILIGHT_TARGET_AVX2 {
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(a.x), x), _mm256_mul_ps(_mm256_set1_ps(a.y), y)),
+                         _mm256_mul_ps(_mm256_set1_ps(a.z), z));
+  };
+  _mm256_store_ps(lx, dot(basis.t));
+  _mm256_store_ps(ly, dot(basis.b));
+  _mm256_store_ps(lz, dot(basis.n));
+}
+#endif
+
 }  // namespace
 
 bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, int rx0, int rx1, int ry0, int ry1,
@@ -233,26 +290,101 @@ bool raster_detail::rasterizer_impl::hidden_in_tile(int face, int tx, int ty, in
   const int rows = face == 0 ? n_ : n_ / 2;
   const int tile_x0 = tx << tile_bits, tile_y0 = ty << tile_bits;
   const int tile_x1 = std::min(tile_x0 + tile_size, n_) - 1, tile_y1 = std::min(tile_y0 + tile_size, rows) - 1;
-  const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(face));
-  if (tile_dirty_[t]) {
-    tile_depth_[t] = least_in_rows(d, n_, tile_x0, tile_x1, tile_y0, tile_y1);
-    tile_dirty_[t] = 0;
-  }
+  // A stale least depth is still a lower bound (depths only grow while drawing): enough to say
+  // hidden; otherwise the tile is read again, or only the rectangle's part of it.
   if (nearest < tile_depth_[t]) return true;
-  // The tile holds a texel as near as `nearest` (or an empty one): is it in the rectangle?
+  const float* d = occluders_ + hemicube_face_offset(n_, static_cast<hemicube_face>(face));
   const int x0 = std::max(rx0, tile_x0), x1 = std::min(rx1, tile_x1);
   const int y0 = std::max(ry0, tile_y0), y1 = std::min(ry1, tile_y1);
-  if (x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1) return false;
+  const bool whole = x0 == tile_x0 && x1 == tile_x1 && y0 == tile_y0 && y1 == tile_y1;
+  if (tile_dirty_[t] && whole) {
+    tile_depth_[t] = least_in_rows(d, n_, tile_x0, tile_x1, tile_y0, tile_y1);
+    tile_dirty_[t] = 0;
+    return nearest < tile_depth_[t];
+  }
+  if (whole) return false;  // the tile's (current) least depth lies in the rectangle
   return nearest < least_in_rows(d, n_, x0, x1, y0, y1);
+}
+
+bool raster_detail::rasterizer_impl::texel_rect(int face, float u0, float u1, float v0, float v1, int& x0, int& x1, int& y0,
+                                                int& y1) const {
+  // Texel centres at (x + 1/2) for x = (u + 1) N / 2; side faces' rows start at v = 0. Widened by
+  // rect_margin texels and the float error of the bounds.
+  const int rows = face == 0 ? n_ : n_ / 2;
+  if (std::isnan(u0) || std::isnan(u1) || std::isnan(v0) || std::isnan(v1)) {  // cannot happen; then: the whole face
+    x0 = y0 = 0;
+    x1 = n_ - 1;
+    y1 = rows - 1;
+    return true;
+  }
+  const float half = 0.5f * static_cast<float>(n_), v_offset = face == 0 ? 1.0f : 0.0f;
+  const float fx0 = (u0 + 1.0f) * half - 0.5f, fx1 = (u1 + 1.0f) * half - 0.5f;
+  const float fy0 = (v0 + v_offset) * half - 0.5f, fy1 = (v1 + v_offset) * half - 0.5f;
+  const float m = rect_margin + 1e-5f * (std::fabs(fx0) + std::fabs(fx1) + std::fabs(fy0) + std::fabs(fy1));
+  // ceil and floor of x clamped to [-1, count], by truncating x + 2 >= 1 (no libm call).
+  const auto first = [](float x, int count) {
+    const float c = std::min(std::max(x, -1.0f), static_cast<float>(count)) + 2.0f;
+    const int t = static_cast<int>(c);
+    return t + (static_cast<float>(t) < c ? 1 : 0) - 2;
+  };
+  const auto last = [](float x, int count) {
+    return static_cast<int>(std::min(std::max(x, -1.0f), static_cast<float>(count)) + 2.0f) - 2;
+  };
+  x0 = std::max(first(fx0 - m, n_), 0);
+  x1 = std::min(last(fx1 + m, n_), n_ - 1);
+  y0 = std::max(first(fy0 - m, rows), 0);
+  y1 = std::min(last(fy1 + m, rows), rows - 1);
+  return x0 <= x1 && y0 <= y1;  // (false also for NaN bounds: nothing to draw either)
 }
 
 bool raster_detail::rasterizer_impl::rect_hidden(int face, int x0, int x1, int y0, int y1, float nearest) {
   // Hidden when `nearest` is below the depth of every texel of the rectangle, read per tile from
   // the tile's least depth where it is known and high enough.
-  for (int ty = y0 >> tile_bits; ty <= (y1 >> tile_bits); ++ty)
+  for (int ty = y0 >> tile_bits; ty <= (y1 >> tile_bits); ++ty) {
+    const float* row = tile_depth_.data() + tile_offset_[face] + static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_);
     for (int tx = x0 >> tile_bits; tx <= (x1 >> tile_bits); ++tx)
-      if (!hidden_in_tile(face, tx, ty, x0, x1, y0, y1, nearest)) return false;
+      if (!(nearest < row[tx]) && !hidden_in_tile(face, tx, ty, x0, x1, y0, y1, nearest)) return false;
+  }
   return true;
+}
+
+bool raster_detail::rasterizer_impl::triangle_hidden(int face, const clip_vertex (&c)[3]) {
+  // As occlusion_test does for a box: w_near bounds w over the part of the triangle in the face's
+  // pyramid, and the part at w >= w_near projects inside its vertices' and its edges' crossings.
+  float u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY, w_min = INFINITY;
+  for (const clip_vertex& q : c) {
+    u_lo = std::min(u_lo, q.u);
+    u_hi = std::max(u_hi, q.u);
+    v_lo = std::min(v_lo, q.v);
+    v_hi = std::max(v_hi, q.v);
+    w_min = std::min(w_min, q.w);
+  }
+  const auto from_zero = [](float a, float b) { return a > 0.0f ? a : b < 0.0f ? -b : 0.0f; };
+  const float v_from_zero = face == 0 ? from_zero(v_lo, v_hi) : std::max(v_lo, 0.0f);
+  const float w_near = std::max(std::max(w_min, from_zero(u_lo, u_hi)), v_from_zero) * (1.0f - 1e-6f);
+  if (!(w_near > near_)) return false;
+  float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+  for (int k = 0; k < 3; ++k) {
+    const clip_vertex& a = c[k];
+    const clip_vertex& b = c[k == 2 ? 0 : k + 1];
+    if (a.w >= w_near) {
+      u0 = std::min(u0, a.u / a.w);
+      u1 = std::max(u1, a.u / a.w);
+      v0 = std::min(v0, a.v / a.w);
+      v1 = std::max(v1, a.v / a.w);
+    }
+    if ((a.w >= w_near) != (b.w >= w_near)) {
+      const float t = (w_near - a.w) / (b.w - a.w);
+      const float pu = (a.u + t * (b.u - a.u)) / w_near, pv = (a.v + t * (b.v - a.v)) / w_near;
+      u0 = std::min(u0, pu);
+      u1 = std::max(u1, pu);
+      v0 = std::min(v0, pv);
+      v1 = std::max(v1, pv);
+    }
+  }
+  int x0, x1, y0, y1;
+  if (!texel_rect(face, u0, u1, v0, v1, x0, x1, y0, y1)) return true;  // no texel centre under it
+  return rect_hidden(face, x0, x1, y0, y1, depth_margin / w_near);
 }
 
 bool raster_detail::rasterizer_impl::plane_hidden(int face, const texel_box& box, const face_setup& fs) {
@@ -266,21 +398,25 @@ bool raster_detail::rasterizer_impl::plane_hidden(int face, const texel_box& box
 }
 
 unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, unsigned mask, const glm::vec3& position,
-                                                        const frame& basis, node_rects& rects) {
+                                                        const frame& basis, node_rects& rects, std::uint32_t triangles) {
   // The box's corners in the local frame, grown by the float error of moving points there (the
   // triangles' vertices carry the same kind of error), as eight lanes per coordinate (corner k
   // takes x from hi if k & 1, y if k & 2, z if k & 4): plain loops the compiler vectorises.
   const glm::vec3 scale = glm::max(glm::max(glm::abs(node.lo), glm::abs(node.hi)), glm::abs(position));
   const glm::vec3 grow(1e-6f * (scale.x + scale.y + scale.z));
   const glm::vec3 lo = node.lo - grow - position, hi = node.hi + grow - position;
-  float lx[8], ly[8], lz[8];
-  for (int k = 0; k < 8; ++k) {
-    const float x = k & 1 ? hi.x : lo.x, y = k & 2 ? hi.y : lo.y, z = k & 4 ? hi.z : lo.z;
-    lx[k] = basis.t.x * x + basis.t.y * y + basis.t.z * z;
-    ly[k] = basis.b.x * x + basis.b.y * y + basis.b.z * z;
-    lz[k] = basis.n.x * x + basis.n.y * y + basis.n.z * z;
-  }
-  const float n = static_cast<float>(n_), half = 0.5f * n;
+  alignas(32) float lx[8], ly[8], lz[8];
+#if HEMILIGHT_RASTER_AVX2
+  if (avx2_)
+    box_corners_avx2(lo, hi, basis, lx, ly, lz);
+  else
+#endif
+    box_corners(lo, hi, basis, lx, ly, lz);
+  unsigned hidden = 0;
+  // Entirely below the tangent plane (every face sees z >= 0 only): nothing to draw.
+  float z_max = lz[0];
+  for (int k = 1; k < 8; ++k) z_max = std::max(z_max, lz[k]);
+  if (z_max < 0.0f) return 0;
   for (int f = 0; f < 5; ++f) {
     if (!(mask >> f & 1u)) continue;
     const int rows = f == 0 ? n_ : n_ / 2;
@@ -295,6 +431,10 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     else
 #endif
       p = project_box(lx, ly, lz, f, near_);
+    if (p.outside) {
+      mask &= ~(1u << f);
+      continue;
+    }
     if (!p.bounded) {
       rects.x0[f] = 0;
       rects.x1[f] = n_ - 1;
@@ -303,20 +443,8 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
       continue;  // its nearest depth is 1/near: nothing drawn can hide it
     }
     const float w_near = p.w_near, u0 = p.u0, u1 = p.u1, v0 = p.v0, v1 = p.v1;
-    // Texel centres at (x + 1/2) for x = (u + 1) N / 2; side faces' rows start at v = 0.
-    const float v_offset = f == 0 ? 1.0f : 0.0f;
-    const float fx0 = (u0 + 1.0f) * half - 0.5f, fx1 = (u1 + 1.0f) * half - 0.5f;
-    const float fy0 = (v0 + v_offset) * half - 0.5f, fy1 = (v1 + v_offset) * half - 0.5f;
-    const float m = rect_margin + 1e-5f * (std::fabs(fx0) + std::fabs(fx1) + std::fabs(fy0) + std::fabs(fy1));
-    const auto first = [](float x, int count) {
-      return static_cast<std::int32_t>(std::ceil(std::min(std::max(x, -1.0f), static_cast<float>(count))));
-    };
-    const auto last = [](float x, int count) {
-      return static_cast<std::int32_t>(std::floor(std::min(std::max(x, -1.0f), static_cast<float>(count))));
-    };
-    const std::int32_t x0 = std::max(first(fx0 - m, n_), 0), x1 = std::min(last(fx1 + m, n_), n_ - 1);
-    const std::int32_t y0 = std::max(first(fy0 - m, rows), 0), y1 = std::min(last(fy1 + m, rows), rows - 1);
-    if (x0 > x1 || y0 > y1) {
+    int x0, x1, y0, y1;
+    if (!texel_rect(f, u0, u1, v0, v1, x0, x1, y0, y1)) {
       mask &= ~(1u << f);  // no texel centre under the node on this face
       continue;
     }
@@ -326,7 +454,14 @@ unsigned raster_detail::rasterizer_impl::occlusion_test(const bvh_node& node, un
     rects.y1[f] = y1;
     // Hidden when its nearest depth, with the margin, is below the depth of every texel of its
     // rectangle, read per tile from the tile's least depth where it is known and high enough.
-    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_near)) mask &= ~(1u << f);
+    if (rect_hidden(f, x0, x1, y0, y1, depth_margin / w_near)) {
+      mask &= ~(1u << f);
+      hidden |= 1u << f;
+    }
+  }
+  if (!mask && hidden) {
+    ++stats_.nodes_occluded;
+    stats_.triangles_occluded += triangles;
   }
   return mask;
 }

@@ -4,6 +4,7 @@
 // so the kernels inline where their target allows); exact edge coverage is in edge.cpp.
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
+#include "lod.hpp"
 
 #include "hemilight/cubemap.hpp"
 
@@ -264,6 +265,8 @@ void validate_raster_options(const raster_options& options, const std::string& w
   if (!std::isfinite(options.near_distance) || options.near_distance < 0.0f)
     throw_invalid_argument(who + ": near_distance is " + std::to_string(options.near_distance) +
                            "; it must be finite and >= 0 (0 = default)");
+  if (!(options.lod_texels >= 0.0f && options.lod_texels <= 16.0f))
+    throw_invalid_argument(who + ": lod_texels is " + std::to_string(options.lod_texels) + "; it must be in [0, 16] (0 = off)");
   if (options.sky) {
     // A cheap structural check; the values were checked when the map was built (from_image).
     const cubemap& m = *options.sky;
@@ -293,6 +296,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
 #endif
   sky_ = options.sky;
   edge_ = options.edge_coverage;
+  lod_texels_ = edge_ ? 0.0f : options.lod_texels;
+  lod_ = lod_texels_ > 0.0f ? &lod_proxies_of(*scene_) : nullptr;
   occlusion_ = options.diagnostics.occlusion_culling &&
                scene_->drawable_triangle_count() >= options.diagnostics.occlusion_min_triangles;
   // Per node, the triangles below it (children follow their parent in the array).
@@ -318,8 +323,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   // order within each face, which the edge resolve's ties need): up to five per triangle.
   const std::size_t draws = scene_->drawable_triangle_count() * (edge_ ? 5 : 1) + 1;
   key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
-  edge_candidates_.clear();
-  if (edge_) edge_find_candidates();
+  edge_table_ = edge_ ? &edge_table_of(*scene_) : nullptr;
+  edge_facing_.assign(edge_ ? edge_table_->planes.size() : 0, 0);
 }
 
 void raster_detail::rasterizer_impl::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -379,6 +384,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   draws_.front().index = no_triangle;
   stats_ = {};
   ties_.clear();
+  ties_.limit = 2 * count;
   tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
   if (edge_) {
     // The per-texel lists are reset where the last render used them (all of them if N changed).
@@ -494,87 +500,145 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     occlusion_prepare();
     tie_sink_ = &ties_;
     culling_ = true;
-    traverse<M>(position, basis, true, true);
+    traverse_front_to_back(position, basis);
     tie_sink_ = nullptr;
     if (ties_decide_order()) {
       ++stats_.occlusion_redraws;
       occlusion_freeze();
       redraw_prepare();
-      traverse<M>(position, basis, false, true);
+      traverse<M>(position, basis, true);
     }
     culling_ = false;
     return;
   }
-  traverse<M>(position, basis, false, false);
+  traverse<M>(position, basis, false);
 }
 
 template <rasterizer_impl::mode M>
-void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const frame& basis, bool front_to_back, bool cull) {
-  const std::vector<bvh_node>& nodes = scene_->bvh();
+inline void raster_detail::rasterizer_impl::draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position,
+                                               const frame& basis, const simd_frame& sf) {
   const std::vector<scene::triangle>& tris = scene_->triangles();
 #if HEMILIGHT_RASTER_AVX2
+  if (avx2_) {
+    const bool log = M == mode::depth && tie_sink_;
+    for (std::uint32_t k = 0; k < node.count; k += 8) {
+      const std::uint32_t first = node.first + k, count = std::min<std::uint32_t>(8, node.count - k);
+      if (log)
+        avx512_ ? draw_leaf_avx512<M, true>(tris.data(), first, count, mask, sf, basis)
+                : draw_leaf_avx2<M, true>(tris.data(), first, count, mask, sf, basis);
+      else
+        avx512_ ? draw_leaf_avx512<M, false>(tris.data(), first, count, mask, sf, basis)
+                : draw_leaf_avx2<M, false>(tris.data(), first, count, mask, sf, basis);
+    }
+    return;
+  }
+#else
+  (void)sf;
+#endif
+  for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
+}
+
+// The reference order: depth first, left to right. With `cull`, nodes are tested against the
+// occluders too (the redraw after a tie, against the frozen depths of the front-to-back pass).
+template <rasterizer_impl::mode M>
+void raster_detail::rasterizer_impl::traverse(const glm::vec3& position, const frame& basis, bool cull) {
+  const std::vector<bvh_node>& nodes = scene_->bvh();
   simd_frame sf;
+#if HEMILIGHT_RASTER_AVX2
   if (avx2_) sf.set(position, basis, *scene_);
 #endif
-  // The nodes to visit with the faces they may touch. The reference order is depth first, left
-  // to right (a stack); front to back it is best first: the node whose box is nearest to the
-  // point (ties: the lower index), so that near occluders are drawn before what they hide
-  // anywhere in the tree.
-  open_.clear();
-  open_.push_back({0.0f, 0, 31});
-  const auto later = [](const open_node& a, const open_node& b) {
-    return a.distance2 > b.distance2 || (a.distance2 == b.distance2 && a.node > b.node);
-  };
+  // Stack entries: node index << 5 | the faces it may touch.
+  stack_.clear();
+  stack_.push_back(31);
   node_rects rects;
-  while (!open_.empty()) {
-    open_node next = open_.back();
-    if (front_to_back) {
-      std::pop_heap(open_.begin(), open_.end(), later);
-      next = open_.back();
-    }
-    open_.pop_back();
-    const std::uint32_t ni = next.node;
+  while (!stack_.empty()) {
+    const std::uint64_t entry = stack_.back();
+    stack_.pop_back();
+    const auto ni = static_cast<std::uint32_t>(entry >> 5);
     const bvh_node& node = nodes[ni];
     ++stats_.nodes_visited;
-    unsigned mask = next.faces & node_faces(node, position, basis);
+    unsigned mask = static_cast<unsigned>(entry & 31u) & node_faces(node, position, basis);
     if (mask) mask = drop_faces_between_texel_centres(node, mask, position, basis, M == mode::depth && edge_);
-    if (mask && cull) {
-      mask = occlusion_test(node, mask, position, basis, rects);
-      if (!mask) {
-        ++stats_.nodes_occluded;
-        stats_.triangles_occluded += subtree_triangles_[ni];
-      }
-    }
+    if (mask && cull) mask = occlusion_test(node, mask, position, basis, rects, subtree_triangles_[ni]);
     if (!mask) continue;
+    if (M == mode::depth && lod_ && lod_draw(node, ni, mask, position, basis)) continue;
     if (node.count == 0) {
-      if (front_to_back) {
-        for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
-          open_.push_back({box_distance2(nodes[c], position), c, mask});
-          std::push_heap(open_.begin(), open_.end(), later);
-        }
-      } else {
-        open_.push_back({0.0f, node.first + 1, mask});  // popped after the left child's subtree
-        open_.push_back({0.0f, node.first, mask});
+      stack_.push_back(std::uint64_t(node.first + 1) << 5 | mask);  // popped after the left child's subtree
+      stack_.push_back(std::uint64_t(node.first) << 5 | mask);
+      continue;
+    }
+    draw_leaf<M>(node, mask, position, basis, sf);
+  }
+}
+
+// Level of detail: a node whose box spans under lod_texels_ texels (its half diagonal R seen from
+// distance d > 2 R: R N / d texels, the angle of 2R over the 2/N of a texel at a face's centre) is
+// drawn from its proxy (lod.hpp), when it has one smaller than itself. True when drawn so.
+bool raster_detail::rasterizer_impl::lod_draw(const bvh_node& node, std::uint32_t node_index, unsigned mask,
+                                              const glm::vec3& position, const frame& basis) {
+  const std::uint32_t count = lod_->count[node_index];
+  if (count == 0 || count >= subtree_triangles_[node_index]) return false;
+  const float r = 0.5f * glm::length(node.hi - node.lo);
+  const float d = glm::length(0.5f * (node.lo + node.hi) - position);
+  if (!(d > 2.0f * r) || !(r * static_cast<float>(n_) < lod_texels_ * d)) return false;
+  ++stats_.lod_nodes;
+  const std::uint32_t first = lod_->first[node_index];
+  for (std::uint32_t k = first; k < first + count; ++k)
+    draw_triangle<mode::depth>(lod_->triangles[k], mask, position, basis, lod_->vertices[k].data());
+  return true;
+}
+
+// Front to back, best first: the node whose box is nearest to the point (ties: the lower index),
+// so that near occluders are drawn before what they hide anywhere in the tree. Each node is tested
+// against the faces' frusta and texel centres and against the occluders by occlusion_test alone
+// (a conservative test of its own: the reference order's node_faces and between-centres tests
+// would only repeat it).
+void raster_detail::rasterizer_impl::traverse_front_to_back(const glm::vec3& position, const frame& basis) {
+  const std::vector<bvh_node>& nodes = scene_->bvh();
+  simd_frame sf;
+#if HEMILIGHT_RASTER_AVX2
+  if (avx2_) sf.set(position, basis, *scene_);
+#endif
+  // Heap keys: the squared distance's bits (non-negative floats order as their bits), the node
+  // index, the faces: the least key is the nearest node.
+  const auto key = [&](std::uint32_t ni, unsigned mask) {
+    std::uint32_t bits;
+    const float d2 = box_distance2(nodes[ni], position);
+    std::memcpy(&bits, &d2, sizeof bits);
+    return std::uint64_t(bits) << 32 | std::uint64_t(ni) << 5 | mask;
+  };
+  stack_.clear();
+  stack_.push_back(31);
+  const std::greater<std::uint64_t> later;
+  node_rects rects;
+  while (!stack_.empty()) {
+    std::pop_heap(stack_.begin(), stack_.end(), later);
+    const std::uint64_t entry = stack_.back();
+    stack_.pop_back();
+    const auto ni = static_cast<std::uint32_t>(entry >> 5 & 0x7ffffffu);
+    const bvh_node& node = nodes[ni];
+    ++stats_.nodes_visited;
+    const unsigned mask = occlusion_test(node, static_cast<unsigned>(entry & 31u), position, basis, rects, subtree_triangles_[ni]);
+    if (!mask) continue;
+    if (lod_ && lod_draw(node, ni, mask, position, basis)) {
+      occlusion_drawn(mask, rects);
+      continue;
+    }
+    if (node.count == 0) {
+      for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
+        stack_.push_back(key(c, mask));
+        std::push_heap(stack_.begin(), stack_.end(), later);
       }
       continue;
     }
-#if HEMILIGHT_RASTER_AVX2
-    if (avx2_) {
-      for (std::uint32_t k = 0; k < node.count; k += 8)
-        if (avx512_)
-          draw_leaf_avx512<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
-        else
-          draw_leaf_avx2<M>(tris.data(), node.first + k, std::min<std::uint32_t>(8, node.count - k), mask, sf, basis);
-    } else
-#endif
-      for (std::uint32_t k = 0; k < node.count; ++k) draw_triangle<M>(tris[node.first + k], mask, position, basis);
-    if (cull) occlusion_drawn(mask, rects);
+    draw_leaf<mode::depth>(node, mask, position, basis, sf);
+    occlusion_drawn(mask, rects);
   }
 }
 
 template <rasterizer_impl::mode M>
 void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, unsigned face_mask, const glm::vec3& position,
-                                        const frame& basis) {
+                                        const frame& basis, const std::uint32_t* vertices) {
   ++stats_.triangles_tested;
   const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
                               basis.to_local(tri.v2 - position)};
@@ -593,6 +657,7 @@ void raster_detail::rasterizer_impl::draw_triangle(const scene::triangle& tri, u
   // A plane through the point is seen edge-on: it covers no texel centre.
   if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;
   rec.index = tri.index;
+  rec.vertices = vertices;
   // The rest of the record (material, texture gradients) is filled in when the triangle first
   // covers a texel centre: most triangles of big scenes cover none.
   std::uint32_t draw = 0;
@@ -676,6 +741,14 @@ void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&loc
     any_out |= code;
   }
   if (all_out) return;
+  // With occlusion culling, a triangle hidden over what the face sees of it is not clipped.
+  if (M == mode::depth && culling_ && any_out) {
+    const clip_vertex c3[3] = {poly[0], poly[1], poly[2]};
+    if (triangle_hidden(face, c3)) {
+      ++stats_.face_triangles_occluded;
+      return;
+    }
+  }
   if (any_out) ++stats_.clipped;
   for (int k = 0; k < 5 && count >= 3; ++k) {
     if (!(any_out >> k & 1u)) continue;
@@ -810,6 +883,7 @@ struct span_writer {
     if (simd && hi - lo >= 3) x = span_sse2(drow, irow, x, hi, zrow, dzdx, draw, target.ties);
 #endif
     // The scalar reference path (and the tail of the SIMD one).
+    tie_log* const ties = target.ties;
     for (; x <= hi; ++x) {
       float z = zrow + dzdx * static_cast<float>(x);
       // 1/w is positive on the triangle; rounding near an edge-on plane may say otherwise, and a
@@ -818,7 +892,7 @@ struct span_writer {
       // Selects, not a branch: short spans would mispredict on every texel.
       const float old = drow[x];
       const bool closer = z > old;
-      if (target.ties && z == old) target.ties->add(drow + x, &z, 1u);
+      if (ties && z == old) ties->add(drow + x, &z, draw, 1u);
       drow[x] = closer ? z : old;
       irow[x] = closer ? draw : irow[x];
     }
@@ -1141,9 +1215,9 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
       if (!rec.textured) continue;
       const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
       const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-      const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
-      const glm::vec2& uv0 = uvs[indices[tri]];
-      const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+      const std::uint32_t* v = rec.vertices ? rec.vertices : indices.data() + 3 * static_cast<std::size_t>(rec.index);
+      const glm::vec2& uv0 = uvs[v[0]];
+      const glm::vec2 uv = uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0);
       const glm::vec3 l = texture->sample(uv);
       red[i] = l.x;
       green[i] = l.y;

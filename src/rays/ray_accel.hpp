@@ -1,8 +1,8 @@
 // Internal to hemilight (not installed): the scene's ray acceleration structure behind rays.hpp.
 //
-// scene (scene.hpp) holds a detail::lazy_slot (src/scene/scene_access.hpp), empty until rays.cpp
-// builds the Embree scene into it on the first ray query or prepare_rays() call; ray_access reads
-// it.
+// scene (scene.hpp) holds a detail::lazy_slot (src/scene/scene_access.hpp, derived_kind::rays),
+// empty until rays.cpp builds the Embree scene into it on the first ray query or prepare_rays()
+// call.
 // The tests (tests/test_rays.cpp) and bench_rays include this header for the hooks below.
 #pragma once
 
@@ -18,12 +18,6 @@ namespace hemilight {
 namespace detail {
 
 struct ray_accel;  // defined in rays.cpp
-struct lazy_slot;  // src/scene/scene_access.hpp
-
-/// The private member of scene whose slot holds its ray_accel (null only for a scene not made by create).
-struct ray_access {
-  static lazy_slot* of(const scene& s) noexcept { return s.rays_.get(); }
-};
 
 /// The fallback queries over the scene's own BVH (rays_bvh.cpp): rays.hpp's contract, without Embree.
 /// rays.cpp uses them when the Embree scene could not be built; the tests run both.

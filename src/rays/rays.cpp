@@ -234,7 +234,7 @@ void build(const scene& s, ray_accel& a) noexcept {
 // take the fast path: an acquire load). Null only for a scene not made by scene::create or when
 // even the empty structure could not be allocated (the queries then use the fallback).
 ray_accel* built(const scene& s) noexcept {
-  lazy_slot* slot = ray_access::of(s);
+  lazy_slot* slot = derived_access::of(s, derived_kind::rays);
   if (!slot) return nullptr;
   if (!slot->done.load(std::memory_order_acquire))
     std::call_once(slot->once, [&] {

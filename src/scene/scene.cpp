@@ -161,7 +161,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
   }
   s->build_bvh();
-  s->rays_ = std::make_shared<detail::lazy_slot>();  // filled by the first ray query (rays.hpp)
+  for (auto& slot : s->derived_) slot = std::make_shared<detail::lazy_slot>();  // filled on first use (scene_access.hpp)
   return s;
 }
 

@@ -24,6 +24,15 @@ struct lazy_slot {
   std::shared_ptr<void> value;
 };
 
+/// The scene's lazy slots, one per kind of data a module derives from it: the ray queries' Embree
+/// scene (rays.cpp), the rasterizer's level-of-detail proxies (src/raster/lod.cpp) and the edges
+/// exact edge coverage may find hard (src/raster/edge_coverage.cpp). Null only for a scene not
+/// made by scene::create.
+enum class derived_kind : int { rays = 0, raster_lod = 1, raster_edges = 2 };
+struct derived_access {
+  static lazy_slot* of(const scene& s, derived_kind kind) noexcept { return s.derived_[static_cast<int>(kind)].get(); }
+};
+
 struct scene_access {
   /// The vertex coordinates of s.triangles() again, one array per coordinate:
   /// vertex_coordinates(s, v, a)[t] is coordinate a (0 = x, 1 = y, 2 = z) of vertex v (0, 1, 2) of
