@@ -10,7 +10,7 @@ mode=${1:-}
 case "$mode" in main|test) ;; *) echo "usage: bash .ci/build.sh main|test" >&2; exit 2 ;; esac
 
 # Debian packages the build, tests, examples and benchmarks need (Debian packages only: no vendored copies).
-packages=(cmake g++ make pkg-config libglm-dev catch2 libopenexr-dev libbenchmark-dev python3-matplotlib
+packages=(cmake g++ make pkg-config libglm-dev libeigen3-dev catch2 libopenexr-dev libbenchmark-dev python3-matplotlib
           glslang-tools libassimp-dev libpng-dev libstb-dev libembree-dev libmeshoptimizer-dev clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do

@@ -14,6 +14,8 @@
 #                                     converged, radius counters, before and after (docs/cache.md; ~1.5 h; not by default)
 #   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
+#   bash benchmarks/run.sh unwrap             the lightmap unwrapper: utilisation, stretch, seams, time, and bakes on its
+#                                     UVs against converged references (docs/unwrap.md; ~10 min; also in the default run)
 #   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
 #                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
