@@ -14,6 +14,9 @@
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 #   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
 #                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
+#   bash benchmarks/run.sh raster_levels      a hemicube's cost on the stand-in levels (default size and 1M
+#                                     triangles) over the hexagon room's, culling on and off, paired rounds
+#                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -139,6 +142,15 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream_open.csv --scenes pavilion,street,terrain \
       --parts cost,n,cache ${EDGE_DOWNSTREAM_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench edge_downstream_open
+    continue
+  fi
+  if [ "$n" = raster_levels ]; then
+    # Issue #33's ratio: cost per hemicube on each level / on hexagon_room(3), N = 64, in paired
+    # interleaved rounds (benchmarks/sweep_raster_levels.cpp has the flags). ~4 min on 2 cores.
+    echo "== sweep_raster_levels"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_raster_levels" docs/bench/raster_levels.csv ${RASTER_LEVELS_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_raster_levels.py docs/bench
     continue
   fi
   if [ "$n" = edge ]; then
