@@ -3,7 +3,9 @@
 #   bash benchmarks/run.sh            every benchmark and sweep
 #   bash benchmarks/run.sh NAME...    only these (e.g. geometry raster)
 #   bash benchmarks/run.sh bake_scaling       bake time and peak memory against triangles, lightmap size
-#                                     and threads (benchmarks/sweep_bake_scaling.cpp; long, not run by default)
+#                                     and threads, on a heightfield and the stand-in levels
+#                                     (benchmarks/sweep_bake_scaling.cpp; ~45-65 min, not run by default);
+#                                     BAKE_SCALING_FLAGS="--quick" or "--studies closed,open --append" etc.
 #   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 #   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
@@ -142,6 +144,14 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream_open.csv --scenes pavilion,street,terrain \
       --parts cost,n,cache ${EDGE_DOWNSTREAM_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench edge_downstream_open
+    continue
+  fi
+  if [ "$n" = bake_scaling ]; then
+    # Each bake in its own process (peak memory); the flags at the top of sweep_bake_scaling.cpp.
+    echo "== sweep_bake_scaling"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_bake_scaling" docs/bench/bake_scaling_sweep.csv ${BAKE_SCALING_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_bake_scaling.py docs/bench
     continue
   fi
   if [ "$n" = raster_levels ]; then
