@@ -16,6 +16,9 @@
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
 #   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
 #                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
+#   bash benchmarks/run.sh cycles             hemilight against Blender's Cycles on the arena at 1024²: error
+#                                     against time (benchmarks/cycles_compare.py; needs Debian's blender;
+#                                     ~1 h; CYCLES_FLAGS="--quick" for a few minutes; not run by default)
 #   bash benchmarks/run.sh raster_levels      a hemicube's cost on the stand-in levels (default size and 1M
 #                                     triangles) over the hexagon room's, culling on and off, paired rounds
 #                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
@@ -27,8 +30,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build-bench
+# Examples on: the Cycles comparison (cycles) runs hemilight_make_level and hemilight_bake.
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHEMILIGHT_BUILD_BENCHMARKS=ON \
-      -DHEMILIGHT_BUILD_TESTS=OFF -DHEMILIGHT_BUILD_EXAMPLES=OFF > /dev/null
+      -DHEMILIGHT_BUILD_TESTS=OFF -DHEMILIGHT_BUILD_EXAMPLES=ON > /dev/null
 cmake --build "$build" -j "$(nproc)"
 mkdir -p docs/bench
 names=("$@")
@@ -144,6 +148,14 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream_open.csv --scenes pavilion,street,terrain \
       --parts cost,n,cache ${EDGE_DOWNSTREAM_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench edge_downstream_open
+    continue
+  fi
+  if [ "$n" = cycles ]; then
+    # hemilight against Cycles (Blender 3.4.1, `apt-get install blender`): docs/levels.md. Each bake's
+    # outputs are kept in build-bench/cycles/ and reused; the flags at the top of cycles_compare.py.
+    echo "== cycles_compare"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    /usr/bin/python3 benchmarks/cycles_compare.py ${CYCLES_FLAGS-}
     continue
   fi
   if [ "$n" = bake_scaling ]; then
