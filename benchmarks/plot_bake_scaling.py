@@ -1,7 +1,10 @@
 """Draws docs/bench/bake_scaling.png from docs/bench/bake_scaling.csv (benchmarks/sweep_bake_scaling.cpp):
 bake wall time (left axes, blue) and peak memory (right axes, red) of the heightfield bake against
 the triangle count (log-log), the lightmap texels (log-log) and the thread count, with labelled
-reference slopes and the measured log-log slopes of every series.
+reference slopes and the measured log-log slopes of every series; below, the same against the
+triangle count for the closed and the open stand-in levels (studies closed, open; one line per
+level), and the cost per hemicube of every triangle series. Prints the level series' slopes per
+step (the exponent per decade, or per half decade).
 
 usage: plot_bake_scaling.py [folder]   (default docs/bench; reads FOLDER/bake_scaling.csv, or
 FOLDER/bake_scaling_sweep.csv, the name benchmarks/run.sh gives sweep CSVs, if the first is missing)
@@ -178,16 +181,103 @@ def threads_panel(ax, rows):
     finish(ax, mem_ax, h, note)
 
 
+LEVEL_STYLES = ["o-", "D--"]
+
+
+def levels_panel(ax, rows, title, kind):
+    """Time and peak memory of each level of one study (closed or open) against its triangles
+    (log-log), one line per level, with the O(T) and O(log T) references from the first point."""
+    if not rows:
+        return empty(ax, title)
+    size, threads = int(rows[0]["size"]), int(rows[0]["threads"])
+    mem_ax = ax.twinx()
+    h, notes = [], []
+    levels = sorted({r["scene"] for r in rows}, key=lambda s: min(r["triangles"] for r in rows if r["scene"] == s))
+    for i, name in enumerate(levels):
+        lr = sorted((r for r in rows if r["scene"] == name), key=lambda r: r["triangles"])
+        t = [r["triangles"] for r in lr]
+        sec = [r["seconds"] for r in lr]
+        mem = [r["peak_mib"] for r in lr]
+        style = LEVEL_STYLES[i % len(LEVEL_STYLES)]
+        h.append(ax.plot(t, sec, style, color=TIME, label=f"{name}: time (slope {fmt_slope(loglog_slope(t, sec))})")[0])
+        h.append(mem_ax.plot(t, mem, style.replace("o", "s"), color=MEMORY, mfc="none",
+                             label=f"{name}: peak memory (slope {fmt_slope(loglog_slope(t, mem))})")[0])
+        for r in lr:
+            ax.annotate(f"{us_per_hemicube(r):.0f} µs/hc", (r["triangles"], r["seconds"]), fontsize=6,
+                        textcoords="offset points", xytext=(4, -9 if i == 0 else 5), color=TIME)
+        per_t = bytes_per(lr, "triangles")
+        hc = [r["hemicubes"] for r in lr]
+        notes.append(f"{name}: time slope per step {step_slopes(t, sec)}; µs/hc {step_slopes(t, [us_per_hemicube(r) for r in lr])}; "
+                     f"memory {step_slopes(t, mem)}\n  hemicubes {int(min(hc))}-{int(max(hc))}"
+                     + (f", marginal peak memory {per_t:.0f} B/triangle" if per_t is not None else ""))
+        if i == 0:
+            h.append(reference(ax, t, t[0], sec[0], "n", "--", TIME_REFERENCE, "time O(T) from the first point"))
+            h.append(reference(ax, t, t[0], sec[0], "log n", ":", TIME_REFERENCE, "time O(log T) from the first point"))
+    finish_loglog(ax, mem_ax, h, "\n".join(notes),
+                  f"triangles ({kind} levels, {size}² lightmap whatever T, with their sun, {threads} threads)", title)
+
+
+def cost_panel(ax, rows):
+    """Thread-µs of bake per hemicube against triangles for every triangle series (log-log)."""
+    title = "(f) bake time per hemicube"
+    series = [("heightfield", study(rows, "triangles", "triangles"))]
+    for st in ("closed", "open"):
+        lr = study(rows, st, "triangles")
+        for name in sorted({r["scene"] for r in lr}):
+            series.append((name, [r for r in lr if r["scene"] == name]))
+    series = [(n, s) for n, s in series if s]
+    if not series:
+        return empty(ax, title)
+    for name, lr in series:
+        t = [r["triangles"] for r in lr]
+        us = [us_per_hemicube(r) for r in lr]
+        ax.plot(t, us, "o-", label=f"{name} (slope {fmt_slope(loglog_slope(t, us))})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("triangles")
+    ax.set_ylabel("bake thread-µs per hemicube (wall x threads / hemicubes)")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+
+
+def print_levels(rows):
+    """The level series as docs/bake.md tables them, with the slope of each step."""
+    for st in ("closed", "open"):
+        lr = study(rows, st, "triangles")
+        for name in sorted({r["scene"] for r in lr}):
+            s = [r for r in lr if r["scene"] == name]
+            t = [r["triangles"] for r in s]
+            print(f"{st} {name} ({int(s[0]['size'])}², {int(s[0]['threads'])} threads): triangles "
+                  + " / ".join(f"{int(x):,}" for x in t))
+            print("  bake s " + " / ".join(f"{r['seconds']:.1f}" for r in s) + f"  (slope per step {step_slopes(t, [r['seconds'] for r in s])})")
+            print("  hemicubes " + " / ".join(f"{r['hemicubes'] / 1000:.1f}k" for r in s)
+                  + "  sampled " + " / ".join(f"{r['sampled_texels'] / 1000:.0f}k" for r in s))
+            us = [us_per_hemicube(r) for r in s]
+            print("  thread-µs per hemicube " + " / ".join(f"{u:.0f}" for u in us) + f"  (slope per step {step_slopes(t, us)})")
+            if all("render_seconds" in r and r["render_seconds"] != "" for r in s):
+                print("  hemicube share of the bake " + " / ".join(f"{100 * r['render_seconds'] / r['seconds']:.0f}%" for r in s))
+            print("  peak MiB " + " / ".join(f"{r['peak_mib']:.0f}" for r in s)
+                  + f"  (slope per step {step_slopes(t, [r['peak_mib'] for r in s])})")
+
+
 def main():
     """Reads the CSV named by the first argument's folder and writes bake_scaling.png next to it."""
     folder = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
     rows = load_csv(csv_path(folder))
-    fig, axes = plt.subplots(1, 3, figsize=(18, 7.5))
-    triangles_panel(axes[0], study(rows, "triangles", "triangles"))
-    texels_panel(axes[1], study(rows, "size", "size"))
-    threads_panel(axes[2], study(rows, "threads", "threads"))
-    fig.suptitle("Lightmap bake scaling (heightfield with planar UVs, N = 64, 1 bounce, default cache a = 0.2; "
-                 "one bake per point, each in its own process; measured slopes in the legends)", fontsize=10)
+    has_levels = any(r["study"] in ("closed", "open") for r in rows)
+    fig, axes = plt.subplots(2 if has_levels else 1, 3, figsize=(18, 15 if has_levels else 7.5), squeeze=False)
+    triangles_panel(axes[0][0], study(rows, "triangles", "triangles"))
+    texels_panel(axes[0][1], study(rows, "size", "size"))
+    threads_panel(axes[0][2], study(rows, "threads", "threads"))
+    if has_levels:
+        levels_panel(axes[1][0], study(rows, "closed", "triangles"), "(d) closed levels against triangles", "closed")
+        levels_panel(axes[1][1], study(rows, "open", "triangles"), "(e) open levels against triangles", "open")
+        cost_panel(axes[1][2], rows)
+        print_levels(rows)
+    fig.suptitle("Lightmap bake scaling (N = 64, 1 bounce, default cache a = 0.2; heightfield with planar UVs"
+                 + ("; stand-in levels with their sun" if has_levels else "")
+                 + "; one bake per point, each in its own process; measured slopes in the legends)", fontsize=10)
     fig.tight_layout()
     fig.savefig(os.path.join(folder, "bake_scaling.png"), dpi=110)
     print(f"wrote {os.path.join(folder, 'bake_scaling.png')}")

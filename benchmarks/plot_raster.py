@@ -12,9 +12,13 @@ out = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 m = medians(load_gbench(f"{out}/raster.csv"))
 # name: raster/<scene>/N:<n>/threads:<t>[/...]; items_per_second is per CPU second for one thread,
 # per wall-clock second for all threads./real_time
+# The stand-in levels' rows (raster/<level>/N:64/threads:<t>/culling:<on|off>, N = 64 only) are left
+# out: docs/raster.md tables them, and plot_raster_levels.py charts their paired-round ratios.
 series = {}
 for name, row in m.items():
     parts = name.split("/")
+    if any(p.startswith("culling:") for p in parts):
+        continue
     scene, n, threads = parts[1], int(parts[2].split(":")[1]), int(parts[3].split(":")[1])
     series.setdefault((scene, threads), []).append((n, row["items_per_second"]))
 

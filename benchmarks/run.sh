@@ -3,7 +3,9 @@
 #   bash benchmarks/run.sh            every benchmark and sweep
 #   bash benchmarks/run.sh NAME...    only these (e.g. geometry raster)
 #   bash benchmarks/run.sh bake_scaling       bake time and peak memory against triangles, lightmap size
-#                                     and threads (benchmarks/sweep_bake_scaling.cpp; long, not run by default)
+#                                     and threads, on a heightfield and the stand-in levels
+#                                     (benchmarks/sweep_bake_scaling.cpp; ~45-65 min, not run by default);
+#                                     BAKE_SCALING_FLAGS="--quick" or "--studies closed,open --append" etc.
 #   bash benchmarks/run.sh cache_resolution   the cache at hemicube N = 64..512 against a converged
 #                                     reference (docs/cache.md; ~25-40 min on 2 cores, not run by default)
 #   bash benchmarks/run.sh cache_weights      the cache's interpolation weights, ward against
@@ -14,8 +16,16 @@
 #                                     converged, radius counters, before and after (docs/cache.md; ~1.5 h; not by default)
 #   bash benchmarks/run.sh edge_downstream    what exact edge coverage buys downstream (docs/raster.md; ~2.5 min; also
 #                                     in the default run); EDGE_DOWNSTREAM_FLAGS="--parts cost" etc. runs a subset
+#   bash benchmarks/run.sh unwrap             the lightmap unwrapper: utilisation, stretch, seams, time, and bakes on its
+#                                     UVs against converged references (docs/unwrap.md; ~10 min; also in the default run)
 #   bash benchmarks/run.sh edge_downstream_open  the same (parts cost, n, cache) on the open scenes: the
 #                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
+#   bash benchmarks/run.sh cycles             hemilight against Blender's Cycles on the arena at 1024²: error
+#                                     against time (benchmarks/cycles_compare.py; needs Debian's blender;
+#                                     ~1 h; CYCLES_FLAGS="--quick" for a few minutes; not run by default)
+#   bash benchmarks/run.sh raster_levels      a hemicube's cost on the stand-in levels (default size and 1M
+#                                     triangles) over the hexagon room's, culling on and off, paired rounds
+#                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -24,8 +34,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build-bench
+# Examples on: the Cycles comparison (cycles) runs hemilight_make_level and hemilight_bake.
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHEMILIGHT_BUILD_BENCHMARKS=ON \
-      -DHEMILIGHT_BUILD_TESTS=OFF -DHEMILIGHT_BUILD_EXAMPLES=OFF > /dev/null
+      -DHEMILIGHT_BUILD_TESTS=OFF -DHEMILIGHT_BUILD_EXAMPLES=ON > /dev/null
 cmake --build "$build" -j "$(nproc)"
 mkdir -p docs/bench
 names=("$@")
@@ -159,6 +170,32 @@ for n in "${names[@]}"; do
     "$build/benchmarks/sweep_edge_downstream" docs/bench/edge_downstream_open.csv --scenes pavilion,street,terrain \
       --parts cost,n,cache ${EDGE_DOWNSTREAM_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_edge_downstream.py docs/bench edge_downstream_open
+    continue
+  fi
+  if [ "$n" = cycles ]; then
+    # hemilight against Cycles (Blender 3.4.1, `apt-get install blender`): docs/levels.md. Each bake's
+    # outputs are kept in build-bench/cycles/ and reused; the flags at the top of cycles_compare.py.
+    echo "== cycles_compare"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    /usr/bin/python3 benchmarks/cycles_compare.py ${CYCLES_FLAGS-}
+    continue
+  fi
+  if [ "$n" = bake_scaling ]; then
+    # Each bake in its own process (peak memory); the flags at the top of sweep_bake_scaling.cpp.
+    # Writes the CSV the docs cite (docs/bench/bake_scaling.csv; --append adds to it).
+    echo "== sweep_bake_scaling"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_bake_scaling" docs/bench/bake_scaling.csv ${BAKE_SCALING_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_bake_scaling.py docs/bench
+    continue
+  fi
+  if [ "$n" = raster_levels ]; then
+    # The levels' ratio: cost per hemicube on each level / on hexagon_room(3), N = 64, in paired
+    # interleaved rounds (benchmarks/sweep_raster_levels.cpp has the flags). ~4 min on 2 cores.
+    echo "== sweep_raster_levels"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_raster_levels" docs/bench/raster_levels.csv ${RASTER_LEVELS_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_raster_levels.py docs/bench
     continue
   fi
   if [ "$n" = edge ]; then

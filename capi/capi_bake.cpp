@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -44,20 +45,23 @@ struct uv_target {
   float map(float uv, int c) const { return placement ? uv * placement->uv_scale[c] + placement->uv_offset[c] : uv; }
 };
 
-std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, const uv_target& target) {
+// With `strict`, a triangle with 3D area but no UV area is a problem (without, the bake counts it).
+std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name, const uv_target& target, bool strict) {
   const int width = target.width, height = target.height;
   if (std::string p = hemilight::capi::positions_problem(mesh.positions, mesh.vertex_count, name + ".positions"); !p.empty())
     return p;
+  constexpr float lo = -hemilight::lightmap_uv_tolerance, hi = 1.0f + hemilight::lightmap_uv_tolerance;
   if (!target.occluder())
     for (std::size_t i = 0; i < 2 * mesh.vertex_count; ++i) {
       const float q = target.map(mesh.lightmap_uvs[i], int(i % 2));
-      if (!(q >= 0.0f && q <= 1.0f)) {
+      if (!(q >= lo && q <= hi)) {
         if (!target.placement)
           return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
-                 ") = " + std::to_string(mesh.lightmap_uvs[i]) + "; it must be in [0, 1]";
+                 ") = " + std::to_string(mesh.lightmap_uvs[i]) + "; it must be in [0, 1] (or at most 0.001 outside: clamped)";
         return name + ".lightmap_uvs[" + std::to_string(i) + "] (vertex " + std::to_string(i / 2) + ", " + (i % 2 ? "v" : "u") +
                ") = " + std::to_string(mesh.lightmap_uvs[i]) + " maps to " + std::to_string(q) + " in page " +
-               std::to_string(target.placement->page) + " (uv * uv_scale + uv_offset); it must be in [0, 1]";
+               std::to_string(target.placement->page) +
+               " (uv * uv_scale + uv_offset); it must be in [0, 1] (or at most 0.001 outside: clamped)";
       }
     }
   if (mesh.normals)
@@ -65,21 +69,21 @@ std::string check_mesh(const hemilight_bake_mesh& mesh, const std::string& name,
       if (!std::isfinite(mesh.normals[i]))
         return name + ".normals[" + std::to_string(i) + "] (vertex " + std::to_string(i / 3) + ") = " +
                std::to_string(mesh.normals[i]) + "; it must be finite";
-  // A triangle with 3D area but no UV area: the baker's own test (src/bake/coverage.cpp, make_tri), computed the
-  // same way, so that the message names the mesh and the triangle within it.
-  for (std::size_t t = 0; t < mesh.triangle_count && !target.occluder(); ++t) {
+  // With strict, a triangle with 3D area but no UV area: the baker's own test (src/bake/coverage.cpp,
+  // triangles_in_texels) on the UVs it bakes (clamped), so that the message names the mesh and the
+  // triangle within it.
+  for (std::size_t t = 0; strict && t < mesh.triangle_count && !target.occluder(); ++t) {
     const std::uint32_t* idx = mesh.indices + 3 * t;
     if (idx[0] >= mesh.vertex_count || idx[1] >= mesh.vertex_count || idx[2] >= mesh.vertex_count) continue;  // named later
     glm::dvec2 uv[3];
-    glm::dvec3 p[3];
+    glm::vec3 p[3];
     for (int k = 0; k < 3; ++k) {
-      uv[k] = glm::dvec2(double(target.map(mesh.lightmap_uvs[2 * idx[k]], 0)) * width,
-                         double(target.map(mesh.lightmap_uvs[2 * idx[k] + 1], 1)) * height);
-      p[k] = glm::dvec3(glm::vec3(mesh.positions[3 * idx[k]], mesh.positions[3 * idx[k] + 1], mesh.positions[3 * idx[k] + 2]));
+      uv[k] = glm::dvec2(double(std::clamp(target.map(mesh.lightmap_uvs[2 * idx[k]], 0), 0.0f, 1.0f)) * width,
+                         double(std::clamp(target.map(mesh.lightmap_uvs[2 * idx[k] + 1], 1), 0.0f, 1.0f)) * height);
+      p[k] = glm::vec3(mesh.positions[3 * idx[k]], mesh.positions[3 * idx[k] + 1], mesh.positions[3 * idx[k] + 2]);
     }
     const double uv_area = 0.5 * std::fabs((uv[1].x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[1].y - uv[0].y) * (uv[2].x - uv[0].x));
-    const double area3 = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
-    if (area3 > 0.0 && !(uv_area > 1e-12 * double(width) * double(height)))
+    if (!hemilight::is_degenerate_triangle(p[0], p[1], p[2]) && !(uv_area > 1e-12 * double(width) * double(height)))
       return name + ": triangle " + std::to_string(t) + " (indices[" + std::to_string(3 * t) + ".." + std::to_string(3 * t + 2) +
              "]) has zero area in " + (target.placement ? "its page's" : "lightmap") +
              " UV space (but not in 3D): it would get no texels";
@@ -181,7 +185,7 @@ hemilight_status check_common_options(const char* fn, const hemilight_bake_optio
   if (o.dilation < -1) return invalid(fn, "options->dilation " + std::to_string(o.dilation) + " must be >= -1 (-1: fill every texel)");
   if (o.thread_count < 0) return invalid(fn, "options->thread_count " + std::to_string(o.thread_count) + " must be >= 0 (0: all cores)");
   const std::pair<const char*, int> switches[] = {
-      {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}};
+      {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}, {"strict", o.strict}};
   for (const auto& sw : switches)
     if (sw.second != 0 && sw.second != 1)
       return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
@@ -211,7 +215,7 @@ struct gathered_scene {
 };
 
 hemilight_status gather_meshes(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
-                               const std::vector<uv_target>& targets, gathered_scene& g, const char* prefix = "") {
+                               const std::vector<uv_target>& targets, bool strict, gathered_scene& g, const char* prefix = "") {
   size_t total_vertices = 0, total_triangles = 0;
   for (size_t m = 0; m < mesh_count; ++m) {
     total_vertices += meshes[m].vertex_count;
@@ -229,7 +233,7 @@ hemilight_status gather_meshes(const char* fn, const hemilight_bake_mesh* meshes
       return invalid(fn, name + ": positions or lightmap_uvs is NULL with vertex_count " + std::to_string(mesh.vertex_count));
     if (mesh.triangle_count > 0 && !mesh.indices)
       return invalid(fn, name + ".indices is NULL with triangle_count " + std::to_string(mesh.triangle_count));
-    if (const std::string problem = check_mesh(mesh, name, targets[m]); !problem.empty()) return invalid(fn, problem);
+    if (const std::string problem = check_mesh(mesh, name, targets[m], strict); !problem.empty()) return invalid(fn, problem);
     const auto base = std::uint32_t(g.positions.size());
     for (size_t v = 0; v < mesh.vertex_count; ++v) {
       g.positions.emplace_back(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
@@ -263,7 +267,9 @@ hemilight::bake_input input_of(const gathered_scene& g, const hemilight_bake_opt
   return in;
 }
 
-hemilight_bake_stats stats_of(const hemilight::bake_stats& s) {
+// The C statistics of a bake of the meshes (their triangles concatenated in order): the first
+// triangle without UV area named by its mesh and its index there.
+hemilight_bake_stats stats_of(const hemilight::bake_stats& s, const hemilight_bake_mesh* meshes, size_t mesh_count) {
   hemilight_bake_stats st;
   st.struct_size = sizeof st;
   st.sampled_texels = s.sampled_texels;
@@ -273,6 +279,19 @@ hemilight_bake_stats stats_of(const hemilight::bake_stats& s) {
   st.hemicubes = s.hemicubes;
   st.records = s.records;
   st.seconds = s.seconds;
+  st.degenerate_triangles = s.degenerate_triangles;
+  st.no_uv_area_triangles = s.no_uv_area_triangles;
+  st.first_no_uv_area_mesh = st.first_no_uv_area_triangle = SIZE_MAX;
+  st.clamped_uvs = s.clamped_uvs;
+  std::size_t t = s.first_no_uv_area_triangle;
+  for (size_t m = 0; t != hemilight::bake_stats::no_index && m < mesh_count; ++m) {
+    if (t < meshes[m].triangle_count) {
+      st.first_no_uv_area_mesh = m;
+      st.first_no_uv_area_triangle = t;
+      break;
+    }
+    t -= meshes[m].triangle_count;
+  }
   return st;
 }
 
@@ -415,7 +434,8 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     uv_target target;
     target.width = o.width;
     target.height = o.height;
-    if (const hemilight_status st = gather_meshes(fn, meshes, mesh_count, std::vector<uv_target>(mesh_count, target), g)) return st;
+    if (const hemilight_status st = gather_meshes(fn, meshes, mesh_count, std::vector<uv_target>(mesh_count, target), o.strict == 1, g))
+      return st;
     // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
     const hemilight::bake_options bo =
         hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), sh_l1_rgb != nullptr, hl2_rgb != nullptr);
@@ -423,7 +443,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     // Step 4: the outputs, only when everything is finite.
     if (!result_finite(r)) return invalid(fn, overflow_message);
     write_page(r, page, mask);
-    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
+    if (stats) hemilight::capi::write_sized(stats_of(r.stats, meshes, mesh_count), stats);
     return HEMILIGHT_OK;
   });
 }
@@ -520,7 +540,7 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
     std::vector<uv_target> targets;
     if (const hemilight_status st = placement_targets(fn, sd, targets)) return st;
     gathered_scene g;
-    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, g, "scene->")) return st;
+    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, o.strict == 1, g, "scene->")) return st;
     // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
     const hemilight::bake_options bo = hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
     const hemilight::scene_bake_result r = hemilight::bake_scene(scene_input_of(sd, g, o), bo);
@@ -528,7 +548,7 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
     for (const hemilight::bake_result& page : r.pages)
       if (!result_finite(page)) return invalid(fn, overflow_message);
     for (size_t p = 0; p < sd.page_count; ++p) write_page(r.pages[p], sd.pages[p], mask);
-    if (stats) hemilight::capi::write_sized(stats_of(r.stats), stats);
+    if (stats) hemilight::capi::write_sized(stats_of(r.stats, sd.meshes, sd.mesh_count), stats);
     return HEMILIGHT_OK;
   });
 }

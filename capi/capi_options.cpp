@@ -41,7 +41,8 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, environment_rgb), HEMILIGHT_SPAN(hemilight_bake_options, environment_size),
     HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
-    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage)};
+    HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage),
+    HEMILIGHT_SPAN(hemilight_bake_options, strict)};  // (reserved1 is padding: never read)
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -49,7 +50,10 @@ const span bake_stats_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_stats, struct_size), HEMILIGHT_SPAN(hemilight_bake_stats, sampled_texels),
     HEMILIGHT_SPAN(hemilight_bake_stats, invalid_texels), HEMILIGHT_SPAN(hemilight_bake_stats, dilated_texels),
     HEMILIGHT_SPAN(hemilight_bake_stats, overlapping_texels), HEMILIGHT_SPAN(hemilight_bake_stats, hemicubes),
-    HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds)};
+    HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds),
+    HEMILIGHT_SPAN(hemilight_bake_stats, degenerate_triangles), HEMILIGHT_SPAN(hemilight_bake_stats, no_uv_area_triangles),
+    HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_mesh), HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_triangle),
+    HEMILIGHT_SPAN(hemilight_bake_stats, clamped_uvs)};
 const span cubemap_irradiance_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, struct_size),
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, method),
@@ -60,15 +64,20 @@ const span cubemap_irradiance_options_fields[] = {
 // The sizes of this ABI's layouts (x86-64 and every LP64 ABI). A struct that grows keeps its old
 // size here and its new fields start at or after it: edge_coverage was appended to the cache
 // options of 96 bytes (after the padding field reserved0, since offset 92 was the old layout's
-// tail padding) and to the bake options of 144.
+// tail padding) and to the bake options of 144; strict to the bake options of 152 (after the
+// padding field reserved1); the bake statistics' input counts to the statistics of 64.
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 104, "hemilight_cache_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_cache_options, edge_coverage) >= 96,
               "hemilight_cache_options: edge_coverage must start past the earlier layout's sizeof");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 152, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 160, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, edge_coverage) >= 144,
               "hemilight_bake_options: edge_coverage must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, strict) >= 152,
+              "hemilight_bake_options: strict must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 64, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 104, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_stats, degenerate_triangles) >= 64,
+              "hemilight_bake_stats: the input counts must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cubemap_irradiance_options) == 24,
               "hemilight_cubemap_irradiance_options changed: see above");
 
@@ -149,6 +158,7 @@ hemilight_bake_options default_bake_options() {
   o.shadow_mask_rgba = nullptr;
   o.shadow_mask_capacity = 0;
   o.edge_coverage = bake_options{}.sampler.raster.edge_coverage ? 1 : 0;
+  o.strict = bake_options{}.strict ? 1 : 0;
   return o;
 }
 
@@ -254,6 +264,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.output_hl2 = output_hl2;
   for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
   o.sampler.raster.edge_coverage = c.edge_coverage == 1;
+  o.strict = c.strict == 1;
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;
@@ -354,3 +365,79 @@ extern "C" void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* 
   hemilight::capi::init_sized(scene, struct_size, hemilight::capi::default_bake_scene_desc(),
                               hemilight::capi::bake_scene_desc_fields);
 }
+
+// ---- hemilight_unwrap_options and hemilight_unwrap_stats (growable like the options above) -------
+
+namespace hemilight::capi {
+namespace {
+
+#define HEMILIGHT_SPAN(T, f) span { offsetof(T, f), sizeof(static_cast<T*>(nullptr)->f) }
+const span unwrap_options_fields[] = {
+    HEMILIGHT_SPAN(hemilight_unwrap_options, struct_size), HEMILIGHT_SPAN(hemilight_unwrap_options, texels_per_unit),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, page_size), HEMILIGHT_SPAN(hemilight_unwrap_options, padding),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, max_chart_angle), HEMILIGHT_SPAN(hemilight_unwrap_options, max_pages),
+    HEMILIGHT_SPAN(hemilight_unwrap_options, thread_count)};
+const span unwrap_stats_fields[] = {
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, struct_size), HEMILIGHT_SPAN(hemilight_unwrap_stats, charts),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, planar_charts), HEMILIGHT_SPAN(hemilight_unwrap_stats, degenerate_triangles),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, pages), HEMILIGHT_SPAN(hemilight_unwrap_stats, texels_per_unit),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, uv_area_fraction), HEMILIGHT_SPAN(hemilight_unwrap_stats, stretch_l2),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, stretch_linf), HEMILIGHT_SPAN(hemilight_unwrap_stats, seam_texels),
+    HEMILIGHT_SPAN(hemilight_unwrap_stats, seconds)};
+#undef HEMILIGHT_SPAN
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_unwrap_options) == 32, "hemilight_unwrap_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_unwrap_stats) == 80, "hemilight_unwrap_stats changed: see above");
+
+}  // namespace
+
+hemilight_unwrap_options default_unwrap_options() {
+  hemilight_unwrap_options o = zeroed<hemilight_unwrap_options>();
+  const unwrap_options d;
+  o.struct_size = sizeof o;
+  o.texels_per_unit = d.texels_per_unit;
+  o.page_size = d.page_size;
+  o.padding = d.padding;
+  o.max_chart_angle = d.max_chart_angle;
+  o.max_pages = d.max_pages;
+  o.thread_count = d.thread_count;
+  return o;
+}
+
+std::string read_sized(const hemilight_unwrap_options* in, hemilight_unwrap_options& out) {
+  return read(in, out, unwrap_options_fields, "hemilight_unwrap_options_init");
+}
+
+unwrap_options to_cpp(const hemilight_unwrap_options& c) {
+  unwrap_options o;
+  o.texels_per_unit = c.texels_per_unit;
+  o.page_size = c.page_size;
+  o.padding = c.padding;
+  o.max_chart_angle = c.max_chart_angle;
+  o.max_pages = c.max_pages;
+  o.thread_count = c.thread_count;
+  return o;
+}
+
+std::string check_sized(const hemilight_unwrap_stats* stats) {
+  return size_problem("stats", "hemilight_unwrap_stats_init", stats->struct_size, sizeof *stats);
+}
+
+void write_sized(const hemilight_unwrap_stats& from, hemilight_unwrap_stats* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(unwrap_stats_fields, &from, out, size);
+  out->struct_size = size;
+}
+
+}  // namespace hemilight::capi
+
+extern "C" {
+
+void hemilight_unwrap_options_init_sized(hemilight_unwrap_options* options, size_t struct_size) {
+  hemilight::capi::init_sized(options, struct_size, hemilight::capi::default_unwrap_options(), hemilight::capi::unwrap_options_fields);
+}
+
+void hemilight_unwrap_stats_init_sized(hemilight_unwrap_stats* stats, size_t struct_size) {
+  hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_unwrap_stats>(), hemilight::capi::unwrap_stats_fields);
+}
+
+}  // extern "C"

@@ -8,6 +8,7 @@
 #include "hemilight/bake.hpp"
 #include "hemilight/cache.hpp"
 #include "hemilight/cubemap.hpp"
+#include "hemilight/unwrap.hpp"
 
 #include <memory>
 #include <string>
@@ -59,5 +60,19 @@ namespace hemilight::capi {
 /// caller's fields within its struct_size over them (returns "" or what is wrong with struct_size).
 hemilight_bake_scene_desc default_bake_scene_desc();
 std::string read_sized(const hemilight_bake_scene_desc* in, hemilight_bake_scene_desc& out);
+
+}  // namespace hemilight::capi
+
+namespace hemilight::capi {
+
+/// hemilight_unwrap_options: the defaults (the C++ defaults), the caller's fields within its
+/// struct_size over them, and the C++ options (checked later by validate_unwrap_options).
+hemilight_unwrap_options default_unwrap_options();
+std::string read_sized(const hemilight_unwrap_options* in, hemilight_unwrap_options& out);
+unwrap_options to_cpp(const hemilight_unwrap_options& c);
+
+/// hemilight_unwrap_stats: the struct_size check and the write within it (as for the bake's).
+std::string check_sized(const hemilight_unwrap_stats* stats);
+void write_sized(const hemilight_unwrap_stats& from, hemilight_unwrap_stats* out);
 
 }  // namespace hemilight::capi

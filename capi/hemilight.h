@@ -32,7 +32,8 @@
  *
  * Structs that grow (what stays compatible)
  *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
- *     hemilight_bake_stats and hemilight_bake_scene_desc begin with size_t struct_size. Their _init functions are inline (below)
+ *     hemilight_bake_stats, hemilight_bake_scene_desc, hemilight_unwrap_options and
+ *     hemilight_unwrap_stats begin with size_t struct_size. Their _init functions are inline (below)
  *     and record the sizeof the program was compiled with; call one before use.
  *   - A later minor version only appends fields to them, each new field starting at or after the
  *     previous version's sizeof. The library reads the fields that lie within the caller's
@@ -566,6 +567,14 @@ typedef struct hemilight_bake_options {
   /* Since 0.14; 0 or 1: every hemicube of the bake with exact edge coverage, as
    * hemilight_cache_options.edge_coverage (default 0). */
   int edge_coverage;
+  int reserved1;           /* padding, not read: keeps strict past the earlier layout's sizeof */
+  /* Since 0.15; 0 or 1 (default 0). A triangle with 3D area but no lightmap UV area (at most 1e-12
+   * of the UV square): 0, it still occludes, gets no texels and is counted in the statistics
+   * (no_uv_area_triangles, first_no_uv_area_mesh and _triangle); 1, the bake fails with
+   * INVALID_ARGUMENT naming it. Degenerate triangles (no 3D area at float precision: twice their
+   * area at most 2^-22 x longest edge x largest coordinate magnitude) are skipped either way:
+   * no texels, never occlude, counted (degenerate_triangles). */
+  int strict;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */
@@ -584,6 +593,13 @@ typedef struct hemilight_bake_stats {
   size_t hemicubes;          /* hemicubes rendered, all bounces */
   size_t records;            /* irradiance cache records, all bounces */
   double seconds;            /* wall time */
+  /* Since 0.15: the input the bake went past (hemilight_bake_options.strict). */
+  size_t degenerate_triangles;       /* triangles without 3D area: skipped (no texels, never occlude) */
+  size_t no_uv_area_triangles;       /* triangles with 3D area but no lightmap UV area: occlude, no texels */
+  size_t first_no_uv_area_mesh;      /* the first of them: its mesh (index into meshes) and its index in */
+  size_t first_no_uv_area_triangle;  /* that mesh; both SIZE_MAX when there is none */
+  size_t clamped_uvs;                /* lightmap UVs (vertices; scene bakes: page UVs) at most 0.001 outside
+                                        [0, 1], clamped onto it (beyond 0.001 they are refused) */
 } hemilight_bake_stats;
 
 /* As hemilight_cache_stats_init, for bake statistics. */
@@ -602,14 +618,18 @@ static inline void hemilight_bake_stats_init(hemilight_bake_stats* stats) {
  * valid: NULL, or at least width height bytes (valid_capacity): 1 where the texel was sampled
  *   and its samples were valid (not inside geometry), 0 for dilated or invalid texels.
  * stats may be NULL. Write the result with hemilight_exr_save_rgb.
+ * Degenerate input is not refused: triangles without 3D area are skipped, UVs at most 0.001
+ * outside [0, 1] clamped, triangles with 3D area but no UV area occlude without texels (unless
+ * options->strict); the statistics count each.
  * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
  * NULL options/irradiance_rgb, capacities too small, options or struct_size (options, stats) out
  * of range (the message names the field), NULL arrays with nonzero counts, NaN/Inf positions,
- * normals or UVs, positions beyond 1e18 in magnitude, UVs outside [0, 1], indices out of range, a
- * triangle with 3D area but zero UV area, invalid materials, no texel covered, an environment map
- * with a bad size or a value negative, non-finite or above 1e30 (named by index), a result that
- * overflows float; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when progress
- * returned 0.
+ * normals or UVs, positions beyond 1e18 in magnitude, UVs more than 0.001 outside [0, 1], indices
+ * out of range, with options->strict a triangle with 3D area but zero UV area ("meshes[1]:
+ * triangle 0 (indices[0..2]) has zero area ..."), invalid materials, no texel covered, an
+ * environment map with a bad size or a value negative, non-finite or above 1e30 (named by index),
+ * a result that overflows float; OUT_OF_MEMORY over 2^31 - 1 vertices or triangles; CANCELLED when
+ * progress returned 0.
  * Cost: see hemilight_cache_irradiance, once per bounce. */
 HEMILIGHT_API hemilight_status hemilight_bake_lightmap(const hemilight_bake_mesh* meshes, size_t mesh_count,
                                                        const hemilight_bake_options* options, float* irradiance_rgb,
@@ -807,12 +827,13 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
  * mesh_count or page_count 0, NULL meshes/placements/pages, an unknown occluder_radiance, a page
  * size out of range, a NULL irradiance_rgb or a capacity too small, an albedo or emission value
  * out of range ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or
- * non-finite scale/offset, a page UV outside [0, 1] ("meshes[2].lightmap_uvs[9] (vertex 4, v) =
- * 0.9 maps to 1.3 in page 1"), a triangle with no area in its page, everything
- * hemilight_bake_lightmap rejects in the meshes and options, no texel sampled in any page, a
- * result that overflows float; OUT_OF_MEMORY, CANCELLED as there, and OUT_OF_MEMORY when the
- * pages' atlas (the widest page x the sum of the heights and two guard rows between pages) passes
- * 2^28 texels (checked before it is allocated).
+ * non-finite scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9]
+ * (vertex 4, v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in
+ * its page (without: counted, as hemilight_bake_lightmap does), everything hemilight_bake_lightmap
+ * rejects in the meshes and options, no texel sampled in any page, a result that overflows float;
+ * OUT_OF_MEMORY, CANCELLED as there, and OUT_OF_MEMORY when the pages' atlas (the widest page x
+ * the sum of the heights and two guard rows between pages) passes 2^28 texels (checked before it
+ * is allocated).
  * Cost: as hemilight_bake_lightmap over the sum of the pages' texels. */
 HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
                                                     hemilight_bake_stats* stats);
@@ -859,6 +880,81 @@ HEMILIGHT_API hemilight_status hemilight_cubemap_irradiance(const float* input, 
                                                             hemilight_edge_fixup fixup, int output_size,
                                                             const hemilight_cubemap_irradiance_options* options,
                                                             float* output);
+/* ---- lightmap UVs -------------------------------------------------------------------------------
+ * hemilight_generate_lightmap_uvs gives a mesh lightmap UVs (include/hemilight/unwrap.hpp,
+ * docs/unwrap.md): vertices at the same position welded, charts grown by normal deviation (planar
+ * ones projected, curved ones flattened by least-squares conformal maps), packed with padding
+ * into square pages at a texel density or into one page. The result is new vertex arrays: each
+ * output vertex copies an input vertex (vertex_source: copy its position, normal, other UVs) and has
+ * its UV in its page; triangles keep their order. Deterministic: the same bytes for any thread
+ * count. */
+
+/* Unwrap options; fill with hemilight_unwrap_options_init (see "Structs that grow" at the top). */
+typedef struct hemilight_unwrap_options {
+  size_t struct_size;     /* set by hemilight_unwrap_options_init */
+  float texels_per_unit;  /* texel density (texels per scene unit), finite, >= 0; 0: the largest density at
+                             which every chart fits one page (default 0) */
+  int page_size;          /* width and height of each page in texels, 16..8192 (default 1024) */
+  int padding;            /* empty texels between charts and at the border, 0..64 and below page_size / 4
+                             (default 2) */
+  float max_chart_angle;  /* degrees, 1..89: most a triangle's normal may deviate from its chart's mean
+                             normal (default 60) */
+  int max_pages;          /* with texels_per_unit > 0: most pages the charts may need, 1..4096 (default 64) */
+  int thread_count;       /* 0 = all cores (default 0); results do not depend on it */
+} hemilight_unwrap_options;
+
+/* As hemilight_cache_options_init_sized, for unwrap options. */
+HEMILIGHT_API void hemilight_unwrap_options_init_sized(hemilight_unwrap_options* options, size_t struct_size);
+static inline void hemilight_unwrap_options_init(hemilight_unwrap_options* options) {
+  hemilight_unwrap_options_init_sized(options, sizeof *options);
+}
+
+typedef struct hemilight_unwrap_stats {
+  size_t struct_size;           /* set by hemilight_unwrap_stats_init */
+  size_t charts;                /* charts packed */
+  size_t planar_charts;         /* of them, projected onto their plane */
+  size_t degenerate_triangles;  /* triangles without area: in no chart, their UVs without area */
+  int pages;                    /* pages used (1 with texels_per_unit = 0) */
+  float texels_per_unit;        /* the density of every chart (the one found, for a target size) */
+  double uv_area_fraction;      /* the triangles' UV area over the pages' area */
+  double stretch_l2;            /* Sander et al.'s L2 stretch (>= 1; 1 for an isometry) */
+  double stretch_linf;          /* Sander et al.'s L-infinity stretch */
+  double seam_texels;           /* UV length in texels, both sides, of the edges between charts */
+  double seconds;               /* wall time */
+} hemilight_unwrap_stats;
+
+/* As hemilight_cache_stats_init, for unwrap statistics. */
+HEMILIGHT_API void hemilight_unwrap_stats_init_sized(hemilight_unwrap_stats* stats, size_t struct_size);
+static inline void hemilight_unwrap_stats_init(hemilight_unwrap_stats* stats) {
+  hemilight_unwrap_stats_init_sized(stats, sizeof *stats);
+}
+
+/* Lightmap UVs for a mesh (positions: 3 * vertex_count floats, finite; indices: 3 * triangle_count,
+ * each < vertex_count; front faces counter-clockwise). options may be NULL (the defaults).
+ * Outputs (written only on success):
+ *   vertex_source   vertex_capacity uint32: per output vertex, the input vertex it copies
+ *   uvs             2 * vertex_capacity floats: per output vertex, (u, v) in [0, 1] of its page
+ *                   (texel (x, y) of a page of size S has its centre at ((x + 0.5) / S, (y + 0.5) / S))
+ *   out_indices     3 * triangle_count uint32, into the output vertices
+ *   triangle_page   NULL, or triangle_count uint32: each triangle's page
+ *   *vertex_count_out  the number of output vertices, at most 3 * triangle_count
+ * vertex_capacity must be at least 3 * triangle_count (the bound, checked before any work).
+ * triangle_count 0: *vertex_count_out = 0, nothing else written (the arrays may be NULL).
+ * stats may be NULL.
+ * Errors (nothing written): INVALID_ARGUMENT for NULL positions/indices with nonzero counts, NULL
+ * vertex_source/uvs/out_indices/vertex_count_out, vertex_capacity below 3 * triangle_count,
+ * NaN/Inf or beyond 1e18 positions, indices out of range, options or a struct_size out of range
+ * (the message names the field), charts that do not fit one page even at one texel each
+ * (texels_per_unit 0), charts that need more than max_pages pages, a triangle larger than a page at
+ * texels_per_unit; OUT_OF_MEMORY for more than (2^31 - 1) / 3 triangles.
+ * Cost: O(V + T log T) plus a sparse factorisation per curved chart (about a second per million
+ * triangles on two cores; docs/unwrap.md); memory up to about 350 bytes per triangle at its peak. */
+HEMILIGHT_API hemilight_status hemilight_generate_lightmap_uvs(const float* positions, size_t vertex_count, const uint32_t* indices,
+                                                               size_t triangle_count, const hemilight_unwrap_options* options,
+                                                               uint32_t* vertex_source, float* uvs, size_t vertex_capacity,
+                                                               uint32_t* out_indices, uint32_t* triangle_page, size_t* vertex_count_out,
+                                                               hemilight_unwrap_stats* stats);
+
 /* ---- memory kept between calls -----------------------------------------------------------------
  * Tables that depend only on a resolution (hemicube weights, integrator weights, SH9 and HL2 cone
  * weights, cube-map face tables) are built on first use and kept in one process-wide cache of the

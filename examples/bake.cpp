@@ -22,8 +22,13 @@
 //
 // Models (model_import.hpp): read with assimp, every node's meshes with its transform (instances
 // included), normals generated when missing. Lightmap UVs are UV channel 1 (glTF TEXCOORD_1;
-// --lightmap-uv 0 for files with one UV set, like OBJ): a model with meshes lacking it fails with
-// all of them named. They must lie in [0, 1] and give every triangle a nonzero UV area. Material:
+// --lightmap-uv 0 for files with one UV set, like OBJ). When a mesh lacks that channel (or with
+// --generate-uvs) the whole model gets lightmap UVs from unwrap.hpp (pages of --size, at the density
+// that fills one page or at --texels-per-unit), said in one line, and the model with them is
+// written as NAME_lightmap_uvs.glb (TEXCOORD_1), for the engine to render with. UVs up to 0.001
+// outside [0, 1] are clamped; degenerate triangles are skipped; a triangle with 3D area but no UV
+// area occludes without texels and is named in a warning (an error with --strict); the statistics
+// count each. Material:
 // base colour (glTF baseColorFactor x baseColorTexture, or Kd x map_Kd) = albedo (clamped to
 // [0, 1]), emissive colour x emissive texture = emitted radiance, two-sided flag; textures are
 // decoded by stb_image and averaged over each lightmap texel's footprint into per-page albedo and
@@ -51,6 +56,7 @@
 #include "hemilight/probes.hpp"
 #include "hemilight/reference_scenes.hpp"
 
+#include "model_export.hpp"
 #include "model_import.hpp"
 #include "preview.hpp"
 
@@ -75,7 +81,8 @@ const char* usage =
     "usage: hemilight_bake [MODEL] [options]\n"
     "  With no MODEL: bakes the built-in hexagon room (lit by the sky through a window) and the\n"
     "  Cornell box. With MODEL (glTF, FBX, OBJ or another format assimp reads): bakes its\n"
-    "  lightmap UVs (UV channel 1, see --lightmap-uv; they must lie in [0, 1]) with its textures.\n"
+    "  lightmap UVs (UV channel 1, see --lightmap-uv; made when missing, see --generate-uvs) with its\n"
+    "  textures.\n"
     "options:\n"
     "  --size N           lightmap width and height in texels, 1..8192 (default 256)\n"
     "  --resolution N     hemicube resolution, even, 2..4096 (default 64)\n"
@@ -102,6 +109,12 @@ const char* usage =
     "                     bounds; built-in scenes always get one\n"
     "  --lightmap-uv C    the model's UV channel holding the lightmap UVs, 0..7 (default 1: glTF's\n"
     "                     TEXCOORD_1; OBJ files have only channel 0)\n"
+    "  --generate-uvs     make new lightmap UVs for the whole model (done anyway when a mesh has none):\n"
+    "                     charts packed into pages of --size; also writes NAME_lightmap_uvs.glb\n"
+    "  --texels-per-unit D  with generated UVs: D texels per scene unit, spilling into several pages\n"
+    "                     (default: the density that fills one page)\n"
+    "  --strict           a triangle with 3D area but no lightmap UV area is an error (default: a\n"
+    "                     warning; it still casts shadows)\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -120,6 +133,8 @@ struct settings {
   glm::vec3 sky{1.0f};
   bool quiet = false, shadow_mask = false;
   unsigned lightmap_uv = 1;  // --lightmap-uv: the model's UV channel holding the lightmap UVs
+  bool generate_uvs = false; // --generate-uvs (also when a mesh has no lightmap UVs)
+  float texels_per_unit = 0.0f;  // --texels-per-unit: generated UVs' density (0: fill one page)
   bool preview = false;      // --preview: a rendered picture of each baked model (built-in scenes: always)
   bool has_camera = false;   // --preview EX,EY,EZ,TX,TY,TZ[,FOV]
   preview::camera camera;
@@ -232,6 +247,12 @@ settings parse(int argc, char** argv) {
       }
     } else if (a == "--lightmap-uv") {
       s.lightmap_uv = unsigned(parse_int("--lightmap-uv", value(), 0, 7));
+    } else if (a == "--generate-uvs") {
+      s.generate_uvs = true;
+    } else if (a == "--texels-per-unit") {
+      s.texels_per_unit = parse_float("--texels-per-unit", value(), 0.0f, 1e6f, true);
+    } else if (a == "--strict") {
+      s.options.strict = true;
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -324,7 +345,7 @@ scene_bake_input model_scene(const model_import::model& m, const settings& s, sc
     bake_mesh bm;
     bm.first_triangle = a.indices.size() / 3;
     bm.triangle_count = me.indices.size() / 3;
-    bm.page = int(me.instance);
+    bm.page = me.page;
     in.meshes.push_back(bm);
     const auto base = std::uint32_t(a.positions.size());
     a.positions.insert(a.positions.end(), me.positions.begin(), me.positions.end());
@@ -398,7 +419,25 @@ struct progress_bar {
   }
 };
 
-void bake_and_write(const std::string& name, const scene_bake_input& in, const settings& s, const std::vector<light>& scene_lights) {
+// The input the bake went past, in one line each: the degenerate triangles it skipped, and its
+// warnings (triangles without UV area, clamped UVs), with meshes[i] named as the model names it.
+void print_skipped_input(const bake_stats& st, const std::vector<std::string>& mesh_names) {
+  if (st.degenerate_triangles > 0)
+    std::printf("  skipped %zu degenerate triangle%s (no area at float precision: no texels, no shadows)\n", st.degenerate_triangles,
+                st.degenerate_triangles > 1 ? "s" : "");
+  for (const std::string& w : st.warnings) {
+    std::string line = w;
+    const std::size_t at = line.find("meshes[");
+    if (at != std::string::npos) {
+      const std::size_t i = std::size_t(std::strtoul(line.c_str() + at + 7, nullptr, 10));
+      if (i < mesh_names.size()) line += " (meshes[" + std::to_string(i) + "] is " + mesh_names[i] + ")";
+    }
+    std::printf("  warning: %s\n", line.c_str());
+  }
+}
+
+void bake_and_write(const std::string& name, const scene_bake_input& in, const settings& s, const std::vector<light>& scene_lights,
+                    const std::vector<std::string>& mesh_names = {}) {
   bake_options o = s.options;
   o.lights.insert(o.lights.end(), scene_lights.begin(), scene_lights.end());
   if (s.shadow_mask)
@@ -442,6 +481,7 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
   if (textured) std::printf("  per-texel albedo/emission from the model's textures\n");
   std::printf("  texels: %zu sampled of %zu covered, %zu invalid (inside geometry), %zu dilated, %zu overlapping\n",
               st.sampled_texels, st.covered_texels, st.invalid_texels, st.dilated_texels, st.overlapping_texels);
+  print_skipped_input(st, mesh_names);
   for (std::size_t p = 0; p < st.passes.size(); ++p)
     std::printf("  pass %zu: %zu hemicubes (%.1f%% of sampled texels), %zu records, %.2f s\n", p + 1, st.passes[p].hemicubes,
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
@@ -470,6 +510,44 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
   for (float b : pr.backface_fraction) inside += b > 0.1f ? 1 : 0;
   std::printf("  %zu probes (%zu inside geometry: back-face fraction > 0.1), %.2f s; wrote %s_probes.json\n", points.size(), inside,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), base.c_str());
+}
+
+// Lightmap UVs for the whole model (unwrap.hpp) when a mesh has none or --generate-uvs asks: its
+// meshes' world positions unwrapped as one, into pages of --size (at --texels-per-unit, or the
+// density that fills one page); the model takes the new vertices and pages; the model with its new
+// UVs is written as OUT/NAME_lightmap_uvs.glb. One line says why and what was made.
+void generate_model_uvs(model_import::model& m, const settings& s, const std::string& name) {
+  if (!s.generate_uvs)
+    std::printf("%s: %zu of %zu meshes have no lightmap UVs (UV channel %u), e.g. %s: generating lightmap UVs for the whole model\n",
+                name.c_str(), m.without_lightmap_uvs.size(), m.meshes.size(), s.lightmap_uv, m.without_lightmap_uvs[0].c_str());
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices;
+  for (const model_import::mesh& me : m.meshes) {
+    const auto base = std::uint32_t(positions.size());
+    positions.insert(positions.end(), me.positions.begin(), me.positions.end());
+    for (std::uint32_t i : me.indices) indices.push_back(base + i);
+  }
+  unwrap_options o;
+  o.page_size = s.options.width;
+  o.padding = s.options.width >= 16 ? 2 : 0;
+  o.texels_per_unit = s.texels_per_unit;
+  o.max_pages = 4096;
+  o.thread_count = s.options.thread_count;
+  if (o.page_size < 16 || s.options.height != s.options.width)
+    fail("--generate-uvs needs square pages of at least 16 texels (--size)", 2);
+  const unwrap_result r = unwrap_lightmap(positions.data(), positions.size(), indices.data(), indices.size() / 3, o);
+  model_import::apply_lightmap_uvs(m, r);
+  const std::string glb = s.out + "/" + name + "_lightmap_uvs.glb";
+  try {
+    model_export::write_glb(m, glb);
+  } catch (const std::runtime_error& e) {
+    fail(e.what());
+  }
+  const unwrap_stats& st = r.stats;
+  std::printf("%s: lightmap UVs: %zu charts (%zu planar), %d page%s of %d x %d at %.4g texels per unit, %.1f%% of the pages' area, "
+              "stretch %.3f (L2) %.3f (max), %.2f s; wrote %s\n",
+              name.c_str(), st.charts, st.planar_charts, st.pages, st.pages > 1 ? "s" : "", o.page_size, o.page_size,
+              double(st.texels_per_unit), 100.0 * st.uv_area_fraction, st.stretch_l2, st.stretch_linf, st.seconds, glb.c_str());
 }
 
 void run_scenes(const settings& s);
@@ -517,18 +595,26 @@ void run_scenes(const settings& s) {
   if (s.options.width < 1 || s.options.width > max_lightmap_size) fail("--size is out of range");
   model_import::model m;
   try {
-    m = model_import::import_model(s.model, s.lightmap_uv);
+    model_import::import_options io;
+    io.lightmap_channel = s.lightmap_uv;
+    io.allow_missing_lightmap_uvs = true;
+    io.strict = s.options.strict;
+    m = model_import::import_model(s.model, io);
   } catch (const std::runtime_error& e) {
     fail(e.what());
   }
-  scene_arrays arrays;
-  const scene_bake_input in = model_scene(m, s, arrays);
   std::string name = std::filesystem::path(s.model).stem().string();
   if (name.empty()) name = "model";
+  const bool generated = s.generate_uvs || !m.without_lightmap_uvs.empty();
+  if (generated) generate_model_uvs(m, s, name);
+  scene_arrays arrays;
+  const scene_bake_input in = model_scene(m, s, arrays);
   if (!m.lights.empty()) std::printf("%s: %zu light%s from the model\n", name.c_str(), m.lights.size(), m.lights.size() > 1 ? "s" : "");
-  if (m.pages > 1)
+  if (m.pages > 1 && !generated)
     std::printf("%s: instanced meshes: instance k of each mesh is baked into page k (%d pages)\n", name.c_str(), m.pages);
-  bake_and_write(name, in, s, m.lights);
+  std::vector<std::string> mesh_names;
+  for (const model_import::mesh& me : m.meshes) mesh_names.push_back(me.name);
+  bake_and_write(name, in, s, m.lights, mesh_names);
 }
 
 }  // namespace

@@ -5,8 +5,10 @@
 #include <assimp/scene.h>
 #include <assimp/Exporter.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -130,6 +132,97 @@ void write_glb(const scene_mesh& mesh, const std::string& path) {
       for (int c = 0; c < 3; ++c) face.mIndices[c] = local[mesh.indices[3 * t + static_cast<std::size_t>(c)]];
     }
     for (std::uint32_t v : used) local[v] = UINT32_MAX;
+  }
+  Assimp::Exporter exporter;
+  if (exporter.Export(scene.get(), "glb2", path) != AI_SUCCESS)
+    throw std::runtime_error("cannot write '" + path + "': " + exporter.GetErrorString());
+}
+
+namespace {
+
+// The material of an imported one: factors, two-sided, and a base colour texture read from a file.
+aiMaterial* make_material(const model_import::material& mat, const std::vector<model_import::texture>& textures,
+                          const std::string& out_dir) {
+  auto* am = new aiMaterial();
+  const aiString name(mat.name);
+  am->AddProperty(&name, AI_MATKEY_NAME);
+  const aiColor4D base(mat.base_color.x, mat.base_color.y, mat.base_color.z, 1.0f);
+  am->AddProperty(&base, 1, AI_MATKEY_BASE_COLOR);
+  const aiColor3D diffuse(mat.base_color.x, mat.base_color.y, mat.base_color.z), emissive(mat.emissive.x, mat.emissive.y, mat.emissive.z);
+  am->AddProperty(&diffuse, 1, AI_MATKEY_COLOR_DIFFUSE);
+  am->AddProperty(&emissive, 1, AI_MATKEY_COLOR_EMISSIVE);
+  const int two_sided = mat.two_sided ? 1 : 0;
+  am->AddProperty(&two_sided, 1, AI_MATKEY_TWOSIDED);
+  std::error_code ec;
+  if (mat.base_color_texture >= 0) {
+    const std::string& source = textures[std::size_t(mat.base_color_texture)].source;
+    if (std::filesystem::is_regular_file(source, ec)) {
+      const aiString file(std::filesystem::relative(source, out_dir, ec).generic_string());
+      am->AddProperty(&file, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0));
+      const int channel = int(mat.base_color_uv);
+      am->AddProperty(&channel, 1, AI_MATKEY_UVWSRC(aiTextureType_DIFFUSE, 0));
+    }
+  }
+  return am;
+}
+
+}  // namespace
+
+void write_glb(const model_import::model& m, const std::string& path) {
+  const auto n = static_cast<unsigned>(m.meshes.size());
+  auto scene = std::make_unique<aiScene>();
+  scene->mRootNode = new aiNode("model");
+  scene->mRootNode->mNumChildren = n;
+  scene->mRootNode->mChildren = new aiNode*[n];
+  scene->mNumMeshes = n;
+  scene->mMeshes = new aiMesh*[n];
+  for (unsigned k = 0; k < n; ++k) scene->mMeshes[k] = nullptr;
+  const std::string out_dir = std::filesystem::absolute(path).parent_path().string();
+  const auto materials = static_cast<unsigned>(std::max<std::size_t>(m.materials.size(), 1));
+  scene->mNumMaterials = materials;
+  scene->mMaterials = new aiMaterial*[materials];
+  for (unsigned k = 0; k < materials; ++k)
+    scene->mMaterials[k] = make_material(k < m.materials.size() ? m.materials[k] : model_import::material{}, m.textures, out_dir);
+  for (unsigned k = 0; k < n; ++k) {
+    const model_import::mesh& me = m.meshes[k];
+    const std::size_t V = me.positions.size(), T = me.indices.size() / 3;
+    if (me.lightmap_uvs.size() != V) throw std::runtime_error("cannot write '" + path + "': " + me.name + " has no lightmap UVs");
+    auto* node = new aiNode(me.name);
+    node->mParent = scene->mRootNode;
+    node->mNumMeshes = 1;
+    node->mMeshes = new unsigned[1]{k};
+    scene->mRootNode->mChildren[k] = node;
+    auto* am = new aiMesh();
+    scene->mMeshes[k] = am;
+    am->mName = aiString(me.name);
+    am->mMaterialIndex = me.material < materials ? me.material : 0;
+    am->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    am->mNumVertices = static_cast<unsigned>(V);
+    am->mVertices = new aiVector3D[V];
+    am->mNormals = new aiVector3D[V];
+    // UV channel 0 as imported (else a copy of the lightmap UVs: glTF's TEXCOORD_1 needs a TEXCOORD_0),
+    // channel 1 the lightmap UVs; assimp's glTF exporter writes 1 - v (its v grows upwards).
+    const bool own0 = !me.uv_channels.empty() && me.uv_channels[0].size() == V;
+    for (unsigned c = 0; c < 2; ++c) {
+      am->mTextureCoords[c] = new aiVector3D[V];
+      am->mNumUVComponents[c] = 2;
+    }
+    for (std::size_t i = 0; i < V; ++i) {
+      const glm::vec3 p = me.positions[i], nn = me.normals[i];
+      am->mVertices[i] = aiVector3D(p.x, p.y, p.z);
+      am->mNormals[i] = aiVector3D(nn.x, nn.y, nn.z);
+      const glm::vec2 uv = me.lightmap_uvs[i];
+      am->mTextureCoords[1][i] = aiVector3D(uv.x, 1.0f - uv.y, 0.0f);
+      am->mTextureCoords[0][i] = own0 ? aiVector3D(me.uv_channels[0][i].x, me.uv_channels[0][i].y, 0.0f) : am->mTextureCoords[1][i];
+    }
+    am->mNumFaces = static_cast<unsigned>(T);
+    am->mFaces = new aiFace[T];
+    for (std::size_t t = 0; t < T; ++t) {
+      aiFace& face = am->mFaces[t];
+      face.mNumIndices = 3;
+      face.mIndices = new unsigned[3];
+      for (int c = 0; c < 3; ++c) face.mIndices[c] = me.indices[3 * t + static_cast<std::size_t>(c)];
+    }
   }
   Assimp::Exporter exporter;
   if (exporter.Export(scene.get(), "glb2", path) != AI_SUCCESS)

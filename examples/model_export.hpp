@@ -5,6 +5,8 @@
 
 #include "hemilight/scene.hpp"
 
+#include "model_import.hpp"
+
 #include <string>
 
 namespace hemilight::model_export {
@@ -20,5 +22,16 @@ namespace hemilight::model_export {
 /// attribute. Throws std::runtime_error naming the file when the mesh has no lightmap UVs or the
 /// export fails. Cost: O(V + T) plus assimp's export (about 1 s per million triangles).
 void write_glb(const scene_mesh& mesh, const std::string& path);
+
+/// Writes an imported model with its lightmap UVs (such as apply_lightmap_uvs gave it) to `path` as
+/// glTF binary, so that an engine renders with the layout that was baked: one node per mesh at the
+/// origin (world-space positions, as imported), its normals, its UV channels (TEXCOORD_0 ...) with
+/// the lightmap UVs as TEXCOORD_1 (channel 0 a copy of them when the mesh had none), and per
+/// material the base colour and emissive factors, two-sided, and a base colour texture read from
+/// a file (referenced by its path relative to `path`'s folder; embedded textures and lights are not
+/// written). The lightmap UVs are stored as the baker reads them (import_model gives them back to
+/// float rounding of 1 - v). Throws std::runtime_error naming the file when a mesh has no lightmap
+/// UVs or the export fails. Cost: O(V + T) plus assimp's export.
+void write_glb(const model_import::model& m, const std::string& path);
 
 }  // namespace hemilight::model_export

@@ -158,7 +158,77 @@ material read_material(const aiScene* sc, unsigned index, const std::string& pat
   return mat;
 }
 
+// The lightmap UVs the baker takes (bake.hpp's rules): within lightmap_uv_tolerance of [0, 1]
+// (it clamps them), and with strict, area wherever there is 3D area (degenerate triangles aside:
+// is_degenerate_triangle), by the baker's own threshold (1e-12 of the UV square).
+void check_lightmap_uvs(const mesh& out, const std::string& path, bool strict) {
+  constexpr float lo = -lightmap_uv_tolerance, hi = 1.0f + lightmap_uv_tolerance;
+  for (std::size_t v = 0; v < out.lightmap_uvs.size(); ++v) {
+    const glm::vec2 t = out.lightmap_uvs[v];
+    if (!(t.x >= lo && t.x <= hi && t.y >= lo && t.y <= hi))
+      fail("'" + path + "' " + out.name + " vertex " + std::to_string(v) + ": lightmap UV (" + std::to_string(t.x) + ", " +
+           std::to_string(t.y) + ") is outside [0, 1] by more than 0.001");
+  }
+  for (std::size_t t = 0; strict && t + 2 < out.indices.size(); t += 3) {
+    const std::uint32_t* i = &out.indices[t];
+    const glm::dvec2 a(glm::clamp(out.lightmap_uvs[i[0]], 0.0f, 1.0f)), b(glm::clamp(out.lightmap_uvs[i[1]], 0.0f, 1.0f)),
+        c(glm::clamp(out.lightmap_uvs[i[2]], 0.0f, 1.0f));
+    const double uv_area = 0.5 * std::fabs((b - a).x * (c - a).y - (b - a).y * (c - a).x);
+    if (!is_degenerate_triangle(out.positions[i[0]], out.positions[i[1]], out.positions[i[2]]) && !(uv_area > 1e-12))
+      fail("'" + path + "' " + out.name + " triangle " + std::to_string(t / 3) +
+           " has zero area in lightmap UV space (but not in 3D): it would get no texels (--strict)");
+  }
+}
+
 }  // namespace
+
+void apply_lightmap_uvs(model& m, const unwrap_result& r) {
+  std::vector<mesh> out;
+  std::size_t first_vertex = 0, first_triangle = 0;
+  std::vector<std::uint32_t> local(r.uvs.size(), 0xffffffffu);
+  int pages = 1;
+  for (mesh& me : m.meshes) {
+    const std::size_t T = me.indices.size() / 3;
+    std::vector<int> used_pages;
+    for (std::size_t t = 0; t < T; ++t) used_pages.push_back(int(r.triangle_page[first_triangle + t]));
+    std::sort(used_pages.begin(), used_pages.end());
+    used_pages.erase(std::unique(used_pages.begin(), used_pages.end()), used_pages.end());
+    for (int page : used_pages) {
+      mesh part;
+      part.name = used_pages.size() > 1 ? me.name + " (page " + std::to_string(page) + ")" : me.name;
+      part.source_mesh = me.source_mesh;
+      part.instance = me.instance;
+      part.material = me.material;
+      part.page = page;
+      part.uv_channels.resize(me.uv_channels.size());
+      std::vector<std::uint32_t> made;
+      for (std::size_t t = 0; t < T; ++t) {
+        if (int(r.triangle_page[first_triangle + t]) != page) continue;
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t o = r.indices[3 * (first_triangle + t) + std::size_t(k)];
+          if (local[o] == 0xffffffffu) {
+            const std::size_t v = r.vertex_source[o] - first_vertex;  // the mesh's own vertex
+            local[o] = std::uint32_t(part.positions.size());
+            made.push_back(o);
+            part.positions.push_back(me.positions[v]);
+            part.normals.push_back(me.normals[v]);
+            part.lightmap_uvs.push_back(r.uvs[o]);
+            for (std::size_t c = 0; c < me.uv_channels.size(); ++c) part.uv_channels[c].push_back(me.uv_channels[c][v]);
+          }
+          part.indices.push_back(local[o]);
+        }
+      }
+      for (std::uint32_t o : made) local[o] = 0xffffffffu;
+      pages = std::max(pages, page + 1);
+      out.push_back(std::move(part));
+    }
+    first_vertex += me.positions.size();
+    first_triangle += T;
+  }
+  m.meshes = std::move(out);
+  m.pages = pages;
+  m.without_lightmap_uvs.clear();
+}
 
 glm::vec3 texture::lookup(glm::vec2 uv) const noexcept {
   if (texels.empty()) return glm::vec3(0.0f);
@@ -185,6 +255,13 @@ hemilight::material material::flat(const std::vector<texture>& textures) const {
 }
 
 model import_model(const std::string& path, unsigned lightmap_channel) {
+  import_options o;
+  o.lightmap_channel = lightmap_channel;
+  return import_model(path, o);
+}
+
+model import_model(const std::string& path, const import_options& options) {
+  const unsigned lightmap_channel = options.lightmap_channel;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail("cannot read '" + path + "': no such file");
   Assimp::Importer importer;
@@ -205,7 +282,7 @@ model import_model(const std::string& path, unsigned lightmap_channel) {
     }
   }
   if (with_triangles == 0) fail("'" + path + "' has no meshes with triangles: nothing to bake");
-  if (missing_count > 0)
+  if (missing_count > 0 && !options.allow_missing_lightmap_uvs)
     fail("'" + path + "': " + std::to_string(missing_count) + (missing_count > 1 ? " meshes have" : " mesh has") +
          " no lightmap UVs (UV channel " + std::to_string(lightmap_channel) + "): " + missing +
          (lightmap_channel == 1 ? "; give them a second UV set (glTF TEXCOORD_1), or bake UV channel 0 with --lightmap-uv 0" : ""));
@@ -238,6 +315,8 @@ model import_model(const std::string& path, unsigned lightmap_channel) {
       mesh out;
       out.source_mesh = mi;
       out.instance = instances[mi]++;
+      out.page = int(out.instance);
+      const bool has_lightmap_uvs = src->HasTextureCoords(lightmap_channel);
       out.name = "mesh " + std::to_string(mi) + " ('" + src->mName.C_Str() + "') at node '" + node->mName.C_Str() + "'";
       out.material = src->mMaterialIndex < m.materials.size() ? src->mMaterialIndex : 0;
       for (unsigned v = 0; v < src->mNumVertices; ++v) {
@@ -248,6 +327,7 @@ model import_model(const std::string& path, unsigned lightmap_channel) {
           n = glm::vec3(t.x, t.y, t.z);
         }
         out.normals.push_back(n);
+        if (!has_lightmap_uvs) continue;
         const aiVector3D& t = src->mTextureCoords[lightmap_channel][v];
         out.lightmap_uvs.emplace_back(t.x, gltf ? 1.0f - t.y : t.y);
       }
@@ -262,22 +342,11 @@ model import_model(const std::string& path, unsigned lightmap_channel) {
         out.indices.insert(out.indices.end(), {face.mIndices[0], mirrored ? face.mIndices[2] : face.mIndices[1],
                                                mirrored ? face.mIndices[1] : face.mIndices[2]});
       }
-      // The lightmap UVs the baker needs: in [0, 1], and area wherever there is 3D area.
-      for (std::size_t v = 0; v < out.lightmap_uvs.size(); ++v) {
-        const glm::vec2 t = out.lightmap_uvs[v];
-        if (!(t.x >= 0.0f && t.x <= 1.0f && t.y >= 0.0f && t.y <= 1.0f))
-          fail("'" + path + "' " + out.name + " vertex " + std::to_string(v) + ": lightmap UV (" + std::to_string(t.x) + ", " +
-               std::to_string(t.y) + ") is outside [0, 1]");
-      }
-      for (std::size_t t = 0; t + 2 < out.indices.size(); t += 3) {
-        const glm::vec2 a = out.lightmap_uvs[out.indices[t]], b = out.lightmap_uvs[out.indices[t + 1]],
-                        c = out.lightmap_uvs[out.indices[t + 2]];
-        const glm::vec3 pa = out.positions[out.indices[t]], pb = out.positions[out.indices[t + 1]], pc = out.positions[out.indices[t + 2]];
-        const float uv_area = std::fabs((b - a).x * (c - a).y - (b - a).y * (c - a).x);
-        if (uv_area == 0.0f && glm::length(glm::cross(pb - pa, pc - pa)) > 0.0f)
-          fail("'" + path + "' " + out.name + " triangle " + std::to_string(t / 3) + " has zero area in lightmap UV space");
-      }
-      m.pages = std::max(m.pages, int(out.instance) + 1);
+      if (has_lightmap_uvs)
+        check_lightmap_uvs(out, path, options.strict);
+      else
+        m.without_lightmap_uvs.push_back(out.name);
+      m.pages = std::max(m.pages, out.page + 1);
       m.meshes.push_back(std::move(out));
     }
   }
@@ -294,7 +363,7 @@ page_images bake_page_materials(const model& m, int page, int width, int height)
   page_images out;
   bool base_textured = false, emissive_textured = false;
   for (const mesh& me : m.meshes)
-    if (int(me.instance) == page) {
+    if (me.page == page) {
       const material& mat = m.materials[me.material];
       base_textured = base_textured || mat.base_color_texture >= 0;
       emissive_textured = emissive_textured || mat.emissive_texture >= 0;
@@ -304,7 +373,7 @@ page_images bake_page_materials(const model& m, int page, int width, int height)
   std::vector<glm::dvec3> albedo(texels, glm::dvec3(0.0)), emission(texels, glm::dvec3(0.0));
   std::vector<double> weight(texels, 0.0);
   for (const mesh& me : m.meshes) {
-    if (int(me.instance) != page) continue;
+    if (me.page != page) continue;
     const material& mat = m.materials[me.material];
     const texture* base_tex = mat.base_color_texture >= 0 ? &m.textures[std::size_t(mat.base_color_texture)] : nullptr;
     const texture* emit_tex = mat.emissive_texture >= 0 ? &m.textures[std::size_t(mat.emissive_texture)] : nullptr;

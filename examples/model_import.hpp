@@ -7,7 +7,11 @@
 //     several nodes use is one `mesh` per node). Normals by the inverse transpose; a mirroring
 //     transform (negative determinant) flips the triangles' winding so that front faces stay front.
 //   - Lightmap UVs from UV channel `lightmap_channel` (1 by default: glTF's TEXCOORD_1). Every mesh
-//     without that channel is named in one error.
+//     without that channel is named in one error, or (import_options::allow_missing_lightmap_uvs)
+//     imported without lightmap UVs for the caller to generate (unwrap.hpp). UVs up to
+//     lightmap_uv_tolerance outside [0, 1] are accepted (the baker clamps them); degenerate
+//     triangles are kept (the baker skips them); a triangle with 3D area but no lightmap UV area is
+//     an error only with import_options::strict (else the baker counts it).
 //   - Materials: base colour (glTF baseColorFactor, else the diffuse colour Kd) times its texture
 //     (glTF baseColorTexture, else the diffuse texture map_Kd), emissive colour (emissiveFactor /
 //     Ke) times its texture, two-sided. Textures are decoded by stb_image (Debian's libstb-dev):
@@ -20,6 +24,7 @@
 
 #include "hemilight/bake.hpp"
 #include "hemilight/lights.hpp"
+#include "hemilight/unwrap.hpp"
 
 #include <string>
 #include <vector>
@@ -63,6 +68,7 @@ struct mesh {
   std::vector<std::vector<glm::vec2>> uv_channels;  ///< every UV channel the mesh has (for textures)
   std::vector<std::uint32_t> indices;
   unsigned material = 0;      ///< index into model::materials
+  int page = 0;               ///< the lightmap page of its UVs: its instance, or the page generated UVs put it on
 };
 
 struct model {
@@ -70,16 +76,35 @@ struct model {
   std::vector<material> materials;
   std::vector<texture> textures;
   std::vector<light> lights;
-  /// Lightmap pages: 1 + the largest instance index (instance k of every mesh goes to page k, so
-  /// that instances, which share their lightmap UVs, never share texels).
+  /// Lightmap pages: 1 + the largest mesh::page (instance k of every mesh goes to page k, so that
+  /// instances, which share their lightmap UVs, never share texels).
   int pages = 1;
+  /// The meshes imported without lightmap UVs (import_options::allow_missing_lightmap_uvs), by name.
+  std::vector<std::string> without_lightmap_uvs;
+};
+
+/// How import_model reads a file.
+struct import_options {
+  unsigned lightmap_channel = 1;            ///< the UV channel of the lightmap UVs, < AI_MAX_NUMBER_OF_TEXTURECOORDS
+  bool allow_missing_lightmap_uvs = false;  ///< meshes without the channel: imported without lightmap UVs, not an error
+  bool strict = false;                      ///< a triangle with 3D area but no lightmap UV area is an error
 };
 
 /// Reads a model file. Throws std::runtime_error with one line naming the file and what is wrong:
 /// no such file, assimp's error, no meshes with triangles, meshes without UV channel
-/// lightmap_channel (all of them named), a texture that cannot be read. Cost: assimp's import
-/// plus one pass over the vertices and the textures' texels.
+/// lightmap_channel (all of them named; unless allowed), a lightmap UV more than
+/// lightmap_uv_tolerance outside [0, 1], with strict a triangle with 3D area but no UV area (named
+/// by its mesh and index), a texture that cannot be read. Cost: assimp's import plus one pass over
+/// the vertices and the textures' texels.
+model import_model(const std::string& path, const import_options& options);
 model import_model(const std::string& path, unsigned lightmap_channel = 1);
+
+/// Gives the model the lightmap UVs of `r`, the unwrap (unwrap_lightmap) of its meshes' world
+/// positions concatenated in order (mesh k's vertices after those of meshes 0..k-1): each mesh's
+/// vertices become the result's (attributes copied from their sources), a mesh whose triangles lie
+/// on several pages is split into one mesh per page (named "... (page P)"), and mesh::page and
+/// model::pages follow the pages. Cost: O(V + T).
+void apply_lightmap_uvs(model& m, const unwrap_result& r);
 
 /// The per-texel albedo and emission of one lightmap page (width x height, the page's texel
 /// convention: bake.hpp), each texel the area-weighted mean, over the parts of the page's

@@ -432,10 +432,16 @@ TEST_CASE("Bad input to the baker names the problem", "[bake]") {
   throws_with(no_uv, o, "no lightmap UVs");
   uv_mesh outside = m;
   outside.uvs[1].x = 1.5f;
-  throws_with(outside.input(), o, "lightmap_uvs[1].u = 1.5 is outside [0, 1]");
+  throws_with(outside.input(), o, "lightmap_uvs[1].u = 1.5 is outside [0, 1] by more than lightmap_uv_tolerance");
+  outside.uvs[1].x = 1.0f + 1.5f * lightmap_uv_tolerance;  // just past the tolerance
+  throws_with(outside.input(), o, "lightmap_uvs[1].u = 1.0015");
   uv_mesh flat = m;
   flat.uvs[2] = flat.uvs[1];
-  throws_with(flat.input(), o, "triangle 0 has zero area in lightmap UV space");
+  bake_options strict = o;
+  strict.strict = true;
+  throws_with(flat.input(), strict, "triangle 0 has zero area in lightmap UV space");
+  // Without strict the triangle covers nothing, and nothing else does.
+  throws_with(flat.input(), o, "no texel is covered by a triangle");
   uv_mesh far = m;
   far.indices[2] = 7;
   throws_with(far.input(), o, "indices[2] = 7 is out of range");
@@ -1117,4 +1123,160 @@ TEST_CASE("Bad lights and shadow-mask indices fail the bake naming the light and
   o.shadow_mask_lights = {{-1, -1, -1, -1}};
   o.direct.penumbra_samples = 2;
   CHECK_THROWS_WITH(bake_lightmap(input_of(c.mesh), o), Catch::Contains("bake_lightmap: direct_options: penumbra_samples"));
+}
+
+// ---- input as real exports give it: degenerate triangles, broken UVs, UVs a hair outside -------
+
+namespace {
+
+// A unit floor (local x, z in [0, 1], facing up) of 4 x 4 quads, exported the way levels come:
+// every triangle with its own three vertices (duplicates at shared corners), the whole thing moved
+// by a node transform applied in double and rounded to float. UVs: u = x, v = z / 2 (the lower
+// half of the map), except that vertices at x = 0 have u = -0.00048 (a packer's margin). Options:
+//   occluder     a 0.4 x 0.4 quad at height 0.3 facing down, with UVs in the upper half of the
+//                map, or (broken_occluder) all at one point: 3D area but no UV area;
+//   degenerate   collinear slivers along the floor's edges (midpoints exact in the local frame,
+//                collinear only up to the transform's rounding) with UV triangles of real area
+//                in the map's free upper corner, a triangle with a zero-length edge (two
+//                duplicate vertices) and one collapsed to a point.
+struct exported_floor {
+  uv_mesh mesh;
+  std::size_t occluder_first = 0, degenerate = 0, clamped = 0;
+  std::size_t nonzero_area = 0;  // degenerate triangles whose area in double is not 0 (collinear only up to rounding)
+
+  static glm::vec3 place(const glm::dvec3& local) {  // rotation about y by 0.6 rad, then a translation
+    const double c = std::cos(0.6), s = std::sin(0.6);
+    return glm::vec3(glm::dvec3(c * local.x + s * local.z, local.y, -s * local.x + c * local.z) + glm::dvec3(37.25, 2.5, -11.75));
+  }
+  void add(const glm::dvec3 (&p)[3], const glm::vec2 (&uv)[3], const material& m) {
+    mesh.add(place(p[0]), place(p[1]), place(p[2]), uv[0], uv[1], uv[2], m);
+  }
+
+  exported_floor(bool occluder, bool broken_occluder, bool degenerate_triangles) {
+    material grey;
+    grey.albedo = glm::vec3(0.5f);
+    const auto floor_uv = [&](const glm::dvec3& p) {
+      if (p.x == 0.0) ++clamped;
+      return glm::vec2(p.x == 0.0 ? -0.00048f : float(p.x), float(p.z / 2.0));
+    };
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const glm::dvec3 a(i / 4.0, 0, j / 4.0), b((i + 1) / 4.0, 0, j / 4.0), c((i + 1) / 4.0, 0, (j + 1) / 4.0),
+            d(i / 4.0, 0, (j + 1) / 4.0);
+        add({a, d, c}, {floor_uv(a), floor_uv(d), floor_uv(c)}, grey);  // counter-clockwise seen from +y
+        add({a, c, b}, {floor_uv(a), floor_uv(c), floor_uv(b)}, grey);
+      }
+    if (degenerate_triangles) {
+      const glm::vec2 free_uv[3] = {{0.8f, 0.8f}, {0.95f, 0.8f}, {0.95f, 0.95f}};  // real UV area, unused by anything
+      for (int k = 0; k < 4; ++k) {
+        const double x0 = k / 4.0, x1 = (k + 1) / 4.0;
+        add({glm::dvec3(x0, 0, 0), glm::dvec3(0.5 * (x0 + x1), 0, 0), glm::dvec3(x1, 0, 0)}, free_uv, grey);
+        add({glm::dvec3(0, 0, x1), glm::dvec3(0, 0, 0.5 * (x0 + x1)), glm::dvec3(0, 0, x0)}, free_uv, grey);
+        degenerate += 2;
+      }
+      for (std::size_t t = mesh.indices.size() / 3 - 8; t < mesh.indices.size() / 3; ++t) {
+        const glm::dvec3 a(mesh.positions[3 * t]), b(mesh.positions[3 * t + 1]), c(mesh.positions[3 * t + 2]);
+        if (glm::length(glm::cross(b - a, c - a)) > 0.0) ++nonzero_area;
+      }
+      const glm::dvec3 p(0.5, 0, 0.5), q(0.75, 0, 0.5);
+      add({p, p, q}, free_uv, grey);  // a zero-length edge: vertices 0 and 1 are duplicates
+      add({q, q, q}, free_uv, grey);
+      degenerate += 2;
+    }
+    if (occluder) {
+      occluder_first = mesh.indices.size() / 3;
+      const glm::dvec3 a(0.3, 0.3, 0.3), b(0.7, 0.3, 0.3), c(0.7, 0.3, 0.7), d(0.3, 0.3, 0.7);
+      const glm::vec2 ua(0.1f, 0.55f), ub(0.4f, 0.55f), uc(0.4f, 0.7f), ud(0.1f, 0.7f);
+      const glm::vec2 point(0.25f, 0.6f);
+      if (broken_occluder) {
+        add({a, b, c}, {point, point, point}, grey);  // counter-clockwise seen from below
+        add({a, c, d}, {point, point, point}, grey);
+      } else {
+        add({a, b, c}, {ua, ub, uc}, grey);
+        add({a, c, d}, {ua, uc, ud}, grey);
+      }
+    }
+  }
+};
+
+// The texels of the floor (the lower half of a size x size map): their irradiance, bit for bit.
+std::vector<float> floor_texels(const bake_result& r, int size) {
+  return std::vector<float>(r.irradiance.pixels.begin(), r.irradiance.pixels.begin() + std::ptrdiff_t(3 * size * size / 2));
+}
+
+}  // namespace
+
+TEST_CASE("Bake: degenerate triangles are skipped, UVs a hair outside clamped, UV-less triangles occlude and are named", "[bake]") {
+  constexpr int size = 16;
+  bake_options o;
+  o.width = o.height = size;
+  o.sampler.resolution = 16;
+  o.use_cache = false;  // a hemicube per texel: a texel's value depends only on its sample and the scene drawn
+  o.thread_count = 2;
+  const exported_floor clean(true, false, false), messy(true, true, true), open(false, false, false);
+  const auto under_sky = [](const exported_floor& f) {
+    bake_input in = f.mesh.input();
+    in.scene.sky_radiance = glm::vec3(1.0f);
+    return in;
+  };
+  const bake_result ref = bake_lightmap(under_sky(clean), o);
+  const bake_result r = bake_lightmap(under_sky(messy), o);
+  // The counts and the warnings name what was skipped.
+  CHECK(r.stats.degenerate_triangles == messy.degenerate);
+  CHECK(r.stats.degenerate_triangles == 10);
+  CHECK(messy.nonzero_area > 0);  // slivers that an exact zero-area test would have drawn
+  CHECK(r.stats.no_uv_area_triangles == 2);
+  CHECK(r.stats.first_no_uv_area_triangle == messy.occluder_first);
+  CHECK(r.stats.clamped_uvs == messy.clamped);
+  CHECK(messy.clamped == 12);  // the vertices at x = 0 of the four leftmost quads' triangles (2 + 1 each)
+  REQUIRE(r.stats.warnings.size() == 2);
+  CHECK_THAT(r.stats.warnings[0], Catch::Contains("bake_lightmap: 12 lightmap UVs lie outside [0, 1] by up to 0.00047999"));
+  CHECK_THAT(r.stats.warnings[1], Catch::Contains("bake_lightmap: 2 triangles have 3D area but no lightmap UV area (the first: triangle " +
+                                                  std::to_string(messy.occluder_first) + "): they occlude but get no texels"));
+  CHECK(ref.stats.warnings.size() == 1);  // the clamped UVs only
+  // The floor's texels are bitwise those of the clean export (UVs clamped to exactly 0, the
+  // occluder drawn, the degenerate triangles neither drawn nor covering texels) ...
+  CHECK(floor_texels(r, size) == floor_texels(ref, size));
+  // ... and the occluder really occludes: under it the floor gets well below the open sky's pi.
+  const bake_result lit = bake_lightmap(under_sky(open), o);
+  const std::size_t under = std::size_t(4 * size + size / 2);  // texel (8, 4): uv (0.53, 0.28), so x = 0.53, z = 0.56
+  // The open floor sees the sky alone: pi (the projected solid angles sum to pi; float rounding).
+  CHECK(lit.irradiance.pixels[3 * under] == Approx(pi).epsilon(1e-5));
+  CHECK(r.irradiance.pixels[3 * under] < 0.9f * lit.irradiance.pixels[3 * under]);
+  // Nothing but the floor and the well-formed occluder covers texels: the degenerate slivers' UV
+  // triangle (upper right) and the broken occluder's point stay empty.
+  for (int y = size / 2; y < size; ++y)
+    for (int x = 0; x < size; ++x) CHECK(r.coverage[std::size_t(y * size + x)] == 0.0f);
+  // strict: the UV-less triangles are an error naming the first; the rest is still accepted.
+  bake_options strict = o;
+  strict.strict = true;
+  test::require_error([&] { bake_lightmap(under_sky(messy), strict); }, status::invalid_argument,
+                      "bake_lightmap: triangle " + std::to_string(messy.occluder_first) + " has zero area in lightmap UV space");
+  const exported_floor strict_ok(true, false, true);
+  CHECK(bake_lightmap(under_sky(strict_ok), strict).stats.degenerate_triangles == 10);
+  // bake_scene, the same rules: one page holding the floor and the occluder as two meshes gives
+  // bitwise the same lightmap and counts, and its warnings name the mesh.
+  scene_bake_input si;
+  si.geometry = under_sky(messy);
+  si.pages.resize(1);
+  si.pages[0].width = si.pages[0].height = size;
+  si.meshes.resize(2);
+  si.meshes[0].triangle_count = messy.occluder_first;
+  si.meshes[0].page = 0;
+  si.meshes[1].first_triangle = messy.occluder_first;
+  si.meshes[1].triangle_count = 2;
+  si.meshes[1].page = 0;
+  const scene_bake_result sr = bake_scene(si, o);
+  CHECK(sr.pages[0].irradiance.pixels == r.irradiance.pixels);
+  CHECK(sr.stats.degenerate_triangles == 10);
+  CHECK(sr.stats.no_uv_area_triangles == 2);
+  CHECK(sr.stats.first_no_uv_area_triangle == messy.occluder_first);
+  CHECK(sr.stats.clamped_uvs == 12);
+  REQUIRE(sr.stats.warnings.size() == 2);
+  CHECK_THAT(sr.stats.warnings[0], Catch::Contains("bake_scene: 12 page UVs lie outside [0, 1] by at most lightmap_uv_tolerance"));
+  CHECK_THAT(sr.stats.warnings[1], Catch::Contains("(the first: meshes[1] triangle 0 (scene triangle " +
+                                                   std::to_string(messy.occluder_first) + "))"));
+  test::require_error([&] { bake_scene(si, strict); }, status::invalid_argument,
+                      "bake_scene: meshes[1] triangle 0 (scene triangle " + std::to_string(messy.occluder_first) +
+                          ") has zero area in its page's UV space");
 }

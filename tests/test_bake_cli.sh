@@ -120,9 +120,15 @@ expect_fail "--directional sideways" "sh, hl2 or both" -- quad.obj --lightmap-uv
 expect_fail "nosky.exr" "no such file" -- quad.obj --lightmap-uv 0 --environment nosky.exr
 printf 'not an exr' > bad.exr
 expect_fail "bad.exr" -- quad.obj --lightmap-uv 0 --environment bad.exr
-expect_fail "no lightmap UVs (UV channel 0)" "mesh 0" -- nouv.obj --lightmap-uv 0
-expect_fail "outside \[0, 1\]" -- outside.obj --lightmap-uv 0
-expect_fail "zero area in lightmap UV space" -- flat.obj --lightmap-uv 0
+# A model without lightmap UVs gets them (one line says so) and is written back with them.
+expect_ok nouv.obj --lightmap-uv 0 --size 16 --resolution 16 --bounces 1 --out gen
+grep -q "generating lightmap UVs for the whole model" ok.log || { echo "FAIL: no generation message:"; cat ok.log; fails=$((fails + 1)); }
+[ -s gen/nouv_lightmap_uvs.glb ] || { echo "FAIL: gen/nouv_lightmap_uvs.glb not written"; fails=$((fails + 1)); }
+expect_fail "outside \[0, 1\] by more than 0.001" -- outside.obj --lightmap-uv 0
+# UVs without area: an error with --strict; without it the triangles cover nothing (and here
+# nothing else does).
+expect_fail "zero area in lightmap UV space" "--strict" -- flat.obj --lightmap-uv 0 --strict
+expect_fail "no texel is covered" -- flat.obj --lightmap-uv 0
 # Previews: --preview renders the baked model (default camera, or eye,target,fov); a bad camera
 # is a usage error.
 expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --preview --out pv
@@ -132,8 +138,71 @@ grep -q "preview from (0.5, 2, 0.5) towards (0.5, 0, 0.5), 50 degrees" ok.log ||
 [ -e pv2/quad_irradiance.png ] && [ -s pv2/quad_preview.png ] || { echo "FAIL: pv2 outputs"; fails=$((fails + 1)); }
 expect_fail "--preview 1,1,1,1,1,1" "EX,EY,EZ,TX,TY,TZ" -- quad.obj --lightmap-uv 0 --preview 1,1,1,1,1,1
 expect_fail "--preview 0,1,0,0,0,0,150" -- quad.obj --lightmap-uv 0 --preview 0,1,0,0,0,0,150
-# Lightmap UVs come from UV channel 1 by default: an OBJ has only channel 0, named with its mesh.
-expect_fail "no lightmap UVs (UV channel 1)" "mesh 0" "--lightmap-uv 0" -- quad.obj
+# Lightmap UVs come from UV channel 1 by default: an OBJ has only channel 0, so they are made.
+expect_ok quad.obj --size 16 --resolution 16 --bounces 1 --out ch1
+grep -q "1 of 1 meshes have no lightmap UVs (UV channel 1)" ok.log || { echo "FAIL: channel 1 not reported missing:"; cat ok.log; fails=$((fails + 1)); }
+
+# A level as real exports come, with no other flag than the model: an OBJ without UVs, every
+# triangle with its own vertices, moved by a transform, with collinear slivers (midpoints exact
+# before the transform), a zero-length edge and a point; then the glTF it writes, baked again with
+# the UVs it holds (TEXCOORD_1): the same texels.
+python3 - <<'PY'
+import math
+c, s = math.cos(0.6), math.sin(0.6)
+V, F = [], []
+def place(p):
+    x, y, z = p
+    return (c * x + s * z + 37.25, y + 2.5, -s * x + c * z - 11.75)
+def tri(a, b, d):
+    for p in (a, b, d): V.append(place(p))
+    F.append((len(V) - 2, len(V) - 1, len(V)))
+def box(lo, hi, inward):
+    p = [(lo[0], lo[1], lo[2]), (hi[0], lo[1], lo[2]), (hi[0], hi[1], lo[2]), (lo[0], hi[1], lo[2]),
+         (lo[0], lo[1], hi[2]), (hi[0], lo[1], hi[2]), (hi[0], hi[1], hi[2]), (lo[0], hi[1], hi[2])]
+    for f in [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (2, 3, 7, 6), (0, 4, 7, 3), (1, 2, 6, 5)]:
+        q = [p[i] for i in (reversed(f) if inward else f)]
+        tri(q[0], q[1], q[2]); tri(q[0], q[2], q[3])
+box((0, 0, 0), (4, 3, 5), False)         # a building under the sky
+box((5, 0, 0), (6, 1, 1), False)         # a crate beside it
+box((-2, -0.2, -2), (9, 0, 7), False)    # the ground slab
+for k in range(4):
+    tri((k, 0, 0), (k + 0.5, 0, 0), (k + 1, 0, 0))   # collinear slivers along the building's foot
+tri((1, 0, 1), (1, 0, 1), (2, 0, 1))                # a zero-length edge
+tri((3, 1, 3), (3, 1, 3), (3, 1, 3))                # a point
+with open('level.obj', 'w') as f:
+    for v in V: f.write('v %.9g %.9g %.9g\n' % v)
+    for t in F: f.write('f %d %d %d\n' % t)
+PY
+if ! "$bake" level.obj > level.log 2>&1; then echo "FAIL: hemilight_bake level.obj:"; cat level.log; fails=$((fails + 1)); fi
+for w in "generating lightmap UVs for the whole model" "skipped 6 degenerate triangles" "wrote out/level_lightmap_uvs.glb"; do
+  grep -q "$w" level.log || { echo "FAIL: '$w' not in:"; cat level.log; fails=$((fails + 1)); }
+done
+for f in out/level_irradiance.exr out/level_mask.exr out/level_lightmap_uvs.glb; do
+  [ -s "$f" ] || { echo "FAIL: $f not written"; fails=$((fails + 1)); }
+done
+sampled=$(grep -o "texels: [0-9]* sampled of [0-9]* covered" level.log)
+if ! "$bake" out/level_lightmap_uvs.glb --out again > again.log 2>&1; then echo "FAIL: rebaking the written glb:"; cat again.log; fails=$((fails + 1)); fi
+grep -q "generating" again.log && { echo "FAIL: the written glb's UVs were not used:"; cat again.log; fails=$((fails + 1)); }
+grep -q "$sampled" again.log || { echo "FAIL: '$sampled' not in:"; cat again.log; fails=$((fails + 1)); }
+# UVs a hair outside [0, 1] (a glTF with TEXCOORD_1 at -0.00048) are clamped with a warning.
+python3 - <<'PY'
+import base64, json, struct
+data = struct.pack('<12f', 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0) + struct.pack('<8f', -0.00048, 0, -0.00048, 1, 1, 1, 1, 0) + \
+       struct.pack('<6H', 0, 1, 2, 0, 2, 3)
+gltf = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 1}, "indices": 2}]}],
+    "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                    {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                  {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+}
+open('margin.gltf', 'w').write(json.dumps(gltf))
+PY
+expect_ok margin.gltf --size 16 --resolution 16 --bounces 1 --out margin
+grep -q "warning: bake_scene: 2 page UVs lie outside \[0, 1\]" ok.log || { echo "FAIL: no clamp warning:"; cat ok.log; fails=$((fails + 1)); }
 # A texture that cannot be read is an error naming the material and the file.
 printf 'newmtl wood\nKd 1 1 1\nmap_Kd missing_wood.png\n' > wood.mtl
 { echo 'mtllib wood.mtl'; echo 'usemtl wood'; cat quad.obj; } > wood.obj

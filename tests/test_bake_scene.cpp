@@ -442,8 +442,10 @@ TEST_CASE("Scene bake: bad pages, meshes and images name the page or mesh", "[ba
   const scene_bake_input good = mm.input({page_of(16, 16), page_of(16, 16)}, glm::vec3(1.0f));
   bake_options o;
   o.sampler.resolution = 8;
-  const auto fails = [&](const scene_bake_input& in, const std::string& needle) {
-    test::require_error([&] { bake_scene(in, o); }, status::invalid_argument, needle);
+  const auto fails = [&](const scene_bake_input& in, const std::string& needle, bool strict = false) {
+    bake_options so = o;
+    so.strict = strict;
+    test::require_error([&] { bake_scene(in, so); }, status::invalid_argument, needle);
   };
   {
     scene_bake_input in = good;
@@ -469,7 +471,16 @@ TEST_CASE("Scene bake: bad pages, meshes and images name the page or mesh", "[ba
   {
     scene_bake_input in = good;
     in.meshes[0].uv_scale = glm::vec2(0.0f, 1.0f);
-    fails(in, "bake_scene: meshes[0] triangle 0 (scene triangle 0) has zero area in its page's UV space");
+    fails(in, "bake_scene: meshes[0] triangle 0 (scene triangle 0) has zero area in its page's UV space", true);
+    // Without strict the mesh's triangles occlude, get no texels and are named in a warning.
+    const scene_bake_result r = bake_scene(in, o);
+    CHECK(r.stats.no_uv_area_triangles == floor.triangle_count());
+    CHECK(r.stats.first_no_uv_area_triangle == 0);
+    REQUIRE(r.stats.warnings.size() == 1);
+    CHECK_THAT(r.stats.warnings[0], Catch::Contains("bake_scene: " + std::to_string(floor.triangle_count()) +
+                                                    " triangles have 3D area but no lightmap UV area (the first: meshes[0] "
+                                                    "triangle 0 (scene triangle 0))"));
+    CHECK(r.pages[0].stats.sampled_texels == 0);
   }
   {
     scene_bake_input in = good;

@@ -6,6 +6,7 @@
 #include "capi_check.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -92,6 +93,99 @@ static void test_edge_coverage(void) {
   CHECK_FAILS(hemilight_bake_lightmap_directional(meshes, 2, &o, out, 3 * W * H, NULL, 0, sh, 12 * W * H, NULL, 0, NULL),
               HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "hemilight_bake_lightmap_directional: options->resolution 7 is invalid: it must be even and in [2, 4096]");
+}
+
+/* Input as exports give it: a floor of 2 x 2 quads (local x, z in [0, 1], facing up) with every
+ * triangle's own three vertices (duplicates at shared corners), moved by a rotation about y and a
+ * translation computed in double and rounded to float; UVs u = x, v = z except u = -0.00048 at
+ * x = 0 (a packer's margin). Mesh 1 adds collinear slivers along the floor's edge (midpoints exact
+ * before the transform, collinear only up to its rounding), a triangle with a zero-length edge and
+ * one collapsed to a point, with UVs of real area. The bake succeeds, also with strict; the
+ * statistics count what was skipped and clamped; every texel sees the sky alone: pi. */
+static void place(double x, double y, double z, float* out3) {
+  const double c = cos(0.6), s = sin(0.6);
+  out3[0] = (float)(c * x + s * z + 37.25);
+  out3[1] = (float)(y + 2.5);
+  out3[2] = (float)(-s * x + c * z - 11.75);
+}
+
+static void test_exported_floor(void) {
+  enum { floor_tris = 8, junk_tris = 6 };
+  static float pos[2][3 * 3 * floor_tris], uv[2][2 * 3 * floor_tris];
+  static uint32_t indices[2][3 * floor_tris];
+  hemilight_bake_mesh m[2];
+  hemilight_bake_options o;
+  hemilight_bake_stats st;
+  int i, j, k, t = 0, clamped = 0, sky_only = 1;
+  /* mesh 0: the floor */
+  for (j = 0; j < 2; ++j)
+    for (i = 0; i < 2; ++i) {
+      const double x0 = i / 2.0, x1 = (i + 1) / 2.0, z0 = j / 2.0, z1 = (j + 1) / 2.0;
+      const double corners[2][3][2] = {{{x0, z0}, {x0, z1}, {x1, z1}}, {{x0, z0}, {x1, z1}, {x1, z0}}};
+      for (k = 0; k < 2; ++k, ++t) {
+        int c;
+        for (c = 0; c < 3; ++c) {
+          const double x = corners[k][c][0], z = corners[k][c][1];
+          place(x, 0.0, z, &pos[0][9 * t + 3 * c]);
+          uv[0][6 * t + 2 * c] = x == 0.0 ? -0.00048f : (float)x;
+          uv[0][6 * t + 2 * c + 1] = (float)z;
+          if (x == 0.0) ++clamped;
+          indices[0][3 * t + c] = (uint32_t)(3 * t + c);
+        }
+      }
+    }
+  /* mesh 1: four slivers along z = 0 and x = 0, a zero-length edge, a point */
+  for (t = 0; t < junk_tris; ++t) {
+    double p[3][3];
+    int c;
+    if (t < 4) {
+      const double a = (t % 2) / 2.0, b = (t % 2 + 1) / 2.0;
+      const double along[3] = {a, 0.5 * (a + b), b};
+      for (c = 0; c < 3; ++c) {
+        p[c][0] = t < 2 ? along[c] : 0.0;
+        p[c][1] = 0.0;
+        p[c][2] = t < 2 ? 0.0 : along[2 - c];
+      }
+    } else {
+      for (c = 0; c < 3; ++c) {
+        p[c][0] = (t == 4 && c == 2) ? 0.75 : 0.5;
+        p[c][1] = 0.0;
+        p[c][2] = 0.5;
+      }
+    }
+    for (c = 0; c < 3; ++c) {
+      place(p[c][0], p[c][1], p[c][2], &pos[1][9 * t + 3 * c]);
+      uv[1][6 * t + 2 * c] = c == 1 ? 0.9f : 0.8f; /* real UV area: it would cover texels if baked */
+      uv[1][6 * t + 2 * c + 1] = c == 2 ? 0.9f : 0.8f;
+      indices[1][3 * t + c] = (uint32_t)(3 * t + c);
+    }
+  }
+  memset(m, 0, sizeof m);
+  for (k = 0; k < 2; ++k) {
+    m[k].positions = pos[k];
+    m[k].lightmap_uvs = uv[k];
+    m[k].indices = indices[k];
+    m[k].material.albedo[0] = m[k].material.albedo[1] = m[k].material.albedo[2] = 0.5f;
+  }
+  m[0].vertex_count = 3 * floor_tris;
+  m[0].triangle_count = floor_tris;
+  m[1].vertex_count = 3 * junk_tris;
+  m[1].triangle_count = junk_tris;
+  hemilight_bake_options_init(&o);
+  o.width = o.height = W;
+  o.resolution = 16;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+  o.strict = 1;
+  hemilight_bake_stats_init(&st);
+  CHECK(hemilight_bake_lightmap(m, 2, &o, out, 3 * W * H, valid, W * H, &st) == HEMILIGHT_OK);
+  CHECK(st.degenerate_triangles == junk_tris);
+  CHECK(st.no_uv_area_triangles == 0 && st.first_no_uv_area_mesh == SIZE_MAX && st.first_no_uv_area_triangle == SIZE_MAX);
+  CHECK(clamped == 6 && st.clamped_uvs == (size_t)clamped);
+  CHECK(st.sampled_texels == W * H);
+  CHECK(st.overlapping_texels == 0); /* the slivers' UV triangle lies over the floor's: baked, it would overlap */
+  for (i = 0; i < 3 * W * H; ++i)
+    if (fabs(out[i] - 3.14159265) > 1e-4) sky_only = 0; /* float sums of exact weights */
+  CHECK(sky_only);
 }
 
 int main(void) {
@@ -298,10 +392,24 @@ int main(void) {
   bad_uv[2] = 1.25f;
   meshes[1].lightmap_uvs = bad_uv;
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "meshes[1].lightmap_uvs[2] (vertex 1, u) = 1.25");
+  bad_uv[2] = -0.0011f; /* past the 0.001 that is clamped */
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "meshes[1].lightmap_uvs[2] (vertex 1, u) = -0.0011");
   bad_uv[2] = bad_uv[0]; /* vertex 1 = vertex 0 in UV: triangle 0 of mesh 1 (triangle 2 overall) is flat in UV */
   bad_uv[3] = bad_uv[1];
+  o.strict = 1;
   CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "meshes[1]: triangle 0 (indices[0..2]) has zero area in lightmap UV space");
+  o.strict = 2;
+  CHECK_FAILS(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->strict is 2; it must be 0 or 1");
+  /* Without strict the flat triangle still occludes but gets no texels; the statistics name it. */
+  o.strict = 0;
+  hemilight_bake_stats_init(&stats);
+  CHECK(hemilight_bake_lightmap(meshes, 2, &o, out, 3 * W * H, valid, W * H, &stats) == HEMILIGHT_OK);
+  CHECK(stats.no_uv_area_triangles == 1 && stats.first_no_uv_area_mesh == 1 && stats.first_no_uv_area_triangle == 0);
+  CHECK(stats.degenerate_triangles == 0 && stats.clamped_uvs == 0);
+  fill_sentinel(); /* the failures below must leave the buffers as they are */
   meshes[1].lightmap_uvs = uv_b;
   memcpy(bad_idx, idx, sizeof bad_idx);
   bad_idx[4] = 4;
@@ -327,6 +435,7 @@ int main(void) {
   CHECK(untouched());
 
   test_edge_coverage();
+  test_exported_floor();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -201,8 +201,18 @@ int main(void) {
               "hemilight_bake_scene: scene->meshes[1].lightmap_uvs[5] (vertex 2, v) = 1.000000 maps to 1.250000 in page 1");
   placements[1].uv_offset[1] = 0.0f;
   placements[0].uv_scale[1] = 0.0f;
+  o.strict = 1;
   CHECK_FAILS(hemilight_bake_scene(&scene, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "hemilight_bake_scene: scene->meshes[0]: triangle 0 (indices[0..2]) has zero area in its page's UV space");
+  o.strict = 0;
+  {
+    /* Without strict: mesh 0's triangles occlude, get no texels, and are counted and named. */
+    hemilight_bake_stats st;
+    hemilight_bake_stats_init(&st);
+    CHECK(hemilight_bake_scene(&scene, &o, &st) == HEMILIGHT_OK);
+    CHECK(st.no_uv_area_triangles == 2 && st.first_no_uv_area_mesh == 0 && st.first_no_uv_area_triangle == 0);
+    fill_sentinel(); /* the failures below must leave the buffers as they are */
+  }
   placements[0].uv_scale[1] = 1.0f;
   placements[0].uv_offset[1] = NAN;
   CHECK_FAILS(hemilight_bake_scene(&scene, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,

@@ -106,6 +106,7 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(b.use_cache == bd.use_cache);
   CHECK(b.thread_count == bd.thread_count);
   CHECK(b.sampler.raster.edge_coverage == bd.sampler.raster.edge_coverage);
+  CHECK(b.strict == bd.strict);
 }
 
 TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
@@ -125,6 +126,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   c.shadow_mask_lights[0] = 2;
   c.shadow_mask_lights[3] = 0;
   c.edge_coverage = 1;
+  c.strict = 1;
   light l;
   l.position = {1, 2, 3};
   const auto env = std::make_shared<const cubemap>();
@@ -148,6 +150,8 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.shadow_mask_lights[1] == -1);
   CHECK(o.shadow_mask_lights[3] == 0);
   CHECK(o.sampler.raster.edge_coverage);
+  CHECK(o.strict);
+  CHECK(!capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false).strict);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
@@ -196,6 +200,16 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   hemilight_bake_options bake_edge_full = capi::default_bake_options();
   REQUIRE(capi::read_sized(&bake_before_edge, bake_edge_full).empty());
   CHECK(bake_edge_full.edge_coverage == 0);
+  // The layout before strict (up to edge_coverage, whose tail padding is not read): strict takes
+  // its default, 0, whatever lies beyond.
+  hemilight_bake_options before_strict;
+  std::memset(&before_strict, 0x01, sizeof before_strict);
+  before_strict.struct_size = offsetof(hemilight_bake_options, reserved1);  // the older sizeof (152 on LP64)
+  hemilight_bake_options strict_full = capi::default_bake_options();
+  REQUIRE(capi::read_sized(&before_strict, strict_full).empty());
+  CHECK(strict_full.strict == 0);
+  CHECK(strict_full.reserved1 == 0);                // padding: never read
+  CHECK(strict_full.edge_coverage == 0x01010101);  // read: within the older size
   // Statistics: only the fields within struct_size are written.
   hemilight_cache_stats from{};
   from.struct_size = sizeof from;
@@ -213,6 +227,34 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   std::memset(&untouched, 0x5a, sizeof untouched);
   CHECK(std::memcmp(&to.seconds, &untouched.seconds, sizeof to.seconds) == 0);
   CHECK(std::memcmp(&to.invalid_samples, &untouched.invalid_samples, sizeof to.invalid_samples) == 0);
+  // The bake statistics of the layout before the input counts (up to seconds): the counts stay
+  // untouched; with the whole struct every count arrives.
+  hemilight_bake_stats bake_from{};
+  bake_from.struct_size = sizeof bake_from;
+  bake_from.hemicubes = 9;
+  bake_from.seconds = 2.5;
+  bake_from.degenerate_triangles = 11;
+  bake_from.no_uv_area_triangles = 3;
+  bake_from.first_no_uv_area_mesh = 1;
+  bake_from.first_no_uv_area_triangle = 4;
+  bake_from.clamped_uvs = 6;
+  hemilight_bake_stats bake_to;
+  std::memset(&bake_to, 0x5a, sizeof bake_to);
+  bake_to.struct_size = offsetof(hemilight_bake_stats, degenerate_triangles);
+  capi::write_sized(bake_from, &bake_to);
+  CHECK(bake_to.hemicubes == 9);
+  CHECK(bake_to.seconds == 2.5);
+  hemilight_bake_stats bake_untouched;
+  std::memset(&bake_untouched, 0x5a, sizeof bake_untouched);
+  CHECK(std::memcmp(&bake_to.degenerate_triangles, &bake_untouched.degenerate_triangles,
+                    sizeof bake_to - offsetof(hemilight_bake_stats, degenerate_triangles)) == 0);
+  bake_to.struct_size = sizeof bake_to;
+  capi::write_sized(bake_from, &bake_to);
+  CHECK(bake_to.degenerate_triangles == 11);
+  CHECK(bake_to.no_uv_area_triangles == 3);
+  CHECK(bake_to.first_no_uv_area_mesh == 1);
+  CHECK(bake_to.first_no_uv_area_triangle == 4);
+  CHECK(bake_to.clamped_uvs == 6);
 }
 
 TEST_CASE("C ABI options: cube-map irradiance options reach the C++ side, defaults are the C++ defaults", "[capi]") {
@@ -236,4 +278,55 @@ TEST_CASE("C ABI options: cube-map irradiance options reach the C++ side, defaul
   CHECK(read.method == HEMILIGHT_IRRADIANCE_SH25);
   CHECK(read.input_size == d.irradiance_input_size);
   CHECK(read.thread_count == d.thread_count);
+}
+
+TEST_CASE("C ABI options: every unwrap option reaches the C++ side, defaults are the C++ defaults, older layouts too", "[capi]") {
+  const unwrap_options d;
+  const unwrap_options def = capi::to_cpp(capi::default_unwrap_options());
+  CHECK(def.texels_per_unit == d.texels_per_unit);
+  CHECK(def.page_size == d.page_size);
+  CHECK(def.padding == d.padding);
+  CHECK(def.max_chart_angle == d.max_chart_angle);
+  CHECK(def.max_pages == d.max_pages);
+  CHECK(def.thread_count == d.thread_count);
+  hemilight_unwrap_options c = capi::default_unwrap_options();
+  c.texels_per_unit = 12.5f;
+  c.page_size = 512;
+  c.padding = 3;
+  c.max_chart_angle = 45.0f;
+  c.max_pages = 9;
+  c.thread_count = 2;
+  const unwrap_options o = capi::to_cpp(c);
+  CHECK(o.texels_per_unit == 12.5f);
+  CHECK(o.page_size == 512);
+  CHECK(o.padding == 3);
+  CHECK(o.max_chart_angle == 45.0f);
+  CHECK(o.max_pages == 9);
+  CHECK(o.thread_count == 2);
+  // An older, shorter layout (up to max_chart_angle): the rest takes the defaults.
+  c.struct_size = offsetof(hemilight_unwrap_options, max_pages);
+  hemilight_unwrap_options read = capi::default_unwrap_options();
+  REQUIRE(capi::read_sized(&c, read).empty());
+  CHECK(read.max_chart_angle == 45.0f);
+  CHECK(read.max_pages == d.max_pages);
+  CHECK(read.thread_count == d.thread_count);
+  c.struct_size = sizeof c + 8;
+  CHECK_THAT(capi::read_sized(&c, read), Catch::Contains("built against a newer hemilight.h"));
+  // Statistics: only the fields within struct_size are written.
+  hemilight_unwrap_stats from{};
+  from.struct_size = sizeof from;
+  from.charts = 7;
+  from.pages = 2;
+  from.seam_texels = 3.5;
+  from.seconds = 0.25;
+  hemilight_unwrap_stats to;
+  std::memset(&to, 0x5a, sizeof to);
+  to.struct_size = offsetof(hemilight_unwrap_stats, seam_texels);
+  REQUIRE(capi::check_sized(&to).empty());
+  capi::write_sized(from, &to);
+  CHECK(to.charts == 7);
+  CHECK(to.pages == 2);
+  hemilight_unwrap_stats untouched;
+  std::memset(&untouched, 0x5a, sizeof untouched);
+  CHECK(std::memcmp(&to.seam_texels, &untouched.seam_texels, sizeof to - offsetof(hemilight_unwrap_stats, seam_texels)) == 0);
 }

@@ -377,3 +377,98 @@ TEST_CASE("Model export: a stand-in level written as glb reads back with the sam
   // 1 - x rounds by at most 2^-25 (3e-8) for x < 0.5 and is exact above.
   CHECK(uv_error <= 1e-7f);
 }
+
+TEST_CASE("Model import: meshes without lightmap UVs get generated ones, written back as TEXCOORD_1 and read back", "[model_import]") {
+  // The floor has no TEXCOORD_1; with allow_missing_lightmap_uvs it comes without lightmap UVs, named.
+  const written_model w = write_model("import_generate", true, false);
+  model_import::import_options io;
+  io.allow_missing_lightmap_uvs = true;
+  model_import::model m = model_import::import_model(w.path, io);
+  REQUIRE(m.without_lightmap_uvs.size() == 1);
+  CHECK(m.without_lightmap_uvs[0].find("mesh 0 ('Floor')") != std::string::npos);
+  CHECK(m.meshes[0].lightmap_uvs.empty());
+  // The model's world positions unwrapped as one (the bake's path, examples/bake.cpp).
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices;
+  std::size_t triangles = 0;
+  for (const model_import::mesh& me : m.meshes) {
+    const auto base = std::uint32_t(positions.size());
+    positions.insert(positions.end(), me.positions.begin(), me.positions.end());
+    for (std::uint32_t i : me.indices) indices.push_back(base + i);
+    triangles += me.indices.size() / 3;
+  }
+  unwrap_options o;
+  o.page_size = 64;
+  const unwrap_result r = unwrap_lightmap(positions.data(), positions.size(), indices.data(), triangles, o);
+  const std::vector<model_import::mesh> before = m.meshes;
+  model_import::apply_lightmap_uvs(m, r);
+  REQUIRE(m.meshes.size() == before.size());  // one page: no mesh is split
+  CHECK(m.pages == 1);
+  for (std::size_t k = 0; k < m.meshes.size(); ++k) {
+    const model_import::mesh& me = m.meshes[k];
+    REQUIRE(me.indices.size() == before[k].indices.size());
+    REQUIRE(me.lightmap_uvs.size() == me.positions.size());
+    for (std::size_t i = 0; i < me.indices.size(); ++i) CHECK(me.positions[me.indices[i]] == before[k].positions[before[k].indices[i]]);
+  }
+  // Written as glb and read back: the same triangles and UVs (to float rounding of 1 - v: 6e-8).
+  const std::string glb = std::string(HEMILIGHT_TEST_TMPDIR) + "/import_generate/with_uvs.glb";
+  model_export::write_glb(m, glb);
+  const model_import::model back = model_import::import_model(glb);
+  REQUIRE(back.meshes.size() == m.meshes.size());
+  float uv_error = 0.0f;
+  for (std::size_t k = 0; k < m.meshes.size(); ++k) {
+    REQUIRE(back.meshes[k].indices.size() == m.meshes[k].indices.size());
+    for (std::size_t i = 0; i < m.meshes[k].indices.size(); ++i) {
+      CHECK(back.meshes[k].positions[back.meshes[k].indices[i]] == m.meshes[k].positions[m.meshes[k].indices[i]]);
+      uv_error = std::max(uv_error, glm::length(back.meshes[k].lightmap_uvs[back.meshes[k].indices[i]] -
+                                                m.meshes[k].lightmap_uvs[m.meshes[k].indices[i]]));
+    }
+  }
+  CHECK(uv_error <= 1e-7f);
+  CHECK(back.materials[back.meshes[0].material].base_color_texture >= 0);  // the checker texture, by its file
+}
+
+// A floor quad (y = 0, facing up) whose TEXCOORD_0 and TEXCOORD_1 are `uv` (glTF's convention).
+std::string write_quad(const std::string& name, const float (&uv)[8]) {
+  const std::string dir = std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name;
+  std::filesystem::create_directories(dir);
+  std::vector<unsigned char> buf;
+  put<float>(buf, {0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0});
+  put<float>(buf, {uv[0], uv[1], uv[2], uv[3], uv[4], uv[5], uv[6], uv[7]});
+  put<std::uint16_t>(buf, {0, 1, 2, 0, 2, 3});
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"name": "floor", "mesh": 0}],
+  "meshes": [{"name": "Floor", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 1}, "indices": 2}]}],
+  "buffers": [{"byteLength": )" + std::to_string(buf.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(buf) + R"("}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                  {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
+                {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+  const std::string path = dir + "/quad.gltf";
+  std::ofstream(path) << gltf;
+  return path;
+}
+
+void import_fails(const std::string& path, const model_import::import_options& io, const std::string& needle) {
+  try {
+    model_import::import_model(path, io);
+    FAIL("no error; expected " << needle);
+  } catch (const std::runtime_error& e) {
+    INFO(e.what());
+    CHECK(std::string(e.what()).find(needle) != std::string::npos);
+  }
+}
+
+TEST_CASE("Model import: UVs a hair outside [0, 1] are taken, UV-less triangles refused only when strict", "[model_import]") {
+  model_import::import_options io, strict;
+  strict.strict = true;
+  // u = -0.00048 (a packer's margin, within lightmap_uv_tolerance): taken as it is (the bake clamps).
+  const model_import::model m = model_import::import_model(write_quad("import_margin", {-0.00048f, 0, -0.00048f, 1, 1, 1, 1, 0}), io);
+  CHECK(m.meshes[0].lightmap_uvs[0].x == -0.00048f);
+  import_fails(write_quad("import_outside", {-0.002f, 0, 0, 1, 1, 1, 1, 0}), io, "vertex 0: lightmap UV (-0.002000, 0.000000) is outside [0, 1] by more than 0.001");
+  // Vertex 2's UV on vertex 1's: triangle 0 (0, 1, 2) has no UV area, triangle 1 (0, 2, 3) has.
+  const std::string flat = write_quad("import_flat", {0, 0, 0, 1, 0, 1, 1, 0});
+  CHECK_NOTHROW(model_import::import_model(flat, io));
+  import_fails(flat, strict, "mesh 0 ('Floor') at node 'floor' triangle 0 has zero area in lightmap UV space");
+}

@@ -297,3 +297,74 @@ TEST_CASE("scene: the SIMD vertex arrays (scene_access::vertex_coordinates) repe
       }
   }
 }
+
+// ---- degenerate triangles (is_degenerate_triangle) ---------------------------------------------
+
+namespace {
+
+// Exactly collinear points p + s d, moved by a rotation about an oblique axis and a translation
+// in float, as a node transform in an exporter does: the result is collinear only up to the
+// rounding of its coordinates.
+std::array<glm::vec3, 3> collinear_after_transform(const glm::dvec3& p, const glm::dvec3& d, double s1, double s2, double s3) {
+  const glm::dvec3 axis = glm::normalize(glm::dvec3(1, 2, 3));
+  const double angle = 0.7;
+  const auto rotate = [&](const glm::dvec3& v) {  // Rodrigues, in double, then rounded once
+    return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1.0 - std::cos(angle));
+  };
+  const glm::dvec3 t(12.5, -3.25, 40.0);
+  return {glm::vec3(rotate(p + s1 * d) + t), glm::vec3(rotate(p + s2 * d) + t), glm::vec3(rotate(p + s3 * d) + t)};
+}
+
+}  // namespace
+
+TEST_CASE("scene: degenerate triangles are those without area at float precision, and are never drawn", "[scene]") {
+  const glm::vec3 o(0.0f), x(1.0f, 0.0f, 0.0f);
+  CHECK(is_degenerate_triangle(o, o, x));                              // a zero-length edge
+  CHECK(is_degenerate_triangle(o, o, o));                              // a point
+  CHECK(is_degenerate_triangle(o, x, {0.5f, 0.0f, 0.0f}));            // exactly collinear
+  CHECK(is_degenerate_triangle(o, x, {std::nanf(""), 0.0f, 0.0f}));  // non-finite: no area to use
+  CHECK_FALSE(is_degenerate_triangle(o, x, {0.0f, 1.0f, 0.0f}));
+  // A thin but real sliver: height 1e-6 with coordinates of magnitude 1, 4 ulps being 2.4e-7.
+  CHECK_FALSE(is_degenerate_triangle(o, x, {0.5f, 1e-6f, 0.0f}));
+  CHECK(is_degenerate_triangle(o, x, {0.5f, 2e-7f, 0.0f}));
+  // Collinear triangles after a transform, at several sizes: degenerate here, although the
+  // area-only rule (area < 1e-10 x longest edge^2) misses most of them, which is why the rule is
+  // relative to the coordinates' precision (scene.hpp, degenerate_height_tolerance).
+  int missed_by_area_rule = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double size = std::pow(10.0, -2.0 + 4.0 * k / 199.0);  // 0.01 .. 100 units
+    const auto t = collinear_after_transform(glm::dvec3(0.3 * k, -0.1 * k, 0.05 * k), glm::dvec3(0.6, 0.3, -0.2) * size, 0.0,
+                                             0.37, 1.0);
+    CHECK(is_degenerate_triangle(t[0], t[1], t[2]));
+    const glm::dvec3 a(t[0]), b(t[1]), c(t[2]);
+    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+    const double longest2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+    if (area >= 1e-10 * longest2) ++missed_by_area_rule;
+  }
+  CHECK(missed_by_area_rule > 100);
+  // scene::create skips them: they are neither drawn nor hit.
+  scene_mesh m;
+  const material lit{glm::vec3(1.0f), glm::vec3(0.5f), false};
+  const auto t = collinear_after_transform(glm::dvec3(1, 2, 3), glm::dvec3(0.5, 0.1, 0.2), 0.0, 0.5, 1.0);
+  m.add_triangle(t[0], t[1], t[2], lit);
+  m.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, lit);
+  m.add_triangle({0, 0, 0}, {0, 0, 0}, {0, 1, 0}, lit);
+  const auto s = scene::create(m.desc());
+  CHECK(s->triangle_count() == 3);
+  REQUIRE(s->drawable_triangle_count() == 1);
+  CHECK(s->triangles()[0].index == 1);
+}
+
+TEST_CASE("scene: the reference scenes have no degenerate triangle (their drawn sets do not change with the rule)", "[scene]") {
+  const scene_mesh scenes[] = {cornell_box(), hexagon_room(1), hexagon_room(3), sky_and_occluders(), heightfield(20000),
+                               many_boxes(200), open_pavilion(), open_street(), hexagon_room_sunlit(2).mesh,
+                               cornell_box_rect_light().mesh};
+  for (const scene_mesh& m : scenes) {
+    std::size_t degenerate = 0;
+    for (std::size_t i = 0; i < m.triangle_count(); ++i)
+      if (is_degenerate_triangle(m.positions[m.indices[3 * i]], m.positions[m.indices[3 * i + 1]], m.positions[m.indices[3 * i + 2]]))
+        ++degenerate;
+    CHECK(degenerate == 0);
+    CHECK(scene::create(m.desc())->drawable_triangle_count() == m.triangle_count());
+  }
+}

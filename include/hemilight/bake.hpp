@@ -14,6 +14,7 @@
 #include "hemilight/image_io.hpp"
 #include "hemilight/lights.hpp"
 #include "hemilight/scene.hpp"
+#include "hemilight/unwrap.hpp"  // generate_lightmap_uvs: lightmap UVs for what the baker bakes
 
 #include <array>
 #include <cstddef>
@@ -32,6 +33,15 @@ inline constexpr int max_lightmap_size = 8192;
 
 /// Largest number of light bounces a bake takes (bake_options::bounces).
 inline constexpr int max_bounces = 64;
+
+/// How far outside [0, 1] a lightmap UV component may lie and still be baked, clamped onto
+/// [0, 1] (bake_lightmap's UVs; bake_scene's page UVs after scale and offset). Why 1e-3: UV sets
+/// made elsewhere leave UVs a hair outside the square (float rounding: 6e-8 near 1; a packer's
+/// margin computed in its own texel grid: up to half a texel, 4.9e-4 for 1024^2, as -0.00048 in a
+/// real export). 1e-3 takes both for maps from 512^2 up, while a UV meant for another tile or
+/// page (1.2, -0.5) is still refused. Clamping moves a vertex by at most 1e-3 of the map: one
+/// texel at 1024, 8 at max_lightmap_size, at the map's border, where charts have their padding.
+inline constexpr float lightmap_uv_tolerance = 1e-3f;
 
 /// Options of bake_lightmap.
 struct bake_options {
@@ -75,6 +85,11 @@ struct bake_options {
   /// validate_lights does. Cost per sample and light: one shadow ray (hard) to 264 (penumbra).
   std::vector<light> lights;
   direct_options direct;  ///< the lights' shadow rays, checked as validate_direct_options does
+  /// A triangle with 3D area but no lightmap UV area (at most 1e-12 of the UV square: a broken
+  /// unwrap): false, it still occludes, gets no texels and is counted and named
+  /// (bake_stats::no_uv_area_triangles, warnings); true, the bake fails with error(invalid_argument)
+  /// naming it. Degenerate triangles (is_degenerate_triangle, scene.hpp) are skipped either way.
+  bool strict = false;
   /// Shadow mask (bake_result::shadow_mask): channel c holds the visibility of light
   /// shadow_mask_lights[c] (an index into lights), -1 leaves it 0. All -1: no mask.
   std::array<int, 4> shadow_mask_lights{{-1, -1, -1, -1}};
@@ -95,11 +110,27 @@ struct bake_stats {
   std::size_t hemicubes = 0;          ///< hemicubes rendered, all passes
   std::size_t records = 0;            ///< cache records, all passes
   std::vector<cache_stats> passes;    ///< the cache's statistics per pass
+  /// Input the bake went past (bake_options::strict). Triangles without 3D area
+  /// (is_degenerate_triangle): skipped, no texels, never occlude.
+  std::size_t degenerate_triangles = 0;
+  /// Triangles with 3D area but no lightmap UV area: they occlude but get no texels.
+  std::size_t no_uv_area_triangles = 0;
+  /// The lowest-numbered of them (scene_desc numbering), or no_index.
+  std::size_t first_no_uv_area_triangle = no_index;
+  /// Lightmap UVs (vertices; bake_scene: page UVs of a mesh's vertices) up to
+  /// lightmap_uv_tolerance outside [0, 1], clamped onto it.
+  std::size_t clamped_uvs = 0;
+  /// One line per kind of input problem above but degenerate triangles, naming the first case
+  /// ("bake_lightmap: 2 triangles have 3D area but no lightmap UV area (the first: triangle 34):
+  /// they occlude but get no texels"). Empty for clean input.
+  std::vector<std::string> warnings;
   double coverage_seconds = 0.0;      ///< exact UV coverage and samples (compute_lightmap_samples)
   double direct_seconds = 0.0;        ///< the lights' direct irradiance (0 without lights)
   std::size_t seam_texels = 0;        ///< texels set by seam stitching (0 without stitch_seams)
   double stitch_seconds = 0.0;        ///< finding and stitching the seams, every output
   double seconds = 0.0;               ///< the whole bake (wall time)
+
+  static constexpr std::size_t no_index = ~std::size_t(0);
 };
 
 /// What bake_lightmap returns.
@@ -141,10 +172,12 @@ struct bake_input {
 /// Errors (hemilight::error naming the problem; nothing returned):
 ///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces not in
 ///     [1, max_bounces], bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN,
-///     dilation < -1, cache options out of range); no lightmap UVs; a UV outside [0, 1]
-///     ("lightmap_uvs[7].u = 1.2 is outside [0, 1]"); a triangle with nonzero 3D area but zero UV
-///     area; a non-finite normal; an albedo outside [0, 1]; everything scene::create rejects; no
-///     texel sampled (nothing to bake);
+///     dilation < -1, cache options out of range); no lightmap UVs; a UV more than
+///     lightmap_uv_tolerance outside [0, 1] ("lightmap_uvs[7].u = 1.2 is outside [0, 1]"); with
+///     strict, a triangle with 3D area but no UV area; a non-finite normal; an albedo outside
+///     [0, 1]; everything scene::create rejects; no texel sampled (nothing to bake);
+/// Degenerate triangles are skipped and counted, UVs within the tolerance clamped and counted,
+/// triangles with 3D area but no UV area (without strict) counted and named (bake_stats).
 ///   cancelled: the progress callback returned false.
 /// Cost: O(UV-covered texels) for the samples, then per pass one cache run (cache.hpp): one
 /// render and integration per hemicube, spread over the threads, plus O(sampled texels).
@@ -235,8 +268,10 @@ struct scene_bake_result {
 /// ("pages[0].albedo (3, 7) = 1.5 is outside [0, 1]"); meshes not covering the triangles in order;
 /// a page index out of range ("meshes[2].page = 5 is not -1 or a page index (3 pages)"); a
 /// non-finite scale or offset; a UV mapped outside the page ("meshes[2] (page 1):
-/// lightmap_uvs[17] * uv_scale + uv_offset = (1.25, 0.5) is outside [0, 1]"); a triangle with
-/// 3D area but no area in its page ("meshes[2] triangle 4 (scene triangle 40) ..."); bad
+/// lightmap_uvs[17] * uv_scale + uv_offset = (1.25, 0.5) is outside [0, 1]", beyond
+/// lightmap_uv_tolerance); with strict, a triangle with 3D area but no area in its page
+/// ("meshes[2] triangle 4 (scene triangle 40) ..."; without strict it is counted and named in the
+/// whole bake's stats, bake_lightmap's rules for degenerate triangles and clamped UVs apply); bad
 /// geometry as bake_lightmap reports it (except that raw UVs may lie outside [0, 1]); no texel
 /// sampled in any page; bad options as bake_lightmap. cancelled: the progress callback.
 /// out_of_memory: the pages' atlas (the widest page x the sum of the heights and two guard rows
@@ -265,13 +300,18 @@ struct lightmap_samples {
   /// (tangent, bitangent, normal) is left-handed on mirrored charts.
   std::vector<glm::vec3> tangent, bitangent;
   std::size_t overlapping_texels = 0;       ///< texels whose covered areas sum to more than 1.001
+  /// Triangles that cover no texel: degenerate (is_degenerate_triangle), and with 3D area but no
+  /// UV area (as bake_stats counts them).
+  std::size_t degenerate_triangles = 0, no_uv_area_triangles = 0;
 
   static constexpr std::uint32_t no_triangle = 0xffffffffu;
 };
 
-/// Exact coverage and sample points of every texel. Validates like bake_lightmap
-/// (size, UVs, normals, zero-area UV triangles); positions and indices must be valid (as
-/// scene::create checks). Cost: O(sum over triangles of the texels in their UV bounding box).
+/// Exact coverage and sample points of every texel. Validates like bake_lightmap (size, UVs,
+/// normals) with its rules for degenerate input (bake_options::strict false: UVs within
+/// lightmap_uv_tolerance clamped, degenerate triangles and triangles without UV area cover
+/// nothing); positions and indices must be valid (as scene::create checks). Cost: O(sum over
+/// triangles of the texels in their UV bounding box).
 lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height);
 
 /// Area (in texel units, [0, 1]) and centroid (texel units) of the part of the triangle a, b, c
@@ -298,15 +338,6 @@ image bake_radiance_texture(const bake_input& input, const bake_options& options
 /// of texels filled. Throws error(invalid_argument) if filled's size is not width x height or
 /// rings < -1. Cost: O(texels x rings).
 std::size_t dilate(image& img, std::vector<std::uint8_t>& filled, int rings);
-
-/// Gives `mesh` lightmap UVs for the baker: planar groups of edge-connected triangles (same
-/// plane, shared edge by position) become charts, each projected onto its plane at one common
-/// texel density and packed in shelves into a size x size lightmap with `padding` empty texels
-/// between charts (and at the border). Vertices shared by several charts are duplicated, so the
-/// mesh's vertex count may grow; triangles keep their order and materials. Meant for the
-/// built-in scenes (boxes, rooms), not as a general unwrapper. Throws error(invalid_argument)
-/// for size < 8, padding < 0 or 4 padding >= size. Cost: O(T log T) plus a few packings.
-void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding = 2);
 
 // ---- directional lightmaps ------------------------------------------------------------------
 

@@ -6,6 +6,7 @@
 //              geometry.hpp (hemicube layout, exact texel weights, frames, cube faces),
 //              image_io.hpp (float images and cube maps as OpenEXR), memory.hpp (the table budget)
 //   scene      scene.hpp: immutable triangle scenes with materials, lightmap UVs, sky and BVH
+//   unwrap     unwrap.hpp: lightmap UVs for any mesh: charts, conformal maps, packing into pages
 //   cubemap    cubemap.hpp: environment cube maps: mappings, sampling, lookup fixup, filtering, SH
 //   rays       rays.hpp (shadow and closest-hit rays), lights.hpp (sun, point, spot, rect lights)
 //   raster     hemicube.hpp (the hemicube buffer), raster.hpp (the software hemicube rasterizer)
@@ -35,3 +36,4 @@
 #include "hemilight/sampler.hpp"
 #include "hemilight/scene.hpp"
 #include "hemilight/seams.hpp"
+#include "hemilight/unwrap.hpp"

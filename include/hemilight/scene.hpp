@@ -14,8 +14,9 @@
 // (raster.hpp) replaces the triangles' emission (it holds emission + albedo E / pi of a bounce).
 // Sky: a constant radiance seen where nothing is hit.
 //
-// Zero-area triangles are accepted and never drawn (they keep their index). An empty scene is
-// valid: every texel sees the sky.
+// Degenerate triangles (no area at the precision of their float coordinates:
+// is_degenerate_triangle) are accepted and never drawn: they never occlude (they keep their
+// index). An empty scene is valid: every texel sees the sky.
 #pragma once
 
 #include "hemilight/error.hpp"
@@ -55,6 +56,24 @@ inline constexpr float max_coordinate = 1e18f;
 /// Largest vertex and triangle counts scene::create accepts (2^31 - 1): indices are uint32 and
 /// the rasterizer keeps triangle numbers in 32 bits. Larger counts get error(out_of_memory).
 inline constexpr std::size_t max_scene_elements = (std::size_t(1) << 31) - 1;
+
+/// Tolerance of is_degenerate_triangle: the height of a triangle over its longest edge, as a
+/// fraction of the largest magnitude m of its vertices' coordinates, at or below which it has no
+/// area. Why 2^-22 (4 float ulps of m): rounding each coordinate of exactly collinear points to
+/// float (an export, a node transform applied in float) moves each vertex by up to
+/// sqrt(3) 2^-24 m, which leaves the rounded triangle a height of up to 2 sqrt(3) 2^-24 m, about
+/// 3.5 x 2^-24 m; 4 covers it with a margin. A test on the area alone (area < 1e-10 x the longest
+/// edge squared) misses such triangles: their area reaches 1e-7 x L x m, and m >= L / (2 sqrt 3).
+/// Every triangle with area <= 1e-10 L^2 is degenerate here too, for the same reason.
+inline constexpr double degenerate_height_tolerance = 0x1p-22;
+
+/// True when the triangle (a, b, c) has no area at the precision of its coordinates: twice its
+/// area |(b - a) x (c - a)| (in double) is at most degenerate_height_tolerance x L x m, L its
+/// longest edge and m the largest coordinate magnitude of its vertices (so also when L = 0:
+/// coincident vertices). Non-finite input gives true. The one rule of the scene (never drawn),
+/// the baker (no texels; bake_stats::degenerate_triangles) and the unwrapper (unwrap.hpp).
+/// Cost: O(1).
+bool is_degenerate_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) noexcept;
 
 /// What scene::create reads (nothing is kept: the scene copies what it needs).
 struct scene_desc {
@@ -126,8 +145,8 @@ class scene {
   ///     ("positions[4].y is nan"); an index >= vertex_count ("indices[17] = 900 is out of range:
   ///     12 vertices"); a negative or non-finite emission, albedo or sky radiance.
   ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
-  /// Zero-area triangles (repeated indices, collinear or coincident positions) are accepted and
-  /// never drawn. Cost: O(T log^2 T) for T triangles; memory about 140 bytes per triangle. The
+  /// Degenerate triangles (is_degenerate_triangle: repeated indices, collinear or coincident
+  /// positions, up to float rounding) are accepted and never drawn. Cost: O(T log^2 T) for T triangles; memory about 140 bytes per triangle. The
   /// ray queries' Embree scene (rays.hpp) is not built here but on the first ray query or
   /// prepare_rays() call.
   static std::shared_ptr<const scene> create(const scene_desc& desc);
@@ -135,7 +154,8 @@ class scene {
   std::size_t vertex_count() const noexcept { return positions_.size(); }
   /// Number of triangles in the scene_desc (drawable or not).
   std::size_t triangle_count() const noexcept { return materials_.size(); }
-  /// Number of triangles with nonzero area (the ones the rasterizer draws).
+  /// Number of non-degenerate triangles (is_degenerate_triangle: the ones the rasterizer draws and
+  /// rays hit).
   std::size_t drawable_triangle_count() const noexcept { return triangles_.size(); }
 
   const std::vector<glm::vec3>& positions() const noexcept { return positions_; }

@@ -344,6 +344,9 @@ bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& s
   r.stats.texels = std::size_t(layout.width) * std::size_t(layout.height);
   r.stats.coverage_seconds = seconds_since(t0);
   r.stats.overlapping_texels = s.overlapping_texels;
+  r.stats.degenerate_triangles = s.degenerate_triangles;
+  r.stats.no_uv_area_triangles = s.no_uv_area_triangles;
+  r.stats.first_no_uv_area_triangle = s.first_no_uv_area_triangle;
   const sample_points pts = place_samples(s, *sc, o, layout, r);
   s = sparse_samples{};  // what the passes need is in pts now
   const light_set lights(o.lights.data(), o.lights.size());
@@ -366,7 +369,11 @@ image bake_radiance_texture(const bake_input& input, const bake_options& o, cons
   if (r.irradiance.width != o.width || r.irradiance.height != o.height || r.sampled.size() != std::size_t(o.width) * std::size_t(o.height))
     throw_invalid_argument("bake_radiance_texture: the result's size does not match options (" + std::to_string(o.width) + " x " +
                            std::to_string(o.height) + ")");
-  const bake_detail::sparse_samples s = bake_detail::compute_sparse_samples(input, o.width, o.height);
+  bake_detail::check_input("bake_radiance_texture", input);
+  bake_detail::clamped_input checked;
+  bake_detail::clamp_lightmap_uvs("bake_radiance_texture", input, checked);
+  const bake_detail::sparse_samples s =
+      bake_detail::compute_sparse_samples(checked.input, o.width, o.height, o.strict, "bake_radiance_texture");
   image texture = image::make(o.width, o.height, 3);
   std::vector<std::uint8_t> filled(texture.pixels.size() / 3, 0);
   for (std::size_t n = 0; n < s.size(); ++n) {
@@ -383,23 +390,32 @@ image bake_radiance_texture(const bake_input& input, const bake_options& o, cons
 }
 
 bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
+  const char* who = "bake_lightmap";
   const auto t0 = std::chrono::steady_clock::now();
   bake_detail::check_options(o);
-  bake_detail::check_input("bake_lightmap", input);
-  const std::shared_ptr<const scene> sc = scene::create(input.scene);
-  bake_detail::check_environment("bake_lightmap", o);
+  bake_detail::check_input(who, input);
+  bake_detail::clamped_input checked;
+  bake_detail::clamp_lightmap_uvs(who, input, checked);
+  const std::shared_ptr<const scene> sc = scene::create(checked.input.scene);
+  bake_detail::check_environment(who, o);
   bake_detail::bake_layout layout;
   layout.width = o.width;
   layout.height = o.height;
   double seam_seconds = 0.0;
   if (o.stitch_seams) {
     const auto ts = std::chrono::steady_clock::now();
-    layout.seams = bake_detail::lightmap_seams(input, o.width, o.height, seam_options{}.coplanar_degrees);
+    layout.seams = bake_detail::lightmap_seams(checked.input, o.width, o.height, seam_options{}.coplanar_degrees);
     layout.seam_pages = {bake_detail::page_rect{0, 0, o.width, o.height}};
     seam_seconds = bake_detail::seconds_since(ts);
   }
   std::vector<std::uint8_t> filled;
-  bake_result r = bake_detail::bake_samples(bake_detail::compute_sparse_samples(input, o.width, o.height), sc, o, layout, t0, filled);
+  bake_result r = bake_detail::bake_samples(bake_detail::compute_sparse_samples(checked.input, o.width, o.height, o.strict, who),
+                                            sc, o, layout, t0, filled);
+  r.stats.clamped_uvs = checked.clamped;
+  if (checked.clamped > 0) r.stats.warnings.push_back(checked.warning);
+  if (r.stats.no_uv_area_triangles > 0)
+    r.stats.warnings.push_back(bake_detail::no_uv_area_warning(
+        who, r.stats.no_uv_area_triangles, "triangle " + std::to_string(r.stats.first_no_uv_area_triangle)));
   r.stats.stitch_seconds += seam_seconds;
   return r;
 }

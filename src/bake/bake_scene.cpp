@@ -106,6 +106,8 @@ scene_atlas make_atlas(const std::vector<lightmap_page>& pages, std::size_t occl
 // (vertices shared by meshes duplicated, occluders' corners pointing at their material's block)
 // and, per vertex, its page UV (for the per-page samples).
 struct scene_geometry {
+  std::size_t clamped_uvs = 0;  // page UVs up to lightmap_uv_tolerance outside [0, 1], clamped
+  std::string clamped_warning;  // naming the first of them
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> page_uvs;
   std::vector<std::uint32_t> indices;
@@ -188,11 +190,16 @@ scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) 
         } else {
           // uv' = uv * scale + offset, in float (the engine's arithmetic).
           const glm::vec2 q = d.lightmap_uvs[v] * mesh.uv_scale + mesh.uv_offset;
-          if (!(q.x >= 0.0f && q.x <= 1.0f && q.y >= 0.0f && q.y <= 1.0f))
+          constexpr float lo = -lightmap_uv_tolerance, hi = 1.0f + lightmap_uv_tolerance;
+          if (!(q.x >= lo && q.x <= hi && q.y >= lo && q.y <= hi))
             throw_invalid_argument(std::string(who) + ": meshes[" + std::to_string(m) + "] (page " + std::to_string(mesh.page) +
                                    "): lightmap_uvs[" + std::to_string(v) + "] * uv_scale + uv_offset = " + uv_text(q) +
-                                   " is outside [0, 1]");
-          out = add_vertex(v, q);
+                                   " is outside [0, 1] by more than lightmap_uv_tolerance (0.001)");
+          const glm::vec2 clamped = glm::clamp(q, 0.0f, 1.0f);
+          if (clamped != q && g.clamped_uvs++ == 0)
+            g.clamped_warning = "meshes[" + std::to_string(m) + "] (page " + std::to_string(mesh.page) + "): lightmap_uvs[" +
+                                std::to_string(v) + "] * uv_scale + uv_offset = " + uv_text(q);
+          out = add_vertex(v, clamped);
           last_user[v] = mu;
           last_copy[v] = out;
         }
@@ -200,6 +207,10 @@ scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) 
       }
     }
   }
+  if (g.clamped_uvs > 0)
+    g.clamped_warning = std::string(who) + ": " + std::to_string(g.clamped_uvs) + " page UV" + (g.clamped_uvs > 1 ? "s lie" : " lies") +
+                        " outside [0, 1] by at most lightmap_uv_tolerance (0.001) (the first: " + g.clamped_warning +
+                        "): clamped onto [0, 1]";
   return g;
 }
 
@@ -286,28 +297,33 @@ struct page_mesh {
   }
 };
 
-// Page p's triangles; a triangle with 3D area but none in the page (the test
-// compute_lightmap_samples makes) is refused, named by its mesh.
-page_mesh page_triangles(const char* who, const scene_bake_input& input, const scene_geometry& g, std::size_t p) {
+// The name of scene triangle t in the caller's terms: "meshes[2] triangle 4 (scene triangle 40)".
+std::string mesh_triangle_name(const scene_bake_input& input, std::size_t t) {
+  std::size_t mesh = 0;
+  while (t >= input.meshes[mesh].first_triangle + input.meshes[mesh].triangle_count) ++mesh;
+  return "meshes[" + std::to_string(mesh) + "] triangle " + std::to_string(t - input.meshes[mesh].first_triangle) +
+         " (scene triangle " + std::to_string(t) + ")";
+}
+
+// Page p's triangles; with strict, a triangle with 3D area but none in the page (the test
+// compute_sparse_samples makes) is refused, named by its mesh (without strict,
+// compute_sparse_samples counts it).
+page_mesh page_triangles(const char* who, const scene_bake_input& input, const scene_geometry& g, std::size_t p, bool strict) {
   constexpr std::uint32_t none = lightmap_samples::no_triangle;
   const lightmap_page& page = input.pages[p];
   const scene_desc& d = input.geometry.scene;
   page_mesh m;
   std::vector<std::uint32_t> remap(g.positions.size(), none);
-  std::size_t mesh = 0;
   for (std::size_t t = 0; t < d.triangle_count; ++t) {
     if (g.triangle_page[t] != int(p)) continue;
-    while (t >= input.meshes[mesh].first_triangle + input.meshes[mesh].triangle_count) ++mesh;
     const std::uint32_t* ti = g.indices.data() + 3 * t;
     const glm::dvec2 a = glm::dvec2(g.page_uvs[ti[0]]) * glm::dvec2(page.width, page.height);
     const glm::dvec2 b = glm::dvec2(g.page_uvs[ti[1]]) * glm::dvec2(page.width, page.height);
     const glm::dvec2 c = glm::dvec2(g.page_uvs[ti[2]]) * glm::dvec2(page.width, page.height);
-    const glm::dvec3 p0(g.positions[ti[0]]), p1(g.positions[ti[1]]), p2(g.positions[ti[2]]);
-    if (glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0 &&
+    if (strict && !is_degenerate_triangle(g.positions[ti[0]], g.positions[ti[1]], g.positions[ti[2]]) &&
         !(0.5 * std::fabs(cross2(a, b, c)) > 1e-12 * double(page.width) * double(page.height)))
-      throw_invalid_argument(std::string(who) + ": meshes[" + std::to_string(mesh) + "] triangle " +
-                             std::to_string(t - input.meshes[mesh].first_triangle) + " (scene triangle " + std::to_string(t) +
-                             ") has zero area in its page's UV space (but not in 3D): it would get no texels");
+      throw_invalid_argument(std::string(who) + ": " + mesh_triangle_name(input, t) +
+                             " has zero area in its page's UV space (but not in 3D): it would get no texels");
     m.tris.push_back(std::uint32_t(t));
     m.mats.push_back(d.materials ? d.materials[t] : material{});
     for (int k = 0; k < 3; ++k) {
@@ -366,20 +382,29 @@ void append_page_samples(sparse_samples& s, sparse_samples&& ps, const std::vect
 // Step 1 per page, in the page's own texel grid (its UVs), merged into the atlas (pages in
 // order: the atlas texel indices stay increasing). page_overlapping receives each page's
 // overlapping texels.
+// The triangles that cover nothing are counted over the pages (the first named in scene_desc
+// numbering); occluder-only meshes' triangles are not counted.
 sparse_samples atlas_samples(const char* who, const scene_bake_input& input, const scene_geometry& g, const scene_atlas& atlas,
-                             std::vector<std::size_t>& page_overlapping) {
+                             bool strict, std::vector<std::size_t>& page_overlapping) {
   sparse_samples s;
   s.width = atlas.layout.width;
   s.height = atlas.layout.height;
   page_overlapping.assign(input.pages.size(), 0);
+  std::size_t degenerate = 0, no_uv_area = 0, first_no_uv_area = bake_stats::no_index;
   for (std::size_t p = 0; p < input.pages.size(); ++p) {
-    const page_mesh m = page_triangles(who, input, g, p);
+    const page_mesh m = page_triangles(who, input, g, p, strict);
     if (m.tris.empty()) continue;  // an empty page: all dilation (nothing to fill from)
-    sparse_samples ps = compute_sparse_samples(m.input(), input.pages[p].width, input.pages[p].height);
+    sparse_samples ps = compute_sparse_samples(m.input(), input.pages[p].width, input.pages[p].height, strict, who);
     page_overlapping[p] = ps.overlapping_texels;
     s.overlapping_texels += ps.overlapping_texels;
+    degenerate += ps.degenerate_triangles;
+    no_uv_area += ps.no_uv_area_triangles;
+    if (ps.no_uv_area_triangles > 0) first_no_uv_area = std::min<std::size_t>(first_no_uv_area, m.tris[ps.first_no_uv_area_triangle]);
     append_page_samples(s, std::move(ps), m.tris, input.pages[p], std::size_t(atlas.page_y[p]), atlas.layout);
   }
+  s.degenerate_triangles = degenerate;
+  s.no_uv_area_triangles = no_uv_area;
+  s.first_no_uv_area_triangle = first_no_uv_area;
   return s;
 }
 
@@ -486,12 +511,17 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   scene_atlas atlas = make_scene_atlas(who, input, g);
   const std::shared_ptr<const scene> sc = combined_scene(input.geometry.scene, g, atlas_uvs(input, g, atlas));
   std::vector<std::size_t> page_overlapping;
-  sparse_samples s = atlas_samples(who, input, g, atlas, page_overlapping);
+  sparse_samples s = atlas_samples(who, input, g, atlas, o.strict, page_overlapping);
   page_materials(input, atlas, s, atlas.layout);
   const double seam_seconds = o.stitch_seams ? scene_seams(input, g, atlas) : 0.0;
   std::vector<std::uint8_t> filled;
   bake_result all = bake_samples(std::move(s), sc, o, atlas.layout, t0, filled);
   all.stats.stitch_seconds += seam_seconds;
+  all.stats.clamped_uvs = g.clamped_uvs;
+  if (g.clamped_uvs > 0) all.stats.warnings.push_back(g.clamped_warning);
+  if (all.stats.no_uv_area_triangles > 0)
+    all.stats.warnings.push_back(
+        no_uv_area_warning(who, all.stats.no_uv_area_triangles, mesh_triangle_name(input, all.stats.first_no_uv_area_triangle)));
   scene_bake_result out;
   out.pages.resize(input.pages.size());
   for (std::size_t p = 0; p < input.pages.size(); ++p)

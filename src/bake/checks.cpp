@@ -4,6 +4,7 @@
 #include "hemilight/cubemap.hpp"
 #include "hemilight/lights.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -38,12 +39,14 @@ void check_input(const char* who, const bake_input& in, bool uvs_in_unit_square)
     if (d.indices[i] >= d.vertex_count)
       throw_invalid_argument(std::string(who) + ": indices[" + std::to_string(i) + "] = " + std::to_string(d.indices[i]) +
                              " is out of range: " + std::to_string(d.vertex_count) + " vertices");
+  constexpr float lo = -lightmap_uv_tolerance, hi = 1.0f + lightmap_uv_tolerance;
   for (std::size_t i = 0; i < d.vertex_count; ++i) {
     const glm::vec2 uv = d.lightmap_uvs[i];
     for (int c = 0; c < 2; ++c)
-      if (uvs_in_unit_square ? !(uv[c] >= 0.0f && uv[c] <= 1.0f) : !std::isfinite(uv[c]))
+      if (uvs_in_unit_square ? !(uv[c] >= lo && uv[c] <= hi) : !std::isfinite(uv[c]))
         throw_invalid_argument(std::string(who) + ": lightmap_uvs[" + std::to_string(i) + "]." + (c ? "v" : "u") + " = " +
-                               num(uv[c]) + (uvs_in_unit_square ? " is outside [0, 1]" : " is not finite"));
+                               num(uv[c]) +
+                               (uvs_in_unit_square ? " is outside [0, 1] by more than lightmap_uv_tolerance (0.001)" : " is not finite"));
     for (int c = 0; c < 3; ++c)
       if (!std::isfinite(d.positions[i][c]))
         throw_invalid_argument(std::string(who) + ": positions[" + std::to_string(i) + "] is not finite");
@@ -52,6 +55,35 @@ void check_input(const char* who, const bake_input& in, bool uvs_in_unit_square)
         if (!std::isfinite(in.normals[i][c]))
           throw_invalid_argument(std::string(who) + ": normals[" + std::to_string(i) + "] is not finite");
   }
+}
+
+void clamp_lightmap_uvs(const char* who, const bake_input& in, clamped_input& out) {
+  out.input = in;
+  const scene_desc& d = in.scene;
+  std::size_t first = 0;
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < d.vertex_count; ++i) {
+    const glm::vec2 uv = d.lightmap_uvs[i];
+    const glm::vec2 c = glm::clamp(uv, 0.0f, 1.0f);
+    if (c == uv) continue;
+    if (out.clamped++ == 0) {
+      first = i;
+      out.uvs.assign(d.lightmap_uvs, d.lightmap_uvs + d.vertex_count);
+    }
+    worst = std::max(worst, std::max(std::fabs(c.x - uv.x), std::fabs(c.y - uv.y)));
+    out.uvs[i] = c;
+  }
+  if (out.clamped == 0) return;
+  out.input.scene.lightmap_uvs = out.uvs.data();
+  out.warning = std::string(who) + ": " + std::to_string(out.clamped) + " lightmap UV" + (out.clamped > 1 ? "s lie" : " lies") +
+                " outside [0, 1] by up to " + num(worst) + " (the first: lightmap_uvs[" + std::to_string(first) +
+                "]): clamped onto [0, 1] (lightmap_uv_tolerance 0.001)";
+}
+
+std::string no_uv_area_warning(const char* who, std::size_t count, const std::string& first) {
+  return std::string(who) + ": " + std::to_string(count) + (count > 1 ? " triangles have" : " triangle has") +
+         " 3D area but no lightmap UV area (the first: " + first + "): " + (count > 1 ? "they occlude" : "it occludes") +
+         " but get" + (count > 1 ? "" : "s") + " no texels";
 }
 
 void check_options(const bake_options& o, const char* who, bool size) {

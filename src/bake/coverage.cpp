@@ -21,7 +21,7 @@ struct tri_data {
   glm::dvec2 t[3];      // texel units
   double uv_area = 0;   // texel units, absolute
   double area3 = 0;     // scene units^2
-  bool drawn = false;   // nonzero 3D area
+  bool drawn = false;   // covers texels: not degenerate (is_degenerate_triangle) and with UV area
 };
 
 tri_data make_tri(const scene_desc& d, std::size_t i, int w, int h) {
@@ -34,7 +34,7 @@ tri_data make_tri(const scene_desc& d, std::size_t i, int w, int h) {
   r.uv_area = 0.5 * std::fabs(cross2(r.t[0], r.t[1], r.t[2]));
   const glm::dvec3 p0(d.positions[idx[0]]), p1(d.positions[idx[1]]), p2(d.positions[idx[2]]);
   r.area3 = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
-  r.drawn = r.area3 > 0.0;
+  r.drawn = !is_degenerate_triangle(d.positions[idx[0]], d.positions[idx[1]], d.positions[idx[2]]);
   return r;
 }
 
@@ -126,15 +126,23 @@ struct coverage_slots {
   std::vector<std::uint32_t> owner;
 };
 
-// The triangles in texel units; a triangle with 3D area but (next to) no UV area would get no
-// texels: a broken unwrap, refused.
-std::vector<tri_data> triangles_in_texels(const char* who, const scene_desc& d, int width, int height) {
+// The triangles in texel units. Degenerate ones cover nothing and are counted; a triangle with 3D
+// area but (next to) no UV area would get no texels (a broken unwrap): refused with strict, else
+// it covers nothing and is counted, the first remembered.
+std::vector<tri_data> triangles_in_texels(const char* who, const scene_desc& d, int width, int height, bool strict,
+                                          sparse_samples& counts) {
   std::vector<tri_data> tris(d.triangle_count);
   for (std::size_t i = 0; i < d.triangle_count; ++i) {
-    tris[i] = make_tri(d, i, width, height);
-    if (tris[i].drawn && !(tris[i].uv_area > 1e-12 * double(width) * double(height)))
-      throw_invalid_argument(std::string(who) + ": triangle " + std::to_string(i) +
-                             " has zero area in lightmap UV space (but not in 3D): it would get no texels");
+    tri_data& t = tris[i] = make_tri(d, i, width, height);
+    if (!t.drawn) {
+      ++counts.degenerate_triangles;
+    } else if (!(t.uv_area > 1e-12 * double(width) * double(height))) {
+      if (strict)
+        throw_invalid_argument(std::string(who) + ": triangle " + std::to_string(i) +
+                               " has zero area in lightmap UV space (but not in 3D): it would get no texels");
+      if (counts.no_uv_area_triangles++ == 0) counts.first_no_uv_area_triangle = i;
+      t.drawn = false;
+    }
   }
   return tris;
 }
@@ -264,12 +272,10 @@ void set_sample(const bake_input& input, const tri_data& t, std::uint32_t ti, gl
 
 // The samples of the covered texels: coverage, owner and, through each texel's triangle (the
 // owner's own centroid where the combined centroid lies on no covering triangle), its point.
-sparse_samples make_samples(const bake_input& input, const std::vector<tri_data>& tris, int width, int height,
-                            coverage_slots& slots, const std::vector<glm::dvec2>& centroid,
-                            const std::vector<std::uint32_t>& through) {
+void make_samples(const bake_input& input, const std::vector<tri_data>& tris, int width, int height, coverage_slots& slots,
+                  const std::vector<glm::dvec2>& centroid, const std::vector<std::uint32_t>& through, sparse_samples& s) {
   constexpr std::uint32_t none = lightmap_samples::no_triangle;
   const std::size_t count = slots.texel.size();
-  sparse_samples s;
   s.width = width;
   s.height = height;
   s.texel = std::move(slots.texel);
@@ -293,21 +299,20 @@ sparse_samples make_samples(const bake_input& input, const std::vector<tri_data>
     }
     set_sample(input, tris[ti], ti, q, n, s);
   }
-  return s;
 }
 
 }  // namespace
 
-sparse_samples compute_sparse_samples(const bake_input& input, int width, int height) {
-  const char* who = "compute_lightmap_samples";
+sparse_samples compute_sparse_samples(const bake_input& input, int width, int height, bool strict, const char* who) {
   check_size(who, width, height);
-  check_input(who, input);
-  const std::vector<tri_data> tris = triangles_in_texels(who, input.scene, width, height);
+  sparse_samples s;
+  const std::vector<tri_data> tris = triangles_in_texels(who, input.scene, width, height, strict, s);
   coverage_slots slots = accumulate_coverage(who, tris, width, height);
   sort_slots_by_texel(slots);
   const std::vector<glm::dvec2> centroid = combined_centroids(slots);
   const std::vector<std::uint32_t> through = through_triangles(tris, width, height, slots, centroid);
-  return make_samples(input, tris, width, height, slots, centroid, through);
+  make_samples(input, tris, width, height, slots, centroid, through, s);
+  return s;
 }
 
 }  // namespace bake_detail
@@ -349,7 +354,12 @@ frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], 
 }
 
 lightmap_samples compute_lightmap_samples(const bake_input& input, int width, int height) {
-  const bake_detail::sparse_samples sp = bake_detail::compute_sparse_samples(input, width, height);
+  const char* who = "compute_lightmap_samples";
+  bake_detail::check_size(who, width, height);
+  bake_detail::check_input(who, input);
+  bake_detail::clamped_input checked;
+  bake_detail::clamp_lightmap_uvs(who, input, checked);
+  const bake_detail::sparse_samples sp = bake_detail::compute_sparse_samples(checked.input, width, height, false, who);
   const std::size_t texels = std::size_t(width) * std::size_t(height);
   constexpr std::uint32_t none = lightmap_samples::no_triangle;
   lightmap_samples s;
@@ -365,6 +375,8 @@ lightmap_samples compute_lightmap_samples(const bake_input& input, int width, in
   s.tangent.assign(texels, glm::vec3(1.0f, 0.0f, 0.0f));
   s.bitangent.assign(texels, glm::vec3(0.0f, 1.0f, 0.0f));
   s.overlapping_texels = sp.overlapping_texels;
+  s.degenerate_triangles = sp.degenerate_triangles;
+  s.no_uv_area_triangles = sp.no_uv_area_triangles;
   for (std::size_t n = 0; n < sp.size(); ++n) {
     const std::size_t k = sp.texel[n];
     s.coverage[k] = sp.coverage[n];

@@ -26,13 +26,19 @@ struct sparse_samples {
   std::vector<glm::vec3> position, normal, tangent, bitangent;
   std::vector<float> texel_world_size;
   std::size_t overlapping_texels = 0;
+  // Triangles that cover nothing (bake_stats' fields of the same names; the first in scene_desc
+  // numbering of the input).
+  std::size_t degenerate_triangles = 0, no_uv_area_triangles = 0;
+  std::size_t first_no_uv_area_triangle = bake_stats::no_index;
 
   std::size_t size() const { return texel.size(); }
 };
 
-// compute_lightmap_samples (bake.hpp) for the covered texels only. Throws error(invalid_argument)
-// as compute_lightmap_samples does; error(out_of_memory) beyond 2^32 - 1 covered texels.
-// Cost: two clips per (triangle, texel of its bounding box).
-sparse_samples compute_sparse_samples(const bake_input& input, int width, int height);
+// compute_lightmap_samples (bake.hpp) for the covered texels only, of an input checked by
+// check_input with its UVs clamped (clamp_lightmap_uvs). A triangle with 3D area but no UV area
+// throws error(invalid_argument) with `strict` (named for `who`), else it is counted. Throws
+// error(out_of_memory) beyond 2^32 - 1 covered texels. Cost: two clips per (triangle, texel of
+// its bounding box).
+sparse_samples compute_sparse_samples(const bake_input& input, int width, int height, bool strict, const char* who);
 
 }  // namespace hemilight::bake_detail

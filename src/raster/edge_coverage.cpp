@@ -388,14 +388,44 @@ const raster_detail::edge_table& raster_detail::edge_table_of(const scene& s) {
   return *static_cast<const edge_table*>(slot->value.get());
 }
 
-// The slopes of each texel's weight density (edge_density_), once per resolution. The
+// Resets the per-render state before a render of count texels at the given resolution: the
+// per-texel lists where the last render used them (all of them if N changed), the hard-texel
+// marks and rows.
+void raster_detail::rasterizer_impl::edge_prepare(std::size_t count, int resolution) {
+  if (edges_.fragment_count.size() != count)
+    edges_.fragment_count.assign(count, 0u);
+  else
+    for (const std::uint32_t t : edges_.fragment_texels) edges_.fragment_count[t] = 0u;
+  edges_.fragments.clear();
+  edges_.fragment_shapes.clear();
+  edges_.fragment_texels.clear();
+  edges_.groups.clear();
+  if (edges_.whole_z.size() != count) {
+    edges_.whole_z.assign(count, 0.0f);
+    edges_.whole_id.resize(count);
+  } else {
+    for (const std::uint32_t t : edges_.hard_texels) edges_.whole_z[t] = 0.0f;
+  }
+  edges_.words_per_row = (static_cast<std::size_t>(resolution) + 63) / 64;
+  edges_.hard_bits.assign(edges_.words_per_row * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
+  edges_.silhouette_bits.assign(edges_.hard_bits.size(), 0u);
+  edges_.hard_texels.clear();
+  edges_.hard_rows.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
+  for (std::size_t i = 0; i < edges_.hard_rows.size(); i += 2) {
+    edges_.hard_rows[i] = resolution;
+    edges_.hard_rows[i + 1] = -1;
+  }
+  edges_.hard_faces = 0;
+}
+
+// The slopes of each texel's weight density (edges_.density), once per resolution. The
 // integrator weights a texel by the projected solid angle over it, of density (1 + u^2 + v^2)^-2
 // on the top face (z = 1) and v (1 + u^2 + v^2)^-2 on the side faces (v = height); relative to
 // the centre's and per texel unit, its derivatives there are wx = -4 u / q step and
 // wy = -4 v / q step (top) or (1 / v - 4 v / q) step (sides), q = 1 + u^2 + v^2, step = 2 / N.
 void raster_detail::rasterizer_impl::edge_make_density() {
   const int n = n_;
-  edge_density_.resize(2 * hemicube_texel_count(n));
+  edges_.density.resize(2 * hemicube_texel_count(n));
   for (int face = 0; face < 5; ++face) {
     const int rows = face == 0 ? n : n / 2;
     const std::size_t face_offset = hemicube_face_offset(n, static_cast<hemicube_face>(face));
@@ -405,31 +435,31 @@ void raster_detail::rasterizer_impl::edge_make_density() {
         const double v = (face == 0 ? first_centre_ : 0.5 * texel_step_) + texel_step_ * static_cast<double>(r);
         const double q = 1.0 + u * u + v * v;
         const std::size_t texel = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
-        edge_density_[2 * texel] = static_cast<float>(-4.0 * u / q * texel_step_);
-        edge_density_[2 * texel + 1] = static_cast<float>((face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_);
+        edges_.density[2 * texel] = static_cast<float>(-4.0 * u / q * texel_step_);
+        edges_.density[2 * texel + 1] = static_cast<float>((face == 0 ? -4.0 * v / q : 1.0 / v - 4.0 * v / q) * texel_step_);
       }
   }
-  edge_density_n_ = n;
+  edges_.density_n = n;
 }
 
 void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, const frame& basis) {
-  if (edge_density_n_ != n_) edge_make_density();
+  if (edges_.density_n != n_) edge_make_density();
   // Facings of the creases' triangles: the sign of the plane's value at the point, 0 within
   // 1e-5 of its scale (seen about edge-on: a silhouette in waiting, so hard).
   const double px = position.x, py = position.y, pz = position.z;
   const double scale = std::fabs(px) + std::fabs(py) + std::fabs(pz);
-  for (std::size_t i = 0; i < edge_table_->planes.size(); ++i) {
-    const glm::vec4& q = edge_table_->planes[i];
+  for (std::size_t i = 0; i < edges_.table->planes.size(); ++i) {
+    const glm::vec4& q = edges_.table->planes[i];
     const double f = static_cast<double>(q.x) * px + static_cast<double>(q.y) * py + static_cast<double>(q.z) * pz -
                      static_cast<double>(q.w);
     const double band = 1e-5 * (scale + std::fabs(static_cast<double>(q.w)));
-    edge_facing_[i] = static_cast<std::int8_t>(f > band ? 1 : (f < -band ? -1 : 0));
+    edges_.facing[i] = static_cast<std::int8_t>(f > band ? 1 : (f < -band ? -1 : 0));
   }
   const std::vector<scene::triangle>& tris = scene_->triangles();
-  for (const edge_table::candidate& c : edge_table_->candidates) {
+  for (const edge_table::candidate& c : edges_.table->candidates) {
     bool silhouette = false;
     if (c.plane_a != no_triangle) {
-      const std::int8_t fa = edge_facing_[c.plane_a], fb = edge_facing_[c.plane_b];
+      const std::int8_t fa = edges_.facing[c.plane_a], fb = edges_.facing[c.plane_b];
       if (fa != 0 && fa == fb) continue;
       silhouette = fa * fb < 0;
     }
@@ -440,7 +470,7 @@ void raster_detail::rasterizer_impl::edge_mark_hard(const glm::vec3& position, c
     ++stats_.edge_hard_edges;
     edge_mark_segment(a, b, silhouette);
   }
-  stats_.edge_hard_texels = hard_texels_.size();
+  stats_.edge_hard_texels = edges_.hard_texels.size();
 }
 
 // Marks the texels that the segment (a, b) (local frame) may cross on each face: the segment is
@@ -492,23 +522,23 @@ void raster_detail::rasterizer_impl::edge_mark_segment(const glm::vec3& a, const
       const int c_first = std::max(0, static_cast<int>(floor_int(xlo - eps)));
       const int c_last = std::min(n - 1, static_cast<int>(floor_int(xhi + eps)));
       if (c_first > c_last) continue;
-      std::int32_t& lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
-      std::int32_t& hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
+      std::int32_t& lo = edges_.hard_rows[2 * (row_base + static_cast<std::size_t>(r))];
+      std::int32_t& hi = edges_.hard_rows[2 * (row_base + static_cast<std::size_t>(r)) + 1];
       lo = std::min(lo, static_cast<std::int32_t>(c_first));
       hi = std::max(hi, static_cast<std::int32_t>(c_last));
       const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
-      std::uint64_t* bits = hard_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
-      std::uint64_t* outline = silhouette_bits_.data() + (row_base + static_cast<std::size_t>(r)) * words_per_row_;
+      std::uint64_t* bits = edges_.hard_bits.data() + (row_base + static_cast<std::size_t>(r)) * edges_.words_per_row;
+      std::uint64_t* outline = edges_.silhouette_bits.data() + (row_base + static_cast<std::size_t>(r)) * edges_.words_per_row;
       for (int c = c_first; c <= c_last; ++c) {
         std::uint64_t& word = bits[c >> 6];
         const std::uint64_t bit = std::uint64_t(1) << (c & 63);
         if (!(word & bit)) {
           word |= bit;
-          hard_texels_.push_back(static_cast<std::uint32_t>(row + static_cast<std::size_t>(c)));
+          edges_.hard_texels.push_back(static_cast<std::uint32_t>(row + static_cast<std::size_t>(c)));
         }
         if (silhouette) outline[c >> 6] |= bit;
       }
-      hard_faces_ |= 1u << face;
+      edges_.hard_faces |= 1u << face;
     }
   }
 }
@@ -520,21 +550,21 @@ bool raster_detail::rasterizer_impl::edge_box_is_hard(int face, std::int64_t c0,
   const std::size_t row_base = face_row_base(n_, face);
   for (std::int64_t r = r0; r <= r1; ++r) {
     const std::size_t row = row_base + static_cast<std::size_t>(r);
-    if (hard_rows_[2 * row] > c1 || hard_rows_[2 * row + 1] < c0) continue;
+    if (edges_.hard_rows[2 * row] > c1 || edges_.hard_rows[2 * row + 1] < c0) continue;
     bool any = false;
-    edge_for_hard(row, std::max<std::int64_t>(c0, hard_rows_[2 * row]), std::min<std::int64_t>(c1, hard_rows_[2 * row + 1]),
+    edge_for_hard(row, std::max<std::int64_t>(c0, edges_.hard_rows[2 * row]), std::min<std::int64_t>(c1, edges_.hard_rows[2 * row + 1]),
                   [&](std::int64_t) { any = true; return false; });
     if (any) return true;
   }
   return false;
 }
 
-// Calls visit(c) for each hard column c in [c0, c1] of face row `row` (hard_bits_), in order,
+// Calls visit(c) for each hard column c in [c0, c1] of face row `row` (edges_.hard_bits), in order,
 // until visit returns false.
 template <class Visit>
 void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const {
   if (c0 > c1) return;
-  const std::uint64_t* bits = hard_bits_.data() + row * words_per_row_;
+  const std::uint64_t* bits = edges_.hard_bits.data() + row * edges_.words_per_row;
   const std::int64_t w0 = c0 >> 6, w1 = c1 >> 6;
   for (std::int64_t w = w0; w <= w1; ++w) {
     const int lo = w == w0 ? static_cast<int>(c0 & 63) : 0, hi = w == w1 ? static_cast<int>(c1 & 63) : 63;
@@ -548,12 +578,12 @@ void raster_detail::rasterizer_impl::edge_for_hard(std::size_t row, std::int64_t
 
 // The hard texels (edge_mark_hard) that the snapped triangle (px, py: fixed point, counter-
 // clockwise) touches on `face`. A texel it covers whole makes it the texel's whole-texel
-// candidate (whole_z_, whole_id_: the nearest, ties to the earlier draw); one it covers in part
+// candidate (edges_.whole_z, edges_.whole_id: the nearest, ties to the earlier draw); one it covers in part
 // gets a fragment with the exact covered fraction of its weight and the triangle's unsnapped
-// edges over the texel (fragment_shapes_, for the blend's overlaps), unless a triangle drawn
+// edges over the texel (edges_.fragment_shapes, for the blend's overlaps), unless a triangle drawn
 // earlier covers the whole texel in front of it.
 // Row by row over the box (the snapped box grown by the snapping, cut to the unsnapped
-// triangle's): the rows' hard texels within it (hard_rows_, hard_bits_) are classified exactly
+// triangle's): the rows' hard texels within it (edges_.hard_rows, edges_.hard_bits) are classified exactly
 // with the integer edge functions at their corners (far: an edge leaves every corner more than
 // 1/64 texel outside; whole: every corner of every edge >= 0; else partial). The rows' texels
 // are not cut to the triangle's extent within each row: computing its crossings per row costs
@@ -665,9 +695,9 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     float z = zrow + fs.dzdx * static_cast<float>(c);
     z = z > FLT_MIN ? z : FLT_MIN;
     if (whole) {
-      if (z > whole_z_[texel]) {
-        whole_z_[texel] = z;
-        whole_id_[texel] = draw;
+      if (z > edges_.whole_z[texel]) {
+        edges_.whole_z[texel] = z;
+        edges_.whole_id[texel] = draw;
       }
       return;
     }
@@ -675,12 +705,12 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     if (!positive) return;
     // Behind a triangle drawn earlier that covers the whole texel: it can take no share (the
     // blend stops at the whole-texel winner, which can only come nearer).
-    if (!(z > whole_z_[texel])) return;
+    if (!(z > edges_.whole_z[texel])) return;
     // Facing away, in a texel a silhouette crosses: near a silhouette the surface's far sheet
     // lies behind its near one over the same part of the texel (a ray entering the surface
     // leaves it through the far sheet), which the blend, taking fragments as side by side,
     // would count again in place of what lies behind.
-    if (back && (silhouette_bits_[(row_base + static_cast<std::size_t>(r)) * words_per_row_ + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
+    if (back && (edges_.silhouette_bits[(row_base + static_cast<std::size_t>(r)) * edges_.words_per_row + static_cast<std::size_t>(c >> 6)] >> (c & 63) & 1u)) return;
     // The covered part is measured against the unsnapped edges (f0 + gx x + gy y >= 0 over the
     // texel, x, y in [0, 1]), so slivers a fraction of a texel wide keep their width; the
     // snapped edges decide which texels are whole. The two differ by less than 1/512 texel. Two
@@ -689,9 +719,9 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     //
     // The integrator weights a texel by the projected solid angle over it; within the texel its
     // density is taken linear about the centre, 1 + wx (x - 1/2) + wy (y - 1/2) (relative to the
-    // centre's, in texel units; edge_density_): the covered fraction of the texel's weight, to
+    // centre's, in texel units; edges_.density): the covered fraction of the texel's weight, to
     // second order.
-    const float* slope = edge_density_.data() + 2 * texel;
+    const float* slope = edges_.density.data() + 2 * texel;
     const double wx = slope[0], wy = slope[1];
     if (f_row_at != r) {
       const double y0 = static_cast<double>(r * sub_one);
@@ -739,16 +769,16 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
     fr.coverage = static_cast<float>(std::min(area, 1.0));
     fr.id = draw;
     fr.mask = 0;  // (made by the blend when first needed)
-    fr.shape = static_cast<std::uint32_t>(fragment_shapes_.size());
-    fragment_shapes_.push_back(shape);
-    if (fragment_count_[texel]++ == 0) fragment_texels_.push_back(fr.texel);
-    fragments_.push_back(fr);
+    fr.shape = static_cast<std::uint32_t>(edges_.fragment_shapes.size());
+    edges_.fragment_shapes.push_back(shape);
+    if (edges_.fragment_count[texel]++ == 0) edges_.fragment_texels.push_back(fr.texel);
+    edges_.fragments.push_back(fr);
     ++kept;
   };
 
   for (std::int64_t r = row_lo; r <= row_hi; ++r) {
-    const std::int32_t hard_lo = hard_rows_[2 * (row_base + static_cast<std::size_t>(r))];
-    const std::int32_t hard_hi = hard_rows_[2 * (row_base + static_cast<std::size_t>(r)) + 1];
+    const std::int32_t hard_lo = edges_.hard_rows[2 * (row_base + static_cast<std::size_t>(r))];
+    const std::int32_t hard_hi = edges_.hard_rows[2 * (row_base + static_cast<std::size_t>(r)) + 1];
     if (hard_lo > col_hi || hard_hi < col_lo) continue;
     const std::int64_t c0 = std::max<std::int64_t>(col_lo, hard_lo), c1 = std::min<std::int64_t>(col_hi, hard_hi);
     const std::size_t row = face_offset + static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
@@ -771,18 +801,18 @@ void raster_detail::rasterizer_impl::edge_texels(int face, const std::int64_t (&
 
 // After the resolve (which gave every texel its centre sample, as without the option): each
 // hard texel with fragments gets its fragments made contiguous, in the order they were added (a
-// counting sort by texel; the texels in first-touch order). fragment_count_ becomes each
+// counting sort by texel; the texels in first-touch order). edges_.fragment_count becomes each
 // texel's end.
 void raster_detail::rasterizer_impl::edge_group_fragments() {
-  edge_groups_.reserve(fragment_texels_.size());
+  edges_.groups.reserve(edges_.fragment_texels.size());
   std::uint32_t offset = 0;
-  for (const std::uint32_t t : fragment_texels_) {
-    edge_groups_.push_back({t, offset, fragment_count_[t]});
-    fragment_count_[t] = offset;
-    offset += edge_groups_.back().count;
+  for (const std::uint32_t t : edges_.fragment_texels) {
+    edges_.groups.push_back({t, offset, edges_.fragment_count[t]});
+    edges_.fragment_count[t] = offset;
+    offset += edges_.groups.back().count;
   }
-  grouped_.resize(fragments_.size());
-  for (const edge_fragment& fr : fragments_) grouped_[fragment_count_[fr.texel]++] = fr;
+  edges_.grouped.resize(edges_.fragments.size());
+  for (const edge_fragment& fr : edges_.fragments) edges_.grouped[edges_.fragment_count[fr.texel]++] = fr;
 }
 
 // The radiance a draw (texel id) gives at a texel whose centre direction meets its plane at 1/w
@@ -823,12 +853,12 @@ double raster_detail::rasterizer_impl::edge_hidden_part(edge_fragment* order, st
                                                         double wy) const {
   double hidden = 0.0;
   edge_fragment& b = order[i];
-  const fragment_shape& sb = fragment_shapes_[b.shape];
+  const fragment_shape& sb = edges_.fragment_shapes[b.shape];
   for (std::uint32_t j = 0; j < i; ++j) {
     edge_fragment& a = order[j];
     // Two parts of one clipped triangle (its fan), or neighbours across an edge: no overlap.
     if (a.id == b.id) continue;
-    const fragment_shape& sa = fragment_shapes_[a.shape];
+    const fragment_shape& sa = edges_.fragment_shapes[a.shape];
     if (edge_shared_opposite(sa, sb)) continue;
     // No common cell: no overlap. (The cells are made when first needed; 0 = not yet.)
     if (a.mask == 0) a.mask = edge_cell_mask(sa.f0, sa.gx, sa.gy, sa.clip);
@@ -857,12 +887,12 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
   float* red = out.channel(0);
   float* green = out.channel(1);
   float* blue = out.channel(2);
-  for (const edge_group& g : edge_groups_) {
-    const float full_z = whole_z_[g.texel];  // the nearest triangle covering the whole texel (0 = none)
-    const std::uint32_t full_id = whole_id_[g.texel];
+  for (const edge_group& g : edges_.groups) {
+    const float full_z = edges_.whole_z[g.texel];  // the nearest triangle covering the whole texel (0 = none)
+    const std::uint32_t full_id = edges_.whole_id[g.texel];
     // The group is in the order the fragments were added; a stable insertion sort by
     // (z descending, draw ascending) keeps that order for ties.
-    edge_fragment* order = grouped_.data() + g.first;
+    edge_fragment* order = edges_.grouped.data() + g.first;
     for (std::uint32_t i = 1; i < g.count; ++i) {
       const edge_fragment f = order[i];
       std::uint32_t j = i;
@@ -876,7 +906,7 @@ void raster_detail::rasterizer_impl::edge_blend(hemicube_buffer& out, const fram
       order[j] = f;
     }
     glm::vec3 sum(0.0f);
-    const float* slope = edge_density_.data() + 2 * g.texel;
+    const float* slope = edges_.density.data() + 2 * g.texel;
     const double wx = slope[0], wy = slope[1];
 
     float left = 1.0f, nearest = 0.0f;  // nearest: 1/w of the first fragment with a share

@@ -216,59 +216,61 @@ class alignas(64) rasterizer_impl {
   void draw_leaf_avx512(const scene::triangle* all, std::uint32_t first, std::uint32_t count, unsigned face_mask,
                         const simd_frame& sf, const frame& basis);
 
-  // Exact edge coverage (raster_options::edge_coverage; edge.cpp).
+  // Exact edge coverage (raster_options::edge_coverage; edge_coverage.cpp): its state, per view
+  // and per render, in edges_; its drawing steps below.
   struct edge_fragment {
     std::uint32_t texel;  // hemicube texel index
     float z;              // the triangle's 1/w at the texel centre (the depth test's value)
     float coverage;       // the covered fraction of the texel's weight, [0, 1]
     std::uint32_t id;     // the draw's texel id (as in ids_)
     std::uint64_t mask;   // the cells of the texel's 8 x 8 grid it may touch (edge_cell_mask; 0: not made yet)
-    std::uint32_t shape;  // its entry in fragment_shapes_
+    std::uint32_t shape;  // its entry in edges_.fragment_shapes
   };
+  struct edge_group {
+    std::uint32_t texel;
+    std::uint32_t first, count;  // its fragments in edges_.grouped
+  };
+  struct edge_state {
+    const edge_table* table = nullptr;  // the scene's edges that may be hard (built once per scene)
+    std::vector<std::int8_t> facing;    // per table->planes entry in this view: +1, -1, 0 (edge-on)
+    // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
+    // silhouettes); only texels they may cross need exact coverage. Per face row (face 0's N
+    // rows, then each side face's N / 2): bit c of word c / 64 set when a hard edge may cross
+    // texel c (words_per_row words a row).
+    std::vector<std::uint64_t> hard_bits;
+    std::vector<std::uint64_t> silhouette_bits;  // the same for silhouette edges only
+    std::size_t words_per_row = 0;
+    std::vector<float> whole_z;              // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
+    std::vector<std::uint32_t> whole_id;     // and its texel id
+    std::vector<std::uint32_t> hard_texels;  // the texels marked in hard_bits (cleared by prepare)
+    std::vector<std::int32_t> hard_rows;     // per face row: lowest, highest hard column (lo > hi: none)
+    unsigned hard_faces = 0;                 // faces with a hard texel
+    // Per texel: the slopes wx, wy of its weight's density across it, relative to the centre's
+    // (texel units; edge_make_density, once per resolution: density_n).
+    std::vector<float> density;
+    int density_n = 0;
+    std::vector<fragment_shape> fragment_shapes;  // per fragment (edge_fragment::shape)
+    std::vector<edge_fragment> fragments;
+    std::vector<std::uint32_t> fragment_count;    // per texel: its fragments (0 = none)
+    std::vector<edge_fragment> grouped;           // fragments by texel (groups' ranges)
+    std::vector<std::uint32_t> fragment_texels;   // texels with fragments, in first-touch order
+    std::vector<edge_group> groups;
+  };
+  void edge_prepare(std::size_t count, int resolution);
   void edge_texels(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], const double (&exact)[6],
                    const face_setup& fs, std::uint32_t draw, bool back);
-  // Hard edges: those that bound what is drawn in a view (mesh boundaries, material changes,
-  // silhouettes); only texels they may cross need exact coverage (edge_coverage.cpp, "Hard
-  // edges"). The scene's candidates are in edge_table_ (built once per scene).
   void edge_mark_hard(const glm::vec3& position, const frame& basis);
   void edge_mark_segment(const glm::vec3& a, const glm::vec3& b, bool silhouette);
   bool edge_box_is_hard(int face, std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) const noexcept;
-  const edge_table* edge_table_ = nullptr;    // the scene's edges that may be hard (with edge_)
-  std::vector<std::int8_t> edge_facing_;      // per edge_table_->planes entry in this view: +1, -1, 0 (edge-on)
-  // Per face row (face 0's N rows, then each side face's N / 2): bit c of word c / 64 set when
-  // a hard edge may cross texel c (words_per_row_ words a row).
-  std::vector<std::uint64_t> hard_bits_;
-  std::vector<std::uint64_t> silhouette_bits_;  // the same for silhouette edges only
-  std::size_t words_per_row_ = 0;
   template <class Visit>
   void edge_for_hard(std::size_t row, std::int64_t c0, std::int64_t c1, Visit&& visit) const;
-  std::vector<float> whole_z_;                // per hard texel: 1/w of the nearest triangle covering it whole (0 = none)
-  std::vector<std::uint32_t> whole_id_;       // and its texel id
-  std::vector<std::uint32_t> hard_texels_;    // the texels marked in hard_bits_ (cleared by prepare)
-  std::vector<std::int32_t> hard_rows_;       // per face row: lowest, highest hard column (lo > hi: none)
-  unsigned hard_faces_ = 0;                   // faces with a hard texel
-  // Per texel: the slopes wx, wy of its weight's density across it, relative to the centre's
-  // (texel units; edge_make_density, once per resolution: edge_density_n_).
-  std::vector<float> edge_density_;
-  int edge_density_n_ = 0;
-  // Per texel with fragments (fragment_count_ nonzero): the sum of its fragments' coverages and
-  // their least 1/w (a later fragment behind all of them once they sum to one gets no share).
-  std::vector<fragment_shape> fragment_shapes_;  // per fragment (edge_fragment::shape)
   double edge_hidden_part(edge_fragment* order, std::uint32_t i, double wx, double wy) const;
   void edge_make_density();
   void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
   glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
   bool edge_ = false;
-  std::vector<edge_fragment> fragments_;
-  std::vector<std::uint32_t> fragment_count_;   // per texel: its fragments (0 = none)
-  std::vector<edge_fragment> grouped_;          // fragments_ by texel (edge_groups_ ranges)
-  std::vector<std::uint32_t> fragment_texels_;  // texels with fragments, in first-touch order
-  struct edge_group {
-    std::uint32_t texel;
-    std::uint32_t first, count;  // its fragments in grouped_
-  };
-  std::vector<edge_group> edge_groups_;
+  edge_state edges_;
 
   // Occlusion culling (raster_options::diagnostics.occlusion_culling; occlusion.cpp): a node is
   // skipped on a face when its nearest possible depth is behind the least depth of every 8 x 8

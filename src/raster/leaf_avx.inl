@@ -214,7 +214,7 @@ HEMILIGHT_LEAF_TARGET void raster_detail::rasterizer_impl::HEMILIGHT_LEAF_NAME(c
     unsigned via_face = clipped;
     if (M == mode::depth && edge_) {
       for (unsigned m = todo; m; m &= m - 1) draw[__builtin_ctz(m)] = 0;
-      if (hard_faces_ >> f & 1u) {
+      if (edges_.hard_faces >> f & 1u) {
         alignas(32) std::int32_t lx[8], hx[8], ly[8], hy[8];
         _mm256_store_si256(reinterpret_cast<__m256i*>(lx), min_x);
         _mm256_store_si256(reinterpret_cast<__m256i*>(hx), max_x);

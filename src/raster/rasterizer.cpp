@@ -1,7 +1,7 @@
 // The hemicube rasterizer (raster.hpp): binding, traversal and culling, clipping and snapping,
 // the coverage paths of one triangle (draw_fixed) and the resolve. The SIMD kernel sets it
 // dispatches to are in kernels_sse2.hpp, kernels_avx2.hpp and leaf_avx.inl (one translation unit,
-// so the kernels inline where their target allows); exact edge coverage is in edge.cpp.
+// so the kernels inline where their target allows); exact edge coverage is in edge_coverage.cpp.
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
 #include "lod.hpp"
@@ -323,8 +323,8 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   // order within each face, which the edge resolve's ties need): up to five per triangle.
   const std::size_t draws = scene_->drawable_triangle_count() * (edge_ ? 5 : 1) + 1;
   key_bits_ = bits < 31 && draws <= (std::size_t(1) << (31 - bits)) ? bits : 0;
-  edge_table_ = edge_ ? &edge_table_of(*scene_) : nullptr;
-  edge_facing_.assign(edge_ ? edge_table_->planes.size() : 0, 0);
+  edges_.table = edge_ ? &edge_table_of(*scene_) : nullptr;
+  edges_.facing.assign(edge_ ? edges_.table->planes.size() : 0, 0);
 }
 
 void raster_detail::rasterizer_impl::check_arguments(const char* who, const glm::vec3& position, const frame& basis,
@@ -386,33 +386,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   ties_.clear();
   ties_.limit = 2 * count;
   tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
-  if (edge_) {
-    // The per-texel lists are reset where the last render used them (all of them if N changed).
-    if (fragment_count_.size() != count)
-      fragment_count_.assign(count, 0u);
-    else
-      for (const std::uint32_t t : fragment_texels_) fragment_count_[t] = 0u;
-    fragments_.clear();
-    fragment_shapes_.clear();
-    fragment_texels_.clear();
-    edge_groups_.clear();
-    if (whole_z_.size() != count) {
-      whole_z_.assign(count, 0.0f);
-      whole_id_.resize(count);
-    } else {
-      for (const std::uint32_t t : hard_texels_) whole_z_[t] = 0.0f;
-    }
-    words_per_row_ = (static_cast<std::size_t>(resolution) + 63) / 64;
-    hard_bits_.assign(words_per_row_ * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)), 0u);
-    silhouette_bits_.assign(hard_bits_.size(), 0u);
-    hard_texels_.clear();
-    hard_rows_.resize(2 * (static_cast<std::size_t>(resolution) + 4 * static_cast<std::size_t>(resolution / 2)));
-    for (std::size_t i = 0; i < hard_rows_.size(); i += 2) {
-      hard_rows_[i] = resolution;
-      hard_rows_[i + 1] = -1;
-    }
-    hard_faces_ = 0;
-  }
+  if (edge_) edge_prepare(count, resolution);
 }
 
 std::uint32_t raster_detail::rasterizer_impl::seen_triangle(std::size_t texel) const noexcept {
@@ -471,7 +445,7 @@ unsigned raster_detail::rasterizer_impl::drop_faces_between_texel_centres(const 
     if (has_centre(x0 - m, x1 + m, n) && has_centre(y0 - m, y1 + m, rows)) continue;
     // With edge coverage a node between texel centres still covers parts of texels: kept where
     // those may be hard (the texels its bounds overlap, widened by the margin).
-    if (hard && (hard_faces_ >> f & 1u)) {
+    if (hard && (edges_.hard_faces >> f & 1u)) {
       const auto clamp_index = [](float x, float count) {
         return static_cast<std::int64_t>(std::floor(std::min(std::max(x, -1.0f), count)));
       };
@@ -1098,7 +1072,7 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   fixed_triangle t;
   if (!set_up_fixed_triangle(px, py, exact, t)) return;
   // 2. Exact edge coverage of the hard texels the triangle touches.
-  if (M == mode::depth && edge_ && (hard_faces_ >> face & 1u))
+  if (M == mode::depth && edge_ && (edges_.hard_faces >> face & 1u))
     if (!draw_hard_texels(face, t, fs, rec, draw, basis, tri)) return;
   // 3. The box of texel centres; the draw and its depth plane once it covers one.
   const texel_box box = centres_in_bounds(t, n, rows);

@@ -24,6 +24,17 @@ void check_non_negative(const std::string& name, const glm::vec3& v) {
 
 }  // namespace
 
+bool is_degenerate_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) noexcept {
+  const glm::dvec3 pa(a), pb(b), pc(c);
+  const glm::dvec3 ab = pb - pa, bc = pc - pb, ca = pa - pc;
+  const double longest = std::sqrt(std::max({glm::dot(ab, ab), glm::dot(bc, bc), glm::dot(ca, ca)}));
+  const glm::dvec3 m3 = glm::max(glm::abs(pa), glm::max(glm::abs(pb), glm::abs(pc)));
+  const double m = std::max({m3.x, m3.y, m3.z});
+  const double twice_area = glm::length(glm::cross(ab, pc - pa));
+  // Written so that NaN (and L = 0: coincident vertices) gives true.
+  return !(twice_area > degenerate_height_tolerance * longest * m) || !std::isfinite(twice_area + m);
+}
+
 scene_desc scene_mesh::desc() const noexcept {
   scene_desc d;
   d.positions = positions.data();
@@ -146,9 +157,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     const glm::vec3& a = s->positions_[s->indices_[3 * i]];
     const glm::vec3& b = s->positions_[s->indices_[3 * i + 1]];
     const glm::vec3& c = s->positions_[s->indices_[3 * i + 2]];
-    // Zero area in double (exact for float inputs up to rounding of the products): never drawn.
-    const glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
-    if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) continue;
+    if (is_degenerate_triangle(a, b, c)) continue;  // no area at float precision: never drawn
     s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
   }
   s->build_bvh();

@@ -1,12 +1,15 @@
-// generate_lightmap_uvs (bake.hpp): planar charts packed in shelves, for the built-in scenes.
-#include "hemilight/bake.hpp"
+// generate_lightmap_uvs (unwrap.hpp): the scene_mesh form of unwrap_lightmap, and the shelf
+// packer of planar charts kept for the built-in scenes.
+#include "hemilight/unwrap.hpp"
 
+#include "hemilight/error.hpp"
 #include "hemilight/geometry.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <string>
@@ -60,6 +63,16 @@ bool pack(std::vector<chart>& charts, const std::vector<std::size_t>& order, dou
 }
 
 }  // namespace
+
+unwrap_result generate_lightmap_uvs(scene_mesh& mesh, const unwrap_options& options) {
+  unwrap_result r = unwrap_lightmap(mesh.positions.data(), mesh.positions.size(), mesh.indices.data(), mesh.triangle_count(), options);
+  std::vector<glm::vec3> positions(r.vertex_source.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = mesh.positions[r.vertex_source[i]];
+  mesh.positions = std::move(positions);
+  mesh.lightmap_uvs = r.uvs;
+  mesh.indices = r.indices;
+  return r;
+}
 
 void generate_lightmap_uvs(scene_mesh& mesh, int size, int padding) {
   if (size < 8) throw_invalid_argument("generate_lightmap_uvs: size " + std::to_string(size) + " must be >= 8");
