@@ -185,7 +185,8 @@ hemilight_status check_common_options(const char* fn, const hemilight_bake_optio
   if (o.dilation < -1) return invalid(fn, "options->dilation " + std::to_string(o.dilation) + " must be >= -1 (-1: fill every texel)");
   if (o.thread_count < 0) return invalid(fn, "options->thread_count " + std::to_string(o.thread_count) + " must be >= 0 (0: all cores)");
   const std::pair<const char*, int> switches[] = {
-      {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}, {"strict", o.strict}};
+      {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}, {"strict", o.strict},
+      {"stitch_seams", o.stitch_seams}};
   for (const auto& sw : switches)
     if (sw.second != 0 && sw.second != 1)
       return invalid(fn, std::string("options->") + sw.first + " is " + std::to_string(sw.second) + "; it must be 0 or 1");
@@ -283,6 +284,8 @@ hemilight_bake_stats stats_of(const hemilight::bake_stats& s, const hemilight_ba
   st.no_uv_area_triangles = s.no_uv_area_triangles;
   st.first_no_uv_area_mesh = st.first_no_uv_area_triangle = SIZE_MAX;
   st.clamped_uvs = s.clamped_uvs;
+  st.seam_texels = s.seam_texels;
+  st.stitch_seconds = s.stitch_seconds;
   std::size_t t = s.first_no_uv_area_triangle;
   for (size_t m = 0; t != hemilight::bake_stats::no_index && m < mesh_count; ++m) {
     if (t < meshes[m].triangle_count) {

@@ -42,7 +42,8 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage),
-    HEMILIGHT_SPAN(hemilight_bake_options, strict)};  // (reserved1 is padding: never read)
+    HEMILIGHT_SPAN(hemilight_bake_options, strict), HEMILIGHT_SPAN(hemilight_bake_options, stitch_seams)};
+// (reserved1 and reserved2 are padding: never read)
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -53,7 +54,8 @@ const span bake_stats_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_stats, records), HEMILIGHT_SPAN(hemilight_bake_stats, seconds),
     HEMILIGHT_SPAN(hemilight_bake_stats, degenerate_triangles), HEMILIGHT_SPAN(hemilight_bake_stats, no_uv_area_triangles),
     HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_mesh), HEMILIGHT_SPAN(hemilight_bake_stats, first_no_uv_area_triangle),
-    HEMILIGHT_SPAN(hemilight_bake_stats, clamped_uvs)};
+    HEMILIGHT_SPAN(hemilight_bake_stats, clamped_uvs), HEMILIGHT_SPAN(hemilight_bake_stats, seam_texels),
+    HEMILIGHT_SPAN(hemilight_bake_stats, stitch_seconds)};
 const span cubemap_irradiance_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, struct_size),
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, method),
@@ -65,19 +67,25 @@ const span cubemap_irradiance_options_fields[] = {
 // size here and its new fields start at or after it: edge_coverage was appended to the cache
 // options of 96 bytes (after the padding field reserved0, since offset 92 was the old layout's
 // tail padding) and to the bake options of 144; strict to the bake options of 152 (after the
-// padding field reserved1); the bake statistics' input counts to the statistics of 64.
+// padding field reserved1); stitch_seams to the bake options of 160 (after the padding field
+// reserved2); the bake statistics' input counts to the statistics of 64, the seam counts to those
+// of 104.
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 104, "hemilight_cache_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_cache_options, edge_coverage) >= 96,
               "hemilight_cache_options: edge_coverage must start past the earlier layout's sizeof");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 160, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 168, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, edge_coverage) >= 144,
               "hemilight_bake_options: edge_coverage must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, strict) >= 152,
               "hemilight_bake_options: strict must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, stitch_seams) >= 160,
+              "hemilight_bake_options: stitch_seams must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 104, "hemilight_bake_stats changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 120, "hemilight_bake_stats changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_stats, degenerate_triangles) >= 64,
               "hemilight_bake_stats: the input counts must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_stats, seam_texels) >= 104,
+              "hemilight_bake_stats: the seam counts must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cubemap_irradiance_options) == 24,
               "hemilight_cubemap_irradiance_options changed: see above");
 
@@ -159,6 +167,7 @@ hemilight_bake_options default_bake_options() {
   o.shadow_mask_capacity = 0;
   o.edge_coverage = bake_options{}.sampler.raster.edge_coverage ? 1 : 0;
   o.strict = bake_options{}.strict ? 1 : 0;
+  o.stitch_seams = bake_options{}.stitch_seams ? 1 : 0;
   return o;
 }
 
@@ -265,6 +274,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   for (std::size_t k = 0; k < 4; ++k) o.shadow_mask_lights[k] = c.shadow_mask_lights[k];
   o.sampler.raster.edge_coverage = c.edge_coverage == 1;
   o.strict = c.strict == 1;
+  o.stitch_seams = c.stitch_seams == 1;
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;

@@ -575,6 +575,14 @@ typedef struct hemilight_bake_options {
    * area at most 2^-22 x longest edge x largest coordinate magnitude) are skipped either way:
    * no texels, never occlude, counted (degenerate_triangles). */
   int strict;
+  int reserved2;           /* padding, not read: keeps stitch_seams past the earlier layout's sizeof */
+  /* Since 0.15; 0 or 1 (default 1). Seam stitching: after the passes, the texels that bilinear
+   * lookups read along seams between near-coplanar faces (two charts of one mesh, two meshes, two
+   * pages) are set by least squares so that both sides agree along the seam, the rest staying near
+   * their baked values; every output (irradiance, shadow mask). Seams the two sides cannot see
+   * each other across (a wall standing on them) are left alone. Counted in
+   * hemilight_bake_stats.seam_texels. */
+  int stitch_seams;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */
@@ -600,6 +608,9 @@ typedef struct hemilight_bake_stats {
   size_t first_no_uv_area_triangle;  /* that mesh; both SIZE_MAX when there is none */
   size_t clamped_uvs;                /* lightmap UVs (vertices; scene bakes: page UVs) at most 0.001 outside
                                         [0, 1], clamped onto it (beyond 0.001 they are refused) */
+  /* Since 0.15: seam stitching (hemilight_bake_options.stitch_seams). */
+  size_t seam_texels;                /* texels set by seam stitching (0 without it) */
+  double stitch_seconds;             /* finding and stitching the seams, wall time, every output */
 } hemilight_bake_stats;
 
 /* As hemilight_cache_stats_init, for bake statistics. */

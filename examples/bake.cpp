@@ -55,6 +55,7 @@
 #include "hemilight/parallel.hpp"
 #include "hemilight/probes.hpp"
 #include "hemilight/reference_scenes.hpp"
+#include "hemilight/seams.hpp"
 
 #include "model_export.hpp"
 #include "model_import.hpp"
@@ -115,8 +116,21 @@ const char* usage =
     "                     (default: the density that fills one page)\n"
     "  --strict           a triangle with 3D area but no lightmap UV area is an error (default: a\n"
     "                     warning; it still casts shadows)\n"
+    "  --no-stitch-seams  leave the seams as baked (default: texels along seams between near-coplanar\n"
+    "                     faces set so that both sides agree under bilinear filtering; docs/bake.md)\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
+
+// The seams' line: what stitching did and the step left along the seams (measure_seams).
+void print_seams(const scene_bake_input& in, const scene_bake_result& sr, const bake_stats& st) {
+  const seam_report r = measure_seams(in, sr);
+  if (r.coplanar.pieces + r.walled.pieces == 0) return;
+  if (st.seam_texels > 0) std::printf("  seams: %zu texels stitched, %.2f s\n", st.seam_texels, st.stitch_seconds);
+  std::printf("  seam step (bilinear, near-coplanar seams, %.0f texels long): RMS %.2f%%, p95 %.2f%%, max %.2f%%", r.coplanar.length_texels,
+              100.0 * r.coplanar.rms, 100.0 * r.coplanar.p95, 100.0 * r.coplanar.max);
+  if (r.walled.pieces > 0) std::printf("; %.0f texels under walls, not stitched", r.walled.length_texels);
+  std::printf("\n");
+}
 
 struct cli_error {
   std::string message;
@@ -253,6 +267,8 @@ settings parse(int argc, char** argv) {
       s.texels_per_unit = parse_float("--texels-per-unit", value(), 0.0f, 1e6f, true);
     } else if (a == "--strict") {
       s.options.strict = true;
+    } else if (a == "--no-stitch-seams") {
+      s.options.stitch_seams = false;
     } else if (a == "--quiet") {
       s.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -487,6 +503,7 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
   if (!o.lights.empty())
     std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
+  print_seams(in, sr, st);
   std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}%s\n", st.seconds, st.coverage_seconds, base.c_str(),
               suffixes.c_str(), sr.pages.size() > 1 ? (" and the same for pages 1.." + std::to_string(sr.pages.size() - 1) + " (" + base + "_pageP_*)").c_str() : "");
   std::fputs(preview_line.c_str(), stdout);

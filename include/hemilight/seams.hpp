@@ -11,6 +11,14 @@
 // and triangles without texels (bake_scene's occluders) have no seams. Pieces whose two sides'
 // UVs agree within seam_uv_tolerance texels at both ends are one chart, not a seam.
 //
+// A seam between near-coplanar faces with a surface standing on it (a wall on a floor whose two
+// rooms' floors are separate charts) is walled: there the lighting legitimately differs, so it is
+// measured apart (seam_report::walled) and never stitched. Walled means: of seam_wall_points
+// segments across the piece, from half a texel inside one side to half a texel inside the other
+// (each at most a quarter of its triangle's height over the edge, lifted off its face by
+// 0.01 + tan(theta / 2) times that distance, theta the angle between the two faces), some segment
+// hits a triangle of the scene.
+//
 // Sampling (the texel convention of bake.hpp): a side is read bilinearly at its UV along the
 // piece, texel (x, y) centred at ((x + 0.5) / W, (y + 0.5) / H), clamp-to-edge in its page.
 #pragma once
@@ -30,6 +38,10 @@ inline constexpr float seam_position_tolerance = 1e-5f;
 /// its ends for the edge to count as the inside of one chart rather than a seam (1e-3 texel:
 /// rounding of UVs interpolated at a T-junction).
 inline constexpr float seam_uv_tolerance = 1e-3f;
+
+/// Segments across each near-coplanar piece (at 0.1, 0.3, ..., 0.9 of its length) that decide
+/// whether a surface stands on it (walled).
+inline constexpr int seam_wall_points = 5;
 
 /// How measure_seams samples and classifies the seams.
 struct seam_options {
@@ -62,7 +74,8 @@ struct seam_figures {
 /// What measure_seams returns.
 struct seam_report {
   seam_figures coplanar;  ///< seams between near-coplanar faces (seam_options::coplanar_degrees): the headline
-  seam_figures crease;    ///< the other seams
+  seam_figures crease;    ///< seams across a crease (normals further apart)
+  seam_figures walled;    ///< near-coplanar seams with a surface standing on them (never stitched)
   /// The relative step's floor: 5% of the mean luminance of the sampled texels (all pages), so
   /// that steps in nearly black regions do not count as large.
   double floor = 0.0;

@@ -440,7 +440,7 @@ void page_materials(const scene_bake_input& input, const scene_atlas& atlas, con
 
 // The seams of a scene bake (within meshes, between meshes and pages) into the atlas's layout, each
 // side in its page's rows; returns the time it took.
-double scene_seams(const scene_bake_input& input, const scene_geometry& g, scene_atlas& atlas) {
+double scene_seams(const scene_bake_input& input, const scene_geometry& g, const scene& walls, scene_atlas& atlas) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<glm::vec2> uvs(g.indices.size());
   for (std::size_t i = 0; i < uvs.size(); ++i) uvs[i] = g.page_uvs[g.indices[i]];
@@ -454,7 +454,7 @@ double scene_seams(const scene_bake_input& input, const scene_geometry& g, scene
   m.triangle_page = g.triangle_page.data();
   for (std::size_t p = 0; p < input.pages.size(); ++p)
     m.pages.push_back(page_rect{0, atlas.page_y[p], input.pages[p].width, input.pages[p].height});
-  atlas.layout.seams = find_seams(m, seam_options{}.coplanar_degrees);
+  atlas.layout.seams = find_seams(m, seam_options{}.coplanar_degrees, walls);
   atlas.layout.seam_pages = m.pages;
   return seconds_since(t0);
 }
@@ -513,7 +513,7 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   std::vector<std::size_t> page_overlapping;
   sparse_samples s = atlas_samples(who, input, g, atlas, o.strict, page_overlapping);
   page_materials(input, atlas, s, atlas.layout);
-  const double seam_seconds = o.stitch_seams ? scene_seams(input, g, atlas) : 0.0;
+  const double seam_seconds = o.stitch_seams ? scene_seams(input, g, *sc, atlas) : 0.0;
   std::vector<std::uint8_t> filled;
   bake_result all = bake_samples(std::move(s), sc, o, atlas.layout, t0, filled);
   all.stats.stitch_seconds += seam_seconds;

@@ -2,6 +2,9 @@
 //   usable_triangles -> collect_edges -> shared_endpoint_pairs + t_junction_pairs -> make_pieces
 #include "seam_search.hpp"
 
+#include "hemilight/rays.hpp"
+#include "hemilight/scene.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -12,32 +15,30 @@ namespace hemilight::bake_detail {
 
 namespace {
 
-// A triangle with texels, as the search reads it; usable = false for degenerate triangles (no 3D
-// area or no UV area) and triangles without texels.
+// A triangle with texels, as the search reads it; usable = false for degenerate triangles
+// (is_degenerate_triangle), triangles without UV area and triangles without texels.
 struct tri_info {
   bool usable = false;
   glm::vec3 face_normal{0.0f};
 };
-
-// Twice the 3D area of a triangle against its longest edge squared: below this it is a sliver or
-// a point (sin of its smallest angle about 1e-6), whose "edges" bound no texels.
-constexpr double degenerate_ratio = 1e-6;
 
 std::vector<tri_info> usable_triangles(const seam_mesh& m) {
   std::vector<tri_info> out(m.triangle_count);
   for (std::size_t t = 0; t < m.triangle_count; ++t) {
     const int page = m.triangle_page ? m.triangle_page[t] : 0;
     if (page < 0 || std::size_t(page) >= m.pages.size()) continue;
-    const glm::dvec3 p0(m.positions[m.indices[3 * t]]), p1(m.positions[m.indices[3 * t + 1]]), p2(m.positions[m.indices[3 * t + 2]]);
+    const glm::vec3 &f0 = m.positions[m.indices[3 * t]], &f1 = m.positions[m.indices[3 * t + 1]], &f2 = m.positions[m.indices[3 * t + 2]];
+    if (is_degenerate_triangle(f0, f1, f2)) continue;
+    const glm::dvec3 p0(f0), p1(f1), p2(f2);
     const glm::dvec3 c = glm::cross(p1 - p0, p2 - p0);
-    const double longest2 = std::max({glm::dot(p1 - p0, p1 - p0), glm::dot(p2 - p1, p2 - p1), glm::dot(p0 - p2, p0 - p2)});
     const double area2 = glm::length(c);
     const page_rect& r = m.pages[std::size_t(page)];
     const glm::dvec2 size(r.width, r.height);
     const glm::dvec2 u0 = glm::dvec2(m.corner_uvs[3 * t]) * size, u1 = glm::dvec2(m.corner_uvs[3 * t + 1]) * size,
                      u2 = glm::dvec2(m.corner_uvs[3 * t + 2]) * size;
     const double uv_area2 = std::fabs((u1.x - u0.x) * (u2.y - u0.y) - (u1.y - u0.y) * (u2.x - u0.x));
-    if (!(area2 > degenerate_ratio * longest2) || !(uv_area2 > 1e-12)) continue;
+    // No UV area: the baker's rule (at most 1e-12 of the UV square; coverage.cpp) gives no texels.
+    if (!(uv_area2 > 2e-12 * size.x * size.y)) continue;
     out[t].usable = true;
     out[t].face_normal = glm::vec3(c / area2);
   }
@@ -283,9 +284,45 @@ bool make_piece(const seam_mesh& m, const std::vector<tri_info>& tris, const edg
   return true;
 }
 
+// A point half a texel inside side s's triangle from the point x of its edge (at most a quarter of
+// the triangle's height over the edge), lifted off its face by `lift` x that distance.
+glm::dvec3 inside_point(const seam_mesh& m, const std::vector<tri_info>& tris, const seam_side& s, const glm::dvec3& x,
+                        const glm::dvec3& edge_dir, double texel_world, double lift) {
+  const std::size_t t = s.triangle;
+  const glm::dvec3 c = (glm::dvec3(m.positions[m.indices[3 * t]]) + glm::dvec3(m.positions[m.indices[3 * t + 1]]) +
+                        glm::dvec3(m.positions[m.indices[3 * t + 2]])) / 3.0;
+  glm::dvec3 in = c - x;
+  in -= edge_dir * glm::dot(in, edge_dir);  // perpendicular to the edge, towards the triangle
+  const double h = glm::length(in);         // a third of the height over the edge
+  if (!(h > 0.0)) return x;
+  const double d = std::min(0.5 * texel_world, 0.75 * h);
+  return x + in * (d / h) + glm::dvec3(tris[t].face_normal) * (lift * d);
+}
+
+// Whether a triangle of `walls` separates the two sides of a near-coplanar piece (seams.hpp).
+bool walled_piece(const seam_mesh& m, const std::vector<tri_info>& tris, const seam_piece& p, const scene& walls) {
+  const glm::dvec3 p0(p.p0), p1(p.p1);
+  const double world = glm::length(p1 - p0);
+  if (!(world > 0.0) || !(p.length_texels > 0.0f)) return false;
+  const glm::dvec3 dir = (p1 - p0) / world;
+  const double texel_world = world / double(p.length_texels);
+  // Lifted by 1% plus tan(theta / 2) of the inward distance, theta the angle between the faces: the
+  // segment clears the two faces' own ridge (smooth-shaded faces may meet at any angle).
+  const double cos_theta = std::clamp(double(glm::dot(tris[p.a.triangle].face_normal, tris[p.b.triangle].face_normal)), -1.0, 1.0);
+  const double lift = 0.01 + std::tan(0.5 * std::min(std::acos(cos_theta), 3.0));
+  for (int k = 0; k < seam_wall_points; ++k) {
+    const double s = (double(k) + 0.5) / double(seam_wall_points);
+    const glm::dvec3 x = p0 + s * (p1 - p0);
+    const glm::dvec3 a = inside_point(m, tris, p.a, x, dir, texel_world, lift),
+                     b = inside_point(m, tris, p.b, x, dir, texel_world, lift);
+    if (occluded(walls, glm::vec3(a), glm::vec3(b - a), 1.0f)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
-std::vector<seam_piece> find_seams(const seam_mesh& m, float coplanar_degrees) {
+std::vector<seam_piece> find_seams(const seam_mesh& m, float coplanar_degrees, const scene& walls) {
   const std::vector<tri_info> tris = usable_triangles(m);
   const std::vector<edge> edges = collect_edges(tris);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs = shared_endpoint_pairs(m, edges);
@@ -297,12 +334,14 @@ std::vector<seam_piece> find_seams(const seam_mesh& m, float coplanar_degrees) {
   std::vector<seam_piece> pieces;
   for (const auto& [i, j] : pairs) {
     seam_piece piece;
-    if (make_piece(m, tris, edges[i], edges[j], cos_max, piece)) pieces.push_back(piece);
+    if (!make_piece(m, tris, edges[i], edges[j], cos_max, piece)) continue;
+    piece.walled = piece.coplanar && walled_piece(m, tris, piece, walls);
+    pieces.push_back(piece);
   }
   return pieces;
 }
 
-std::vector<seam_piece> lightmap_seams(const bake_input& in, int width, int height, float coplanar_degrees) {
+std::vector<seam_piece> lightmap_seams(const bake_input& in, int width, int height, float coplanar_degrees, const scene& walls) {
   const scene_desc& d = in.scene;
   std::vector<glm::vec2> uvs(3 * d.triangle_count);
   for (std::size_t i = 0; i < uvs.size(); ++i) uvs[i] = d.lightmap_uvs[d.indices[i]];
@@ -314,7 +353,7 @@ std::vector<seam_piece> lightmap_seams(const bake_input& in, int width, int heig
   m.normals = in.normals;
   m.corner_uvs = uvs.data();
   m.pages = {page_rect{0, 0, width, height}};
-  return find_seams(m, coplanar_degrees);
+  return find_seams(m, coplanar_degrees, walls);
 }
 
 }  // namespace hemilight::bake_detail

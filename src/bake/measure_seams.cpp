@@ -80,14 +80,16 @@ seam_figures summarise(steps s, std::size_t pieces, double length, double thresh
 // The relative steps at the sample points of every piece (seams.hpp), summarised per class.
 seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vector<const image*>& pages, double floor,
                           const seam_options& o) {
-  steps coplanar, crease;
-  std::size_t n_coplanar = 0, n_crease = 0;
-  double l_coplanar = 0.0, l_crease = 0.0;
+  // Per class (coplanar, crease, walled): the steps, the pieces, the length.
+  steps s[3];
+  std::size_t count[3] = {0, 0, 0};
+  double length[3] = {0.0, 0.0, 0.0};
   for (const seam_piece& p : pieces) {
     const auto n = std::size_t(std::max(1.0, std::ceil(double(o.samples_per_texel) * double(p.length_texels))));
-    steps& out = p.coplanar ? coplanar : crease;
-    (p.coplanar ? n_coplanar : n_crease) += 1;
-    (p.coplanar ? l_coplanar : l_crease) += double(p.length_texels);
+    const int c = p.walled ? 2 : p.coplanar ? 0 : 1;
+    steps& out = s[c];
+    count[c] += 1;
+    length[c] += double(p.length_texels);
     for (std::size_t j = 0; j < n; ++j) {
       const float t = (float(j) + 0.5f) / float(n);
       const double ya = lookup(*pages[std::size_t(p.a.page)], p.a.t0 + t * (p.a.t1 - p.a.t0));
@@ -99,8 +101,9 @@ seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vect
   }
   seam_report r;
   r.floor = floor;
-  r.coplanar = summarise(std::move(coplanar), n_coplanar, l_coplanar, o.step_threshold);
-  r.crease = summarise(std::move(crease), n_crease, l_crease, o.step_threshold);
+  r.coplanar = summarise(std::move(s[0]), count[0], length[0], o.step_threshold);
+  r.crease = summarise(std::move(s[1]), count[1], length[1], o.step_threshold);
+  r.walled = summarise(std::move(s[2]), count[2], length[2], o.step_threshold);
   return r;
 }
 
@@ -146,7 +149,9 @@ seam_report measure_seams(const bake_input& input, const bake_result& result, co
   check_seam_options(o);
   check_result_page(result, "result");
   check_geometry(input.scene, input.normals);
-  const std::vector<seam_piece> pieces = lightmap_seams(input, result.irradiance.width, result.irradiance.height, o.coplanar_degrees);
+  const std::shared_ptr<const scene> walls = scene::create(input.scene);
+  const std::vector<seam_piece> pieces =
+      lightmap_seams(input, result.irradiance.width, result.irradiance.height, o.coplanar_degrees, *walls);
   return sample_pieces(pieces, {&result.irradiance}, step_floor({&result}), o);
 }
 
@@ -202,7 +207,8 @@ seam_report measure_seams(const scene_bake_input& input, const scene_bake_result
   m.normals = input.geometry.normals;
   m.corner_uvs = uvs.data();
   m.triangle_page = page_of.data();
-  const std::vector<seam_piece> pieces = find_seams(m, o.coplanar_degrees);
+  const std::shared_ptr<const scene> walls = scene::create(d);
+  const std::vector<seam_piece> pieces = find_seams(m, o.coplanar_degrees, *walls);
   return sample_pieces(pieces, images, step_floor(pages), o);
 }
 

@@ -49,17 +49,20 @@ struct seam_piece {
   glm::vec3 p0{0.0f}, p1{0.0f};
   float length_texels = 0.0f;  // the mean of the two sides' UV lengths, in texels
   bool coplanar = false;       // shading normals within the angle at both ends
+  bool walled = false;         // a surface stands on the seam: the sides cannot see each other (seams.hpp)
 };
 
 // The seam pieces of m (seams.hpp), in a fixed order (by the pair of triangle edges). coplanar
 // marks pieces whose sides' shading normals lie within coplanar_degrees of each other at both
-// ends. Precondition: indices in range, positions finite. Cost: O(E log E) for E edges, plus the
-// T-junction search (a grid of the vertices, about median-edge-length cells).
-std::vector<seam_piece> find_seams(const seam_mesh& m, float coplanar_degrees);
+// ends; walled, coplanar pieces that some triangle of `walls` (the scene of m's geometry) separates
+// (seams.hpp, seam_wall_points). Precondition: indices in range, positions finite. Cost: O(E log E)
+// for E edges, plus the T-junction search (a grid of the vertices, about median-edge-length cells),
+// plus seam_wall_points rays per coplanar piece.
+std::vector<seam_piece> find_seams(const seam_mesh& m, float coplanar_degrees, const scene& walls);
 
 // The seams of a bake_lightmap input (one page: the whole width x height lightmap). Cost: as
 // find_seams, plus a copy of the corners' UVs.
-std::vector<seam_piece> lightmap_seams(const bake_input& in, int width, int height, float coplanar_degrees);
+std::vector<seam_piece> lightmap_seams(const bake_input& in, int width, int height, float coplanar_degrees, const scene& walls);
 
 // The bilinear footprint of texel coordinates t (texel units of the page) in a page: four texel
 // indices in the grid of width `grid_width` that holds the page at r, clamp-to-edge within the

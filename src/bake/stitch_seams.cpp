@@ -43,7 +43,7 @@ std::vector<stitch_point> stitch_points(const std::vector<seam_piece>& pieces, c
   std::vector<stitch_point> out;
   std::vector<double> cuts;
   for (const seam_piece& p : pieces) {
-    if (!p.coplanar) continue;
+    if (!p.coplanar || p.walled) continue;
     cuts.assign({0.0, 1.0});
     grid_crossings(p.a, cuts);
     grid_crossings(p.b, cuts);
