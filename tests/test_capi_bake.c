@@ -188,6 +188,60 @@ static void test_exported_floor(void) {
   CHECK(sky_only);
 }
 
+/* Seam stitching through the C ABI: a floor of two unit quads (x in [0, 1] and [1, 2]) in two
+ * meshes and two charts (u in [0.05, 0.45] and [0.55, 0.95]), a black wall at x = 1.6 making the
+ * sky's irradiance fall across the cut. stitch_seams (default 1) sets texels along the cut and
+ * counts them; 0 leaves the bake as it was; 2 is refused. */
+static void test_stitch_seams(void) {
+  static const float pos_a[12] = {0, 0, 1, 1, 0, 1, 1, 0, 0, 0, 0, 0};
+  static const float pos_b[12] = {1, 0, 1, 2, 0, 1, 2, 0, 0, 1, 0, 0};
+  static const float pos_w[12] = {1.6f, 0, -0.5f, 1.6f, 0, 1.5f, 1.6f, 0.5f, 1.5f, 1.6f, 0.5f, -0.5f};
+  static const float uv_a[8] = {0.05f, 0.05f, 0.45f, 0.05f, 0.45f, 0.95f, 0.05f, 0.95f};
+  static const float uv_b[8] = {0.55f, 0.05f, 0.95f, 0.05f, 0.95f, 0.95f, 0.55f, 0.95f};
+  static const float uv_w[8] = {0, 0, 0, 0, 0, 0, 0, 0}; /* no texels: it only occludes */
+  static const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
+  static float stitched[3 * 32 * 32], raw[3 * 32 * 32];
+  static uint8_t v[32 * 32];
+  hemilight_bake_mesh m[3];
+  hemilight_bake_options o;
+  hemilight_bake_stats st;
+  int k, changed_far = 0;
+  memset(m, 0, sizeof m);
+  m[0].positions = pos_a;
+  m[0].lightmap_uvs = uv_a;
+  m[1].positions = pos_b;
+  m[1].lightmap_uvs = uv_b;
+  m[2].positions = pos_w;
+  m[2].lightmap_uvs = uv_w;
+  m[2].material.two_sided = 1;
+  for (k = 0; k < 3; ++k) {
+    m[k].vertex_count = 4;
+    m[k].indices = quad;
+    m[k].triangle_count = 2;
+    if (k < 2) m[k].material.albedo[0] = m[k].material.albedo[1] = m[k].material.albedo[2] = 0.5f;
+  }
+  hemilight_bake_options_init(&o);
+  CHECK(o.stitch_seams == 1);
+  o.width = o.height = 32;
+  o.resolution = 32;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+  hemilight_bake_stats_init(&st);
+  CHECK(hemilight_bake_lightmap(m, 3, &o, stitched, 3 * 32 * 32, v, 32 * 32, &st) == HEMILIGHT_OK);
+  CHECK(st.seam_texels > 0 && st.stitch_seconds > 0.0);
+  o.stitch_seams = 0;
+  hemilight_bake_stats_init(&st);
+  CHECK(hemilight_bake_lightmap(m, 3, &o, raw, 3 * 32 * 32, v, 32 * 32, &st) == HEMILIGHT_OK);
+  CHECK(st.seam_texels == 0);
+  /* Only texels near the cut move: columns 13..18 of the 32 (u 0.45 and 0.55 are 14.4 and 17.6). */
+  for (k = 0; k < 32 * 32; ++k)
+    if ((k % 32 < 12 || k % 32 > 19) && memcmp(&raw[3 * k], &stitched[3 * k], 3 * sizeof(float)) != 0) ++changed_far;
+  CHECK(changed_far == 0);
+  CHECK(memcmp(raw, stitched, sizeof raw) != 0);
+  o.stitch_seams = 2;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 3, &o, raw, 3 * 32 * 32, v, 32 * 32, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->stitch_seams is 2; it must be 0 or 1");
+}
+
 int main(void) {
   /* Two unit floor quads side by side (x in [0, 1] and [1, 2]), facing up, each on half of the map. */
   static const float pos_a[] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
@@ -436,6 +490,7 @@ int main(void) {
 
   test_edge_coverage();
   test_exported_floor();
+  test_stitch_seams();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -107,6 +107,7 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(b.thread_count == bd.thread_count);
   CHECK(b.sampler.raster.edge_coverage == bd.sampler.raster.edge_coverage);
   CHECK(b.strict == bd.strict);
+  CHECK(b.stitch_seams == bd.stitch_seams);
 }
 
 TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
@@ -127,6 +128,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   c.shadow_mask_lights[3] = 0;
   c.edge_coverage = 1;
   c.strict = 1;
+  c.stitch_seams = 0;
   light l;
   l.position = {1, 2, 3};
   const auto env = std::make_shared<const cubemap>();
@@ -152,6 +154,8 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(o.sampler.raster.edge_coverage);
   CHECK(o.strict);
   CHECK(!capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false).strict);
+  CHECK(!o.stitch_seams);
+  CHECK(capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false).stitch_seams);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
@@ -210,6 +214,16 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   CHECK(strict_full.strict == 0);
   CHECK(strict_full.reserved1 == 0);                // padding: never read
   CHECK(strict_full.edge_coverage == 0x01010101);  // read: within the older size
+  // The layout before stitch_seams (up to strict and its tail padding, now reserved2, not read):
+  // stitch_seams takes its default, 1, whatever lies beyond.
+  hemilight_bake_options before_stitch;
+  std::memset(&before_stitch, 0x01, sizeof before_stitch);
+  before_stitch.struct_size = offsetof(hemilight_bake_options, stitch_seams);  // the older sizeof (160 on LP64)
+  hemilight_bake_options stitch_full = capi::default_bake_options();
+  REQUIRE(capi::read_sized(&before_stitch, stitch_full).empty());
+  CHECK(stitch_full.stitch_seams == 1);
+  CHECK(stitch_full.reserved2 == 0);         // padding: never read
+  CHECK(stitch_full.strict == 0x01010101);  // read: within the older size
   // Statistics: only the fields within struct_size are written.
   hemilight_cache_stats from{};
   from.struct_size = sizeof from;
