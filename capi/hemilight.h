@@ -580,7 +580,8 @@ typedef struct hemilight_bake_options {
    * lookups read along seams between near-coplanar faces (two charts of one mesh, two meshes, two
    * pages) are set by least squares so that both sides agree along the seam, the rest staying near
    * their baked values; every output (irradiance, shadow mask). Seams the two sides cannot see
-   * each other across (a wall standing on them) are left alone. Counted in
+   * each other across (a wall standing on them), and points where the irradiance jumps across the
+   * seam (a hard shadow along it), are left as baked. Counted in
    * hemilight_bake_stats.seam_texels. */
   int stitch_seams;
 } hemilight_bake_options;

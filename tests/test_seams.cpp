@@ -312,6 +312,32 @@ TEST_CASE("Stitching covers the directional maps and the shadow mask", "[seams][
   for (float v : stitched.shadow_mask.pixels) CHECK((v >= 0.0f && v <= 1.0f));
 }
 
+TEST_CASE("A hard shadow edge along a seam is kept, not blurred", "[seams][bake]") {
+  // A black roof over chart A exactly (x in [0, 1], 0.5 up) and a hard sun straight down, no sky:
+  // A is 0 and B is 2 up to the cut (closed form). Each side is flat, so the step is no sampling
+  // step: stitching leaves both sides as baked.
+  uv_mesh m;
+  two_chart_floor(m);
+  const material black{glm::vec3(0.0f), glm::vec3(0.0f), true};
+  m.quad({0, 0.5f, 0}, {1, 0.5f, 0}, {1, 0.5f, 1}, {0, 0.5f, 1}, uv(0, 0), uv(0, 0), uv(0, 0), uv(0, 0), black);
+  const bake_input in = m.input(glm::vec3(0.0f));
+  bake_options o = small_options();
+  light sun;
+  sun.type = light_type::directional;
+  sun.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  sun.color = glm::vec3(2.0f);
+  o.lights = {sun};
+  o.stitch_seams = false;
+  const bake_result raw = bake_lightmap(in, o);
+  o.stitch_seams = true;
+  const bake_result stitched = bake_lightmap(in, o);
+  CHECK(stitched.stats.seam_texels == 0);
+  CHECK(std::memcmp(raw.irradiance.pixels.data(), stitched.irradiance.pixels.data(), raw.irradiance.pixels.size() * sizeof(float)) == 0);
+  const seam_report s = measure_seams(in, stitched);
+  CHECK(s.coplanar.pieces == 1);
+  CHECK(s.coplanar.rms == Approx(2.0 / 1.0).epsilon(1e-6));  // |0 - 2| / mean 1
+}
+
 TEST_CASE("A seam under a wall is not stitched", "[seams][bake]") {
   // The wall stands on the cut: its two sides see different halves of the sky, and stitching
   // them together would carry light under the wall (a leak).

@@ -71,6 +71,8 @@ struct bake_options {
   /// Stitch the seams (seams.hpp): after the passes, the texels that bilinear lookups along
   /// near-coplanar seams read (both sides, padding included) are set by least squares so that
   /// both sides agree along the seam while staying close to their baked values; dilation follows.
+  /// Seams with a wall standing on them and points where the irradiance jumps across the seam
+  /// (more than the two sides' gradients explain: a hard shadow along it) are left as baked.
   /// Within a mesh, between meshes and between pages; every output (irradiance, SH, HL2, shadow
   /// mask). Cost: O(T log T) to find the seams, then about linear in the seams' texels
   /// (docs/bake.md, "Seams").

@@ -244,6 +244,12 @@ seam_side make_side(const seam_mesh& m, const std::vector<tri_info>& tris, const
   const glm::dvec2 u0 = glm::dvec2(m.corner_uvs[3 * t + std::size_t(c0)]), u1 = glm::dvec2(m.corner_uvs[3 * t + std::size_t(c1)]);
   side.t0 = glm::vec2((u0 + s0 * (u1 - u0)) * size);
   side.t1 = glm::vec2((u0 + s1 * (u1 - u0)) * size);
+  // Inward: the edge's perpendicular (texel units) on the side of the third corner.
+  const glm::dvec2 along = (u1 - u0) * size, u2 = glm::dvec2(m.corner_uvs[3 * t + std::size_t((c1 + 1) % 3)]) * size;
+  glm::dvec2 in(-along.y, along.x);
+  if (glm::dot(in, u2 - u0 * size) < 0.0) in = -in;
+  const double in_length = glm::length(in);
+  side.inward = in_length > 0.0 ? glm::vec2(in / in_length) : glm::vec2(0.0f);
   const glm::dvec3 n0 = corner_normal(m, tris, e.tri, c0), n1 = corner_normal(m, tris, e.tri, c1);
   const auto normal_at = [&](double s) {
     const glm::dvec3 n = n0 + s * (n1 - n0);

@@ -91,7 +91,8 @@ void write_outputs(const sample_points& pts, const pass_values& last, const pass
   const auto ts = std::chrono::steady_clock::now();
   output_finisher out{o, layout, written, nullptr};
   if (o.stitch_seams && !layout.seams.empty())
-    out.stitcher = std::make_unique<seam_stitcher>(layout.seams, layout.seam_pages, layout.width, o.output_hl2);
+    out.stitcher = std::make_unique<seam_stitcher>(layout.seams, layout.seam_pages, layout.width, o.output_hl2, r.irradiance, written,
+                                                   layout.blocked_mask());
   constexpr float unbounded = std::numeric_limits<float>::max();
   if (o.output_sh_l1)
     for (std::size_t j = 0; j < 4; ++j)

@@ -39,6 +39,7 @@ struct seam_side {
   std::uint32_t triangle = 0;
   int page = 0;
   glm::vec2 t0{0.0f}, t1{0.0f};
+  glm::vec2 inward{0.0f};  // unit, in texel units: perpendicular to t1 - t0, towards the triangle
   glm::vec3 n0{0.0f}, n1{0.0f};
   glm::vec3 tangent{0.0f}, bitangent{0.0f};
 };

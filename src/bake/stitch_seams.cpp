@@ -54,8 +54,14 @@ std::vector<stitch_point> stitch_points(const std::vector<seam_piece>& pieces, c
       for (int g = 0; g < 3; ++g) {
         const auto t = float(m + h * node[g]);
         stitch_point s;
-        s.a = bilinear_footprint(pages[std::size_t(p.a.page)], grid_width, p.a.t0 + t * (p.a.t1 - p.a.t0));
-        s.b = bilinear_footprint(pages[std::size_t(p.b.page)], grid_width, p.b.t0 + t * (p.b.t1 - p.b.t0));
+        const page_rect &ra = pages[std::size_t(p.a.page)], &rb = pages[std::size_t(p.b.page)];
+        const glm::vec2 ta = p.a.t0 + t * (p.a.t1 - p.a.t0), tb = p.b.t0 + t * (p.b.t1 - p.b.t0);
+        s.a = bilinear_footprint(ra, grid_width, ta);
+        s.b = bilinear_footprint(rb, grid_width, tb);
+        for (std::size_t k = 0; k < 2; ++k) {
+          s.a_in[k] = bilinear_footprint(ra, grid_width, ta + float(k + 1) * p.a.inward);
+          s.b_in[k] = bilinear_footprint(rb, grid_width, tb + float(k + 1) * p.b.inward);
+        }
         s.weight = weight[g] * h * double(p.length_texels);
         s.ta = p.a.tangent;
         s.ba = p.a.bitangent;
@@ -163,10 +169,38 @@ image initial_values(const image& img, const std::vector<std::uint8_t>& filled, 
   return start;
 }
 
+// The points whose irradiance step the two sides' gradients explain (stitch_seams.hpp, top): the
+// others sit on a discontinuity.
+std::vector<stitch_point> continuous_points(std::vector<stitch_point> points, const image& start) {
+  const auto luminance = [&](std::size_t k) {
+    const float* p = start.pixels.data() + 3 * k;
+    return 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]);
+  };
+  const auto lookup = [&](const footprint& f) {
+    double y = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) y += double(f.weight[k]) * luminance(f.texel[k]);
+    return y;
+  };
+  std::vector<stitch_point> kept;
+  kept.reserve(points.size());
+  for (const stitch_point& p : points) {
+    const double ya = lookup(p.a), yb = lookup(p.b);
+    const double ga = std::fabs(lookup(p.a_in[0]) - lookup(p.a_in[1])), gb = std::fabs(lookup(p.b_in[0]) - lookup(p.b_in[1]));
+    if (std::fabs(ya - yb) <= 3.0 * (ga + gb) + 0.05 * (std::fabs(ya) + std::fabs(yb))) kept.push_back(p);
+  }
+  return kept;
+}
+
 }  // namespace
 
-seam_stitcher::seam_stitcher(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages, int grid_width, bool hl2)
-    : points_(stitch_points(pieces, pages, std::size_t(grid_width))) {
+seam_stitcher::seam_stitcher(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages, int grid_width, bool hl2,
+                             const image& irradiance, const std::vector<std::uint8_t>& filled, const std::uint8_t* blocked) {
+  std::vector<stitch_point> all = stitch_points(pieces, pages, std::size_t(grid_width));
+  if (all.empty()) return;
+  const image start = initial_values(irradiance, filled, blocked, unknown_texels(all));
+  const std::size_t count = all.size();
+  points_ = continuous_points(std::move(all), start);
+  discontinuities_ = count - points_.size();
   texels_ = unknown_texels(points_);
   if (texels_.empty()) return;
   scalar_ = std::make_unique<system>();

@@ -7,6 +7,10 @@
 // sum is the exact integral of the squared step along the seam (w_s: the node's share of the
 // piece's length in texels). Solved through the normal equations (A^T W A + lambda I) x = lambda x_baked
 // with Eigen's SimplicialLDLT, once per system, for every channel.
+// Discontinuities on a seam (a hard shadow edge along it) are kept: a point whose step in the
+// irradiance is larger than 3 x the two sides' gradients (the change of each side's lookup between
+// 1 and 2 texels inside it) plus 10% of the two sides' mean is dropped from every system, since
+// sampling at other distances from the seam explains a step of about a texel's change at most.
 #pragma once
 
 #include "seam_search.hpp"
@@ -29,6 +33,7 @@ inline constexpr double stitch_regularization = 0.01;
 // each side's lightmap tangent frame (for the HL2 maps).
 struct stitch_point {
   footprint a, b;
+  std::array<footprint, 2> a_in, b_in;  // each side's lookups 1 and 2 texels inside it
   double weight = 0.0;
   glm::vec3 ta{0.0f}, ba{0.0f}, tb{0.0f}, bb{0.0f};
 };
@@ -37,15 +42,19 @@ struct stitch_point {
 // the pages at `pages` (built once per bake; solved once per image).
 class seam_stitcher {
  public:
-  // Builds and factorises the scalar system (and the HL2 system when `hl2`). Cost: O(points) to
-  // assemble; the factorisation of a matrix whose graph is the seams' footprints (chains along
-  // each seam: about linear in the unknowns).
-  seam_stitcher(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages, int grid_width, bool hl2);
+  // Builds the seam points, drops those where the irradiance (grid-sized RGB as baked, the sampled
+  // texels in `filled`) jumps across the seam (see the top), and factorises the scalar system (and
+  // the HL2 system when `hl2`). Cost: O(points) to assemble; the factorisation of a matrix whose
+  // graph is the seams' footprints (chains along each seam: about linear in the unknowns).
+  seam_stitcher(const std::vector<seam_piece>& pieces, const std::vector<page_rect>& pages, int grid_width, bool hl2,
+                const image& irradiance, const std::vector<std::uint8_t>& filled, const std::uint8_t* blocked);
   ~seam_stitcher();
   seam_stitcher(const seam_stitcher&) = delete;
   seam_stitcher& operator=(const seam_stitcher&) = delete;
 
   bool empty() const { return texels_.empty(); }
+  // The points dropped as discontinuities.
+  std::size_t discontinuities() const { return discontinuities_; }
   // The unknown texels (grid indices, increasing).
   const std::vector<std::size_t>& texels() const { return texels_; }
   const std::vector<stitch_point>& points() const { return points_; }
@@ -64,6 +73,7 @@ class seam_stitcher {
   struct system;
   std::vector<std::size_t> texels_;
   std::vector<stitch_point> points_;
+  std::size_t discontinuities_ = 0;
   std::unique_ptr<system> scalar_, hl2_;
 };
 
