@@ -129,6 +129,7 @@ void print_seams(const scene_bake_input& in, const scene_bake_result& sr, const 
   std::printf("  seam step (bilinear, near-coplanar seams, %.0f texels long): RMS %.2f%%, p95 %.2f%%, max %.2f%%", r.coplanar.length_texels,
               100.0 * r.coplanar.rms, 100.0 * r.coplanar.p95, 100.0 * r.coplanar.max);
   if (r.walled.pieces > 0) std::printf("; %.0f texels under walls, not stitched", r.walled.length_texels);
+  if (r.hidden_length_texels > 0.0) std::printf("; %.0f texels with a side inside geometry, not counted", r.hidden_length_texels);
   std::printf("\n");
 }
 

@@ -76,6 +76,10 @@ struct seam_report {
   seam_figures coplanar;  ///< seams between near-coplanar faces (seam_options::coplanar_degrees): the headline
   seam_figures crease;    ///< seams across a crease (normals further apart)
   seam_figures walled;    ///< near-coplanar seams with a surface standing on them (never stitched)
+  /// Seam length (texels, all classes) not counted above: points where a side's bilinear
+  /// footprint holds no valid texel (bake_result::valid; sampled where valid is empty), so that
+  /// side is inside geometry there and nobody sees the step.
+  double hidden_length_texels = 0.0;
   /// The relative step's floor: 5% of the mean luminance of the sampled texels (all pages), so
   /// that steps in nearly black regions do not count as large.
   double floor = 0.0;
@@ -83,12 +87,14 @@ struct seam_report {
 
 /// Finds the seams of a bake_lightmap input (one page: the whole lightmap) and measures the step
 /// of result.irradiance along them. Reads input.scene's positions, indices and lightmap UVs
-/// (input.normals for the coplanar test), result.irradiance and result.sampled.
+/// (input.normals for the coplanar test), result.irradiance, result.sampled and result.valid
+/// (may be empty). Builds the scene's rays for the walled test.
 /// Errors (error(invalid_argument), naming the argument): options out of range; no lightmap UVs,
 /// an index out of range; a result whose irradiance is not an RGB image or whose sampled array
-/// does not match it. Non-finite texels are read as they are (the bake writes none).
-/// Cost: O(E log E) for E triangle edges (sorting, a grid of the vertices for T-junctions) plus
-/// O(sample points).
+/// does not match it, a valid array neither empty nor of that size. Non-finite texels are read as
+/// they are (the bake writes none).
+/// Cost: O(E log E) for E triangle edges (sorting, a grid of the vertices for T-junctions), the
+/// scene's Embree build and 5 rays per near-coplanar piece, plus O(sample points).
 seam_report measure_seams(const bake_input& input, const bake_result& result, const seam_options& options = {});
 
 /// The same for a bake_scene input and result: seams within a mesh, between meshes and between

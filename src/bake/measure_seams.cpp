@@ -33,17 +33,32 @@ void check_result_page(const bake_result& r, const std::string& name) {
   if (r.sampled.size() != std::size_t(e.width) * std::size_t(e.height))
     throw_invalid_argument("measure_seams: " + name + ".sampled has " + std::to_string(r.sampled.size()) +
                            " entries, the irradiance " + std::to_string(std::size_t(e.width) * std::size_t(e.height)) + " texels");
+  if (!r.valid.empty() && r.valid.size() != r.sampled.size())
+    throw_invalid_argument("measure_seams: " + name + ".valid has " + std::to_string(r.valid.size()) + " entries, the irradiance " +
+                           std::to_string(r.sampled.size()) + " texels");
 }
 
 double luminance(const float* p) { return 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]); }
 
-// Luminance of a bilinear lookup at texel coordinates t of a page image.
-double lookup(const image& img, const glm::vec2& t) {
+// A page as the metric reads it: its irradiance and which texels hold a valid sample.
+struct page_view {
+  const image* irradiance = nullptr;
+  const std::vector<std::uint8_t>* valid = nullptr;  // bake_result::valid, or sampled where valid is empty
+};
+
+// Luminance of a bilinear lookup at texel coordinates t of a page; false when no texel of its
+// footprint (with a nonzero weight) is valid: the side is hidden there (inside geometry).
+bool lookup(const page_view& page, const glm::vec2& t, double& y) {
+  const image& img = *page.irradiance;
   const page_rect r{0, 0, img.width, img.height};
   const footprint f = bilinear_footprint(r, std::size_t(img.width), t);
-  double y = 0.0;
-  for (std::size_t k = 0; k < 4; ++k) y += double(f.weight[k]) * luminance(img.pixels.data() + 3 * f.texel[k]);
-  return y;
+  y = 0.0;
+  bool seen = false;
+  for (std::size_t k = 0; k < 4; ++k) {
+    y += double(f.weight[k]) * luminance(img.pixels.data() + 3 * f.texel[k]);
+    seen = seen || (f.weight[k] > 0.0f && (*page.valid)[f.texel[k]]);
+  }
+  return seen;
 }
 
 // One class's steps: (relative step, length it stands for) per sample point.
@@ -78,8 +93,9 @@ seam_figures summarise(steps s, std::size_t pieces, double length, double thresh
 }
 
 // The relative steps at the sample points of every piece (seams.hpp), summarised per class.
-seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vector<const image*>& pages, double floor,
+seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vector<page_view>& pages, double floor,
                           const seam_options& o) {
+  double hidden = 0.0;
   // Per class (coplanar, crease, walled): the steps, the pieces, the length.
   steps s[3];
   std::size_t count[3] = {0, 0, 0};
@@ -92,8 +108,13 @@ seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vect
     length[c] += double(p.length_texels);
     for (std::size_t j = 0; j < n; ++j) {
       const float t = (float(j) + 0.5f) / float(n);
-      const double ya = lookup(*pages[std::size_t(p.a.page)], p.a.t0 + t * (p.a.t1 - p.a.t0));
-      const double yb = lookup(*pages[std::size_t(p.b.page)], p.b.t0 + t * (p.b.t1 - p.b.t0));
+      double ya = 0.0, yb = 0.0;
+      const bool seen_a = lookup(pages[std::size_t(p.a.page)], p.a.t0 + t * (p.a.t1 - p.a.t0), ya);
+      const bool seen_b = lookup(pages[std::size_t(p.b.page)], p.b.t0 + t * (p.b.t1 - p.b.t0), yb);
+      if (!seen_a || !seen_b) {
+        hidden += double(p.length_texels) / double(n);
+        continue;
+      }
       const double scale = std::max(0.5 * (ya + yb), floor);
       const double d = scale > 0.0 ? std::fabs(ya - yb) / scale : 0.0;
       out.emplace_back(d, double(p.length_texels) / double(n));
@@ -101,6 +122,7 @@ seam_report sample_pieces(const std::vector<seam_piece>& pieces, const std::vect
   }
   seam_report r;
   r.floor = floor;
+  r.hidden_length_texels = hidden;
   r.coplanar = summarise(std::move(s[0]), count[0], length[0], o.step_threshold);
   r.crease = summarise(std::move(s[1]), count[1], length[1], o.step_threshold);
   r.walled = summarise(std::move(s[2]), count[2], length[2], o.step_threshold);
@@ -152,7 +174,8 @@ seam_report measure_seams(const bake_input& input, const bake_result& result, co
   const std::shared_ptr<const scene> walls = scene::create(input.scene);
   const std::vector<seam_piece> pieces =
       lightmap_seams(input, result.irradiance.width, result.irradiance.height, o.coplanar_degrees, *walls);
-  return sample_pieces(pieces, {&result.irradiance}, step_floor({&result}), o);
+  return sample_pieces(pieces, {page_view{&result.irradiance, result.valid.empty() ? &result.sampled : &result.valid}},
+                       step_floor({&result}), o);
 }
 
 seam_report measure_seams(const scene_bake_input& input, const scene_bake_result& result, const seam_options& o) {
@@ -161,7 +184,7 @@ seam_report measure_seams(const scene_bake_input& input, const scene_bake_result
   if (result.pages.size() != input.pages.size())
     throw_invalid_argument("measure_seams: the result has " + std::to_string(result.pages.size()) + " pages, the input " +
                            std::to_string(input.pages.size()));
-  std::vector<const image*> images;
+  std::vector<page_view> images;
   std::vector<const bake_result*> pages;
   seam_mesh m;
   for (std::size_t p = 0; p < input.pages.size(); ++p) {
@@ -171,7 +194,7 @@ seam_report measure_seams(const scene_bake_input& input, const scene_bake_result
       throw_invalid_argument("measure_seams: result.pages[" + std::to_string(p) + "] is " + std::to_string(r.irradiance.width) + " x " +
                              std::to_string(r.irradiance.height) + ", the input's page " + std::to_string(input.pages[p].width) +
                              " x " + std::to_string(input.pages[p].height));
-    images.push_back(&r.irradiance);
+    images.push_back(page_view{&r.irradiance, r.valid.empty() ? &r.sampled : &r.valid});
     pages.push_back(&r);
     m.pages.push_back(page_rect{0, 0, r.irradiance.width, r.irradiance.height});
   }
