@@ -13,6 +13,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -310,6 +311,74 @@ TEST_CASE("Dilation grows charts ring by ring with the mean of filled neighbours
         if (near_sample) CHECK(r.irradiance.at(x, y)[0] == Approx(pi).epsilon(1e-4));
       }
   }
+}
+
+TEST_CASE("Texels inside geometry are filled from valid texels of their own chart, never across the padding", "[bake][leaks]") {
+  // A 32² map with three charts two texels apart: F, a floor under a bright emitter (u texels
+  // 1-15); G, a quad inside a closed box (u 17-31, v 1-15): every sample invalid; H, a quad half
+  // inside another box (u 17-31, v 17-31), its invalid half next to F in the atlas, 3 texels from
+  // F's chart and 7 from its own valid texels. The emitter and the boxes have no texels (zero UV
+  // area: they occlude and are seen). Sky 1.
+  scene_mesh m;
+  const material grey{glm::vec3(0.0f), glm::vec3(0.5f), false}, lamp{glm::vec3(60.0f), glm::vec3(0.5f), false};
+  // A quad a, b, c, d (counter-clockwise from its front) with UVs ua, ub, uc, ud.
+  const auto quad = [&m](std::array<glm::vec3, 4> p, std::array<glm::vec2, 4> uv, const material& mat) {
+    const auto base = std::uint32_t(m.positions.size());
+    m.positions.insert(m.positions.end(), p.begin(), p.end());
+    m.lightmap_uvs.insert(m.lightmap_uvs.end(), uv.begin(), uv.end());
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    m.materials.insert(m.materials.end(), {mat, mat});
+  };
+  // A floor facing up over [x0, x1] x [z0, z1], u along x over texels [u0, u1), v along z over [v0, v1).
+  const auto floor = [&](float x0, float x1, float z0, float z1, float u0, float u1, float v0, float v1) {
+    quad({glm::vec3(x0, 0, z0), glm::vec3(x0, 0, z1), glm::vec3(x1, 0, z1), glm::vec3(x1, 0, z0)},
+         {glm::vec2(u0, v0) / 32.0f, glm::vec2(u0, v1) / 32.0f, glm::vec2(u1, v1) / 32.0f, glm::vec2(u1, v0) / 32.0f}, grey);
+  };
+  floor(-1, 1, -1, 1, 1, 15, 1, 31);  // F: triangles 0, 1
+  floor(5, 6, 0, 1, 17, 31, 1, 15);   // G: triangles 2, 3
+  floor(8, 10, 0, 1, 17, 31, 17, 31);  // H: triangles 4, 5; x < 9 inside the box
+  const glm::vec2 none(0.0f);
+  quad({glm::vec3(-0.5f, 1, -0.5f), glm::vec3(0.5f, 1, -0.5f), glm::vec3(0.5f, 1, 0.5f), glm::vec3(-0.5f, 1, 0.5f)},
+       {none, none, none, none}, lamp);  // facing down
+  const std::size_t before_boxes = m.positions.size();
+  m.add_box({4.8f, -0.2f, -0.2f}, {6.2f, 0.6f, 1.2f}, grey);
+  m.add_box({7.8f, -0.2f, -0.2f}, {9.0f, 0.6f, 1.2f}, grey);
+  m.lightmap_uvs.resize(m.positions.size(), none);
+  REQUIRE(m.positions.size() > before_boxes);
+  m.sky_radiance = glm::vec3(1.0f);
+  bake_options o;
+  o.width = o.height = 32;
+  o.sampler.resolution = 16;
+  const bake_input in = input_of(m);
+  const bake_result r = bake_lightmap(in, o);
+  const lightmap_samples smp = compute_lightmap_samples(in, 32, 32);
+  float f_min = 1e30f, h_valid_max = 0.0f, h_invalid_max = 0.0f;
+  std::size_t g = 0, g_invalid = 0, h_invalid = 0;
+  for (std::size_t k = 0; k < smp.owner.size(); ++k) {
+    if (!r.sampled[k]) continue;
+    const float e = r.irradiance.pixels[3 * k + 1];
+    if (smp.owner[k] < 2) f_min = std::min(f_min, e);
+    if (smp.owner[k] == 2 || smp.owner[k] == 3) {
+      ++g;
+      g_invalid += r.valid[k] ? 0u : 1u;
+      CHECK(e == 0.0f);  // no valid texel in its chart: nothing to fill it from (was F's light)
+    }
+    if (smp.owner[k] == 4 || smp.owner[k] == 5) {
+      if (r.valid[k])
+        h_valid_max = std::max(h_valid_max, e);
+      else {
+        ++h_invalid;
+        h_invalid_max = std::max(h_invalid_max, e);
+      }
+    }
+  }
+  CHECK(g == 14u * 14u);
+  CHECK(g_invalid == g);
+  REQUIRE(h_invalid > 14u);
+  INFO("F at least " << f_min << ", H's valid texels at most " << h_valid_max << ", its invalid ones " << h_invalid_max);
+  CHECK(f_min > 2.0f * h_valid_max);  // F is much brighter than H
+  CHECK(h_invalid_max > 0.0f);
+  CHECK(h_invalid_max <= h_valid_max);  // H's invalid texels hold H's own light, not F's
 }
 
 TEST_CASE("Bakes are bitwise identical for 1 and 2 threads", "[bake]") {

@@ -58,9 +58,11 @@ sample_points place_samples(const sparse_samples& s, const scene& sc, const bake
 }
 
 invalid_filler::invalid_filler(const sample_points& pts, const std::vector<std::uint8_t>& invalid, const bake_layout& layout)
-    : pts_(pts), invalid_(invalid), layout_(layout), filled_(std::size_t(layout.width) * std::size_t(layout.height), 0) {
+    : pts_(pts), invalid_(invalid), layout_(layout), filled_(std::size_t(layout.width) * std::size_t(layout.height), 0),
+      blocked_(filled_.size(), 1) {
   for (std::size_t i = 0; i < invalid.size(); ++i) {
     if (!invalid[i]) filled_[pts.texel_of[i]] = 1;
+    blocked_[pts.texel_of[i]] = 0;
     any_ = any_ || invalid[i];
   }
 }
@@ -71,7 +73,7 @@ void invalid_filler::operator()(std::vector<glm::vec3>& values) const {
   image tmp = image::make(layout_.width, layout_.height, 3);
   for (std::size_t i = 0; i < count; ++i) std::memcpy(tmp.pixels.data() + 3 * pts_.texel_of[i], &values[i], sizeof(glm::vec3));
   std::vector<std::uint8_t> f = filled_;
-  dilate_masked(tmp, f, -1, layout_.blocked_mask());
+  dilate_masked(tmp, f, -1, blocked_.data());
   for (std::size_t i = 0; i < count; ++i)
     if (invalid_[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts_.texel_of[i], sizeof(glm::vec3));
 }

@@ -84,8 +84,11 @@ struct direct_values {
 };
 
 // Per-sample values at samples inside geometry (invalid[i] = 1) replaced by those of the valid
-// texels around them in the lightmap (texel dilation until every such texel is reached): the same
-// chart, so the same side of the same surface, never a record across a wall.
+// texels around them in the lightmap: texel dilation that grows through sampled texels only, so it
+// stays in the texel's own chart (charts apart in the atlas are not 8-connected through sampled
+// texels), the same side of the same surface, never a chart across a wall nor a record. An invalid
+// texel whose chart has no valid texel gets 0, not the light of whatever chart lies next to it in
+// the atlas (docs/bake.md, "Leaks").
 class invalid_filler {
  public:
   invalid_filler(const sample_points& pts, const std::vector<std::uint8_t>& invalid, const bake_layout& layout);
@@ -97,6 +100,7 @@ class invalid_filler {
   const std::vector<std::uint8_t>& invalid_;
   const bake_layout& layout_;
   std::vector<std::uint8_t> filled_;
+  std::vector<std::uint8_t> blocked_;  // 1: not sampled (padding, other pages' guards): never filled nor crossed
   bool any_ = false;
 };
 
