@@ -255,28 +255,26 @@ TEST_CASE("Leaks: two rooms, a zero-thickness wall over the floor seam, direct l
   bake_and_check({"two_rooms", "plane, back to back, floor seam", 0.0f, 0.0f, zero_wall::back_to_back}, {1});
 }
 
-// Fails the target (measured 62-65% with the cache; at most 0.09% with a hemicube per texel). The
-// dark room's samples within a few texels of the plane see its back face over more than 10% of
-// their hemicube and are invalid, so they make no records; the dark points between them are
-// covered by the lit room's records on the other side of the plane (floor and ceiling are
-// coplanar across it, same normal, not behind, within a record's reach of at least
-// a x min_radius = 2 texels) and interpolate their light from the second bounce on. Nothing in
-// the cache sees the plane between a record and a point.
-TEST_CASE("Leaks: two rooms, one-sided zero-thickness wall, three bounces", "[leaks][!mayfail]") {
+// The dark room's samples within a few texels of the plane see its back face over more than 10%
+// of their hemicube and are invalid, so they make no records; the dark points between them lie
+// within the reach of the lit room's records across the plane (floor and ceiling are coplanar
+// across it, same normal, a reach of at least a x min_radius = 2 texels). The cache's segment
+// test (cache_run::segment_blocked) keeps those records off them: without it, 62-65%.
+TEST_CASE("Leaks: two rooms, one-sided zero-thickness wall, three bounces", "[leaks]") {
   bake_and_check({"two_rooms", "plane, one-sided, floor seam", 0.0f}, {3});
 }
 
-// Fails the target (measured 62-65%) by the mechanism of the one-sided plane: the lit side's quad
-// comes first in the mesh and wins the depth tie with its coincident twin, so the dark room sees
-// its back face. (With the dark side's quad first it is the lit room whose texels turn invalid:
-// no leak, but the lit room loses 40% of its light near the wall.)
-TEST_CASE("Leaks: two rooms, back-to-back zero-thickness wall, three bounces", "[leaks][!mayfail]") {
+// As the one-sided plane: the lit side's quad comes first in the mesh and wins the depth tie with
+// its coincident twin, so the dark room sees its back face (with the dark side's quad first it is
+// the lit room whose texels turn invalid: no leak, but the lit room loses 40% of its light near the
+// wall). Without the cache's segment test, 62-65%.
+TEST_CASE("Leaks: two rooms, back-to-back zero-thickness wall, three bounces", "[leaks]") {
   bake_and_check({"two_rooms", "plane, back to back, floor seam", 0.0f, 0.0f, zero_wall::back_to_back}, {3});
 }
 
-// Fails the target (measured 144-147% at one bounce): the same interpolation across the plane as
-// above, from the first pass on, because the hemicubes see the emitter.
-TEST_CASE("Leaks: two rooms, one-sided zero-thickness wall, emissive patch, one bounce", "[leaks][!mayfail]") {
+// The same interpolation across the plane as above, from the first pass on, because the
+// hemicubes see the emitter: 144-147% at one bounce without the cache's segment test.
+TEST_CASE("Leaks: two rooms, one-sided zero-thickness wall, emissive patch, one bounce", "[leaks]") {
   leak_case c{"two_rooms", "plane, one-sided, floor seam", 0.0f};
   c.light = leak_light::emissive_patch;
   bake_and_check(c, {1});
@@ -319,14 +317,14 @@ TEST_CASE("Leaks: an inner corner of zero-thickness walls, direct light (one bou
   bake_and_check({"thin_wall_corner", "plane, back to back", 0.0f, 0.0f, zero_wall::back_to_back}, {1});
 }
 
-// Fails the target (measured 90-91%): the mechanism of the two rooms' planes (the pocket's samples
-// near the planes are invalid, the lit side's records cover the points between them).
-TEST_CASE("Leaks: an inner corner of one-sided zero-thickness walls, three bounces", "[leaks][!mayfail]") {
+// The mechanism of the two rooms' planes (the pocket's samples near the planes are invalid, the
+// lit side's records reach the points between them): 90-91% without the cache's segment test.
+TEST_CASE("Leaks: an inner corner of one-sided zero-thickness walls, three bounces", "[leaks]") {
   bake_and_check({"thin_wall_corner", "plane, one-sided", 0.0f}, {3});
 }
 
-// Fails the target (measured 66-80%), as above.
-TEST_CASE("Leaks: an inner corner of back-to-back zero-thickness walls, three bounces", "[leaks][!mayfail]") {
+// As above: 66-80% without the cache's segment test.
+TEST_CASE("Leaks: an inner corner of back-to-back zero-thickness walls, three bounces", "[leaks]") {
   bake_and_check({"thin_wall_corner", "plane, back to back", 0.0f, 0.0f, zero_wall::back_to_back}, {3});
 }
 

@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace hemilight {
@@ -64,6 +65,10 @@ struct cache_record {
   /// stands at a contact or where surfaces intersect: its radius is limited to its sample's
   /// min_distance (the nearest hit), so its reach a R never crosses the geometry it touches.
   float backface_fraction = 0.0f;
+  /// The sample's irradiance_sample::min_distance (its hemicube's nearest hit; +inf if none): no
+  /// geometry lies nearer in its visible half-space. Beyond it, with cache_run::segment_blocked,
+  /// the record covers a point only if nothing blocks the segment between them.
+  float clear_distance = std::numeric_limits<float>::infinity();
   /// L1 spherical harmonics of the incoming radiance, world space, the sample's
   /// irradiance_sample::sh_l1 (integrate.hpp: Y00, Y1-1 (y), Y10 (z), Y11 (x); coefficient k,
   /// channel c: sh_l1[k][c]). Zero unless cache_run::directional.
@@ -183,6 +188,13 @@ struct cache_run {
   /// worker's index; must be deterministic and safe to call from different workers at once.
   /// Used with cache_expert_options::pretest_inside. Empty = none.
   std::function<bool(int worker, const glm::vec3& position, const glm::vec3& normal)> inside_test;
+  /// Optional (the baker: an Embree any-hit ray): true when geometry blocks the segment from a
+  /// record's position to a point. A record covers a point farther from it than its
+  /// cache_record::clear_distance only when this says false, so no record reaches across a wall
+  /// its radius spans (records are clamped up to min_radius: two texels at the defaults, more than
+  /// a thin wall's thickness). Must be deterministic and thread-safe. Empty = none. Cost: one
+  /// call per (record, point) pair weighed beyond the record's clear distance.
+  std::function<bool(const glm::vec3& from, const glm::vec3& to)> segment_blocked;
 };
 
 /// What one placement round of cache_irradiance did (cache_stats::round_details).

@@ -14,10 +14,10 @@
 // A seam between near-coplanar faces with a surface standing on it (a wall on a floor whose two
 // rooms' floors are separate charts) is walled: there the lighting legitimately differs, so it is
 // measured apart (seam_report::walled) and never stitched. Walled means: of seam_wall_points
-// segments across the piece, from half a texel inside one side to half a texel inside the other
-// (each at most a quarter of its triangle's height over the edge, lifted off its face by
-// 0.01 + tan(theta / 2) times that distance, theta the angle between the two faces), some segment
-// hits a triangle of the scene.
+// segments across the piece, from half a texel into one side to half a texel into the other
+// (perpendicular to the edge in each triangle's plane, also where the triangle is thinner, lifted
+// off its face by 0.01 + tan(theta / 2) times that distance, theta the angle between the two
+// faces), some segment hits a triangle of the scene.
 //
 // Sampling (the texel convention of bake.hpp): a side is read bilinearly at its UV along the
 // piece, texel (x, y) centred at ((x + 0.5) / W, (y + 0.5) / H), clamp-to-edge in its page.

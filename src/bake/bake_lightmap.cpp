@@ -302,7 +302,11 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   cache_run run;
   run.thread_count = o.thread_count;
   run.point_spacing = pts.spacing.data();
-  if (o.use_cache) run.inside_test = rays_inside_test(sc);
+  if (o.use_cache) {
+    run.inside_test = rays_inside_test(sc);
+    // No record reaches across a wall (cache_run::segment_blocked): one any-hit ray.
+    run.segment_blocked = [sc](const glm::vec3& from, const glm::vec3& to) { return occluded(*sc, from, to - from, 1.0f); };
+  }
   bounce_values out;
   out.valid.assign(count, 1);
   std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass

@@ -290,8 +290,9 @@ bool make_piece(const seam_mesh& m, const std::vector<tri_info>& tris, const edg
   return true;
 }
 
-// A point half a texel inside side s's triangle from the point x of its edge (at most a quarter of
-// the triangle's height over the edge), lifted off its face by `lift` x that distance.
+// A point half a texel from the point x of side s's edge, perpendicular to the edge in the plane
+// of its triangle and towards it (past the triangle when it is thinner: the chart goes on there, or
+// the segment still shows what stands on the seam), lifted off its face by `lift` x that distance.
 glm::dvec3 inside_point(const seam_mesh& m, const std::vector<tri_info>& tris, const seam_side& s, const glm::dvec3& x,
                         const glm::dvec3& edge_dir, double texel_world, double lift) {
   const std::size_t t = s.triangle;
@@ -299,9 +300,9 @@ glm::dvec3 inside_point(const seam_mesh& m, const std::vector<tri_info>& tris, c
                         glm::dvec3(m.positions[m.indices[3 * t + 2]])) / 3.0;
   glm::dvec3 in = c - x;
   in -= edge_dir * glm::dot(in, edge_dir);  // perpendicular to the edge, towards the triangle
-  const double h = glm::length(in);         // a third of the height over the edge
+  const double h = glm::length(in);
   if (!(h > 0.0)) return x;
-  const double d = std::min(0.5 * texel_world, 0.75 * h);
+  const double d = 0.5 * texel_world;
   return x + in * (d / h) + glm::dvec3(tris[t].face_normal) * (lift * d);
 }
 

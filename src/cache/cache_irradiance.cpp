@@ -63,7 +63,8 @@ struct coverage_detail {
 float interpolate(const std::vector<cache_record>& records, const record_lists& lists, const record_bvh& large, std::size_t point, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
-                  coverage_detail* detail = nullptr) {
+                  coverage_detail* detail = nullptr,
+                  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked = nullptr) {
   // 1. The covering records and their weights, then in record order: the sums below do not
   // depend on how the lists and the tree report records (the same order as interpolate_records).
   struct covering {
@@ -76,7 +77,10 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
   const auto consider = [&](const record_key& key) {
     ++visited;
     const float w = weight_of(key, x, n, o);
-    if (w > 0.0f && !is_behind(key, x, n)) cover.push_back({key.index, w});
+    if (!(w > 0.0f) || is_behind(key, x, n)) return;
+    // Beyond the nearest geometry the record's hemicube saw, a wall may stand between it and x.
+    if (blocked && glm::length(x - key.position) > records[key.index].clear_distance && (*blocked)(key.position, x)) return;
+    cover.push_back({key.index, w});
   };
   lists.query(point, consider);  // the records of few points, listed at the point
   large.query(x, consider);      // the others (each record is in one of the two)
@@ -439,7 +443,8 @@ class placement {
       const float reach = o_.error_threshold * key.radius;
       return glm::dot(dx, dx) <= 1.0002f * reach * reach;
     });
-    const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail);
+    const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail,
+                                blocked());
     visited = detail.visited;
     bool ok = w > 0.0f;
     open_reason why = open_reason::uncovered;
@@ -603,6 +608,11 @@ class placement {
     return first_new;
   }
 
+  // cache_run::segment_blocked, or null.
+  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked() const {
+    return r_.segment_blocked ? &r_.segment_blocked : nullptr;
+  }
+
   cache_record make_record(std::size_t i, const sampler_result& s) const {
     cache_record r;
     r.position = p_[i];
@@ -612,6 +622,7 @@ class placement {
     r.translation_gradient = s.translation_gradient;
     r.harmonic_distance = s.harmonic_mean_distance;
     r.backface_fraction = s.backface_fraction;
+    r.clear_distance = s.min_distance;
     if (r_.directional) {
       r.sh_l1 = s.sh_l1;
       r.cone = s.cone;
@@ -913,7 +924,7 @@ class placement {
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
         if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, r_.directional ? &sh : nullptr,
-                                      r_.directional ? &cone : nullptr) > 0.0f) {
+                                      r_.directional ? &cone : nullptr, nullptr, blocked()) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
           if (r_.directional) {
