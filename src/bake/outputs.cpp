@@ -22,11 +22,16 @@ struct output_finisher {
   const bake_layout& layout;
   const std::vector<std::uint8_t>& written;  // the sampled texels
   std::unique_ptr<seam_stitcher> stitcher;
+  mutable double seconds = 0.0;  // spent stitching (bake_stats::stitch_seconds)
 
   // Stitches (values clamped to [lo, hi]) and dilates one image; `f` receives the texels filled.
   void finish(image& img, std::vector<std::uint8_t>& f, float lo, float hi) const {
     f = written;
-    if (stitcher) stitcher->stitch(img, f, layout.blocked_mask(), lo, hi);
+    if (stitcher) {
+      const auto ts = std::chrono::steady_clock::now();
+      stitcher->stitch(img, f, layout.blocked_mask(), lo, hi);
+      seconds += seconds_since(ts);
+    }
     dilate_masked(img, f, o.dilation, layout.blocked_mask());
   }
   image finish(image img, float lo, float hi) const {
@@ -64,7 +69,11 @@ void hl2_outputs(const sample_points& pts, const pass_values& last, const pass_v
   }
   for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = sample_image(pts, out.layout, [&](std::size_t i) { return h[i][j]; });
   std::vector<std::uint8_t> f = out.written;
-  if (out.stitcher) out.stitcher->stitch_hl2(r.hl2, f, out.layout.blocked_mask());
+  if (out.stitcher) {
+    const auto ts = std::chrono::steady_clock::now();
+    out.stitcher->stitch_hl2(r.hl2, f, out.layout.blocked_mask());
+    out.seconds += seconds_since(ts);
+  }
   for (std::size_t j = 0; j < 3; ++j) {
     std::vector<std::uint8_t> fj = f;
     dilate_masked(r.hl2[j], fj, out.o.dilation, out.layout.blocked_mask());
@@ -88,11 +97,13 @@ void write_outputs(const sample_points& pts, const pass_values& last, const pass
     r.valid[pts.texel_of[i]] = valid[i];
     if (!valid[i]) ++r.stats.invalid_texels;
   }
-  const auto ts = std::chrono::steady_clock::now();
-  output_finisher out{o, layout, written, nullptr};
-  if (o.stitch_seams && !layout.seams.empty())
+  output_finisher out{o, layout, written, nullptr, 0.0};
+  if (o.stitch_seams && !layout.seams.empty()) {
+    const auto ts = std::chrono::steady_clock::now();
     out.stitcher = std::make_unique<seam_stitcher>(layout.seams, layout.seam_pages, layout.width, o.output_hl2, r.irradiance, written,
                                                    layout.blocked_mask());
+    out.seconds += seconds_since(ts);
+  }
   constexpr float unbounded = std::numeric_limits<float>::max();
   if (o.output_sh_l1)
     for (std::size_t j = 0; j < 4; ++j)
@@ -110,7 +121,7 @@ void write_outputs(const sample_points& pts, const pass_values& last, const pass
   }
   out.finish(r.irradiance, filled, 0.0f, unbounded);
   if (out.stitcher) r.stats.seam_texels = out.stitcher->texels().size();
-  r.stats.stitch_seconds += seconds_since(ts);
+  r.stats.stitch_seconds += out.seconds;
   for (std::size_t k = 0; k < texels; ++k)
     if (filled[k] && !written[k]) ++r.stats.dilated_texels;
 }
