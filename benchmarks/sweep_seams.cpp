@@ -64,7 +64,9 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace hemilight;
@@ -158,9 +160,22 @@ std::uint64_t input_hash(const scene_mesh& m, const std::vector<light>& lights, 
   add(m.positions.data(), m.positions.size() * sizeof(glm::vec3));
   add(m.indices.data(), m.indices.size() * sizeof(std::uint32_t));
   add(m.lightmap_uvs.data(), m.lightmap_uvs.size() * sizeof(glm::vec2));
-  add(m.materials.data(), m.materials.size() * sizeof(material));
+  for (const material& x : m.materials) {  // field by field: the structs' padding bytes are not part of the value
+    add(&x.emission, sizeof x.emission);
+    add(&x.albedo, sizeof x.albedo);
+    add(&x.two_sided, sizeof x.two_sided);
+  }
   add(&m.sky_radiance, sizeof m.sky_radiance);
-  add(lights.data(), lights.size() * sizeof(light));
+  for (const light& l : lights) {
+    add(&l.type, sizeof l.type);
+    add(&l.color, sizeof l.color);
+    add(&l.position, sizeof l.position);
+    add(&l.direction, sizeof l.direction);
+    add(&l.tangent, sizeof l.tangent);
+    const float f[5] = {l.width, l.height, l.radius, l.spot_inner, l.spot_outer};
+    add(f, sizeof f);
+    add(&l.casts_shadows, sizeof l.casts_shadows);
+  }
   add(&n, sizeof n);
   return h;
 }
@@ -215,7 +230,6 @@ double relative_rms(const bake_result& r, const bake_result& ref, Keep keep) {
 
 // The baker's seams for this input (the internal search the bake runs) and the stitcher's texels.
 struct seam_layout {
-  double seconds = 0.0;  // the search (lightmap_seams, with the scene it needs), as the bake runs it
   std::vector<bake_detail::seam_piece> pieces;
   std::vector<std::uint8_t> stitched;  // per texel: set by the stitcher
   std::size_t stitched_count = 0;
@@ -224,9 +238,7 @@ struct seam_layout {
 seam_layout baker_seams(const bake_input& in, int size) {
   seam_layout l;
   const auto sc = scene::create(in.scene);
-  const auto t0 = std::chrono::steady_clock::now();
   l.pieces = bake_detail::lightmap_seams(in, size, size, seam_options{}.coplanar_degrees, *sc);
-  l.seconds = bench::seconds_since(t0);
   const std::vector<bake_detail::page_rect> pages = {bake_detail::page_rect{0, 0, size, size}};
   const std::vector<bake_detail::stitch_point> points = bake_detail::stitch_points(l.pieces, pages, std::size_t(size));
   l.stitched.assign(std::size_t(size) * std::size_t(size), 0);
@@ -234,6 +246,36 @@ seam_layout baker_seams(const bake_input& in, int size) {
     for (std::size_t k = 0; k < 4; ++k) l.stitched[p.a.texel[k]] = l.stitched[p.b.texel[k]] = 1;
   for (std::uint8_t s : l.stitched) l.stitched_count += s;
   return l;
+}
+
+// The stitching of one bake's irradiance in its parts, timed here with the baker's internal
+// classes as write_outputs runs them (medians of `runs`): the seam search (lightmap_seams), the
+// systems' assembly and factorisation (seam_stitcher), the solve of one image (seam_stitcher::
+// stitch, with its start values) on the unstitched bake's values at the sampled texels.
+struct stitch_parts {
+  double search = 0.0, build = 0.0, solve = 0.0;
+};
+
+stitch_parts time_stitching(const bake_input& in, const bake_result& off, int size, int runs) {
+  const auto sc = scene::create(in.scene);
+  const std::vector<bake_detail::page_rect> pages = {bake_detail::page_rect{0, 0, size, size}};
+  std::vector<double> search, build, solve;
+  for (int run = 0; run < runs; ++run) {
+    auto t = std::chrono::steady_clock::now();
+    const std::vector<bake_detail::seam_piece> pieces = bake_detail::lightmap_seams(in, size, size, seam_options{}.coplanar_degrees, *sc);
+    search.push_back(bench::seconds_since(t));
+    t = std::chrono::steady_clock::now();
+    const bake_detail::seam_stitcher stitcher(pieces, pages, size, false);
+    build.push_back(bench::seconds_since(t));
+    image img = image::make(size, size, 3);
+    for (std::size_t k = 0; k < off.sampled.size(); ++k)
+      if (off.sampled[k]) std::memcpy(img.pixels.data() + 3 * k, off.irradiance.pixels.data() + 3 * k, 3 * sizeof(float));
+    std::vector<std::uint8_t> filled = off.sampled;
+    t = std::chrono::steady_clock::now();
+    stitcher.stitch(img, filled, nullptr, 0.0f, std::numeric_limits<float>::max());
+    solve.push_back(bench::seconds_since(t));
+  }
+  return {median(search), median(build), median(solve)};
 }
 
 // What a side of a piece reads at the piece's middle: some valid sampled texel (weight > 0), and
@@ -254,9 +296,10 @@ side_read read_side(const bake_result& r, const bake_detail::seam_side& s, int s
   return out;
 }
 
-// The largest relative step along a piece (measure_seams' definition, its sample points).
-double piece_max_step(const bake_result& r, const bake_detail::seam_piece& p, int size, double floor) {
-  const auto n = std::size_t(std::max(1.0, std::ceil(4.0 * double(p.length_texels))));
+// The relative steps along a piece at measure_seams' sample points (seams.hpp; default
+// seam_options: 4 per texel of length), each with the length it stands for.
+std::vector<std::pair<double, double>> piece_steps(const bake_result& r, const bake_detail::seam_piece& p, int size, double floor) {
+  const auto n = std::size_t(std::max(1.0, std::ceil(double(seam_options{}.samples_per_texel) * double(p.length_texels))));
   const bake_detail::page_rect page{0, 0, size, size};
   const auto lookup = [&](const glm::vec2& t) {
     const bake_detail::footprint f = bake_detail::bilinear_footprint(page, std::size_t(size), t);
@@ -264,20 +307,42 @@ double piece_max_step(const bake_result& r, const bake_detail::seam_piece& p, in
     for (std::size_t k = 0; k < 4; ++k) y += double(f.weight[k]) * luminance(r, f.texel[k]);
     return y;
   };
-  double worst = 0.0;
+  std::vector<std::pair<double, double>> out;
   for (std::size_t j = 0; j < n; ++j) {
     const float t = (float(j) + 0.5f) / float(n);
     const double ya = lookup(p.a.t0 + t * (p.a.t1 - p.a.t0)), yb = lookup(p.b.t0 + t * (p.b.t1 - p.b.t0));
     const double scale = std::max(0.5 * (ya + yb), floor);
-    if (scale > 0.0) worst = std::max(worst, std::fabs(ya - yb) / scale);
+    out.emplace_back(scale > 0.0 ? std::fabs(ya - yb) / scale : 0.0, double(p.length_texels) / double(n));
   }
-  return worst;
+  return out;
 }
+
+double max_step(const std::vector<std::pair<double, double>>& steps) {
+  double m = 0.0;
+  for (const auto& [d, l] : steps) m = std::max(m, d);
+  return m;
+}
+
+// Length-weighted RMS of the steps (measure_seams' rms).
+struct rms_sum {
+  double sum2 = 0.0, length = 0.0;
+  void add(const std::vector<std::pair<double, double>>& steps) {
+    for (const auto& [d, l] : steps) {
+      sum2 += l * d * d;
+      length += l;
+    }
+  }
+  double rms() const { return length > 0.0 ? std::sqrt(sum2 / length) : 0.0; }
+};
 
 std::string figures_csv(const seam_figures& f) {
   char b[160];
   std::snprintf(b, sizeof b, "%.6f,%.6f,%.6f,%.5f", f.rms, f.p95, f.max, f.step_fraction);
   return b;
+}
+
+const char* describe(const side_read& r) {
+  return r.valid ? (r.invalid ? "valid+inside" : "valid") : (r.invalid ? "inside only" : "padding only");
 }
 
 void run_seams(const std::string& csv, const std::vector<std::string>& scenes, const std::vector<int>& sizes, int runs, int ref_n,
@@ -291,9 +356,11 @@ void run_seams(const std::string& csv, const std::vector<std::string>& scenes, c
                   "coplanar_pieces,coplanar_length,walled_pieces,walled_length,crease_pieces,crease_length,"
                   "rms_off,p95_off,max_off,step_fraction_off,rms_on,p95_on,max_on,step_fraction_on,"
                   "rms_ref,p95_ref,max_ref,step_fraction_ref,walled_rms_off,walled_rms_on,"
+                  "clean_pieces,clean_length,rms_off_clean,rms_on_clean,max_on_clean,sides_without_valid,sides_with_invalid,"
                   "reference_n,reference_seconds,error_off,error_on,seam_error_off,seam_error_on,"
                   "interior_change,all_change,seam_change,interior_max_change,seam_texels,stitched_texels_check,"
-                  "sides_without_valid,sides_with_invalid,stitch_seconds,search_seconds,seconds_off,seconds_on,runs,deterministic,load_before,load_after\n");
+                  "stitch_seconds,stitch_seconds_off,search_seconds,build_seconds,solve_seconds,seconds_off,seconds_on,"
+                  "runs,deterministic,load_before,load_after\n");
   for (const std::string& name : scenes)
     for (int size : sizes) {
       seam_scene s;
@@ -318,6 +385,7 @@ void run_seams(const std::string& csv, const std::vector<std::string>& scenes, c
         if (run == 0) on = std::move(b);
         else deterministic = deterministic && same_bytes(on, b);
       }
+      const stitch_parts parts = time_stitching(in, off, size, runs);
       const double load_after = bench::loadavg();
       const seam_report m_off = measure_seams(in, off), m_on = measure_seams(in, on);
       double ref_seconds = 0.0;
@@ -348,8 +416,11 @@ void run_seams(const std::string& csv, const std::vector<std::string>& scenes, c
       for (std::size_t k = 0; k < off.sampled.size(); ++k)
         if (off.sampled[k] && !layout.stitched[k])
           interior_max = std::max(interior_max, std::fabs(luminance(on, k) - luminance(off, k)) / std::max(luminance(off, k), 0.05 * mean_y));
-      // Sides of the stitched pieces that read no valid texel, or a texel inside geometry.
-      std::size_t without_valid = 0, with_invalid = 0;
+      // The stitched pieces (coplanar, not walled): sides that read no valid texel or a texel
+      // inside geometry; the step over the "clean" pieces, both of whose sides read a valid texel.
+      std::size_t without_valid = 0, with_invalid = 0, clean = 0;
+      double clean_length = 0.0, clean_max_on = 0.0;
+      rms_sum clean_off, clean_on;
       struct worst_piece {
         double step;
         std::size_t index;
@@ -358,49 +429,56 @@ void run_seams(const std::string& csv, const std::vector<std::string>& scenes, c
       for (std::size_t i = 0; i < layout.pieces.size(); ++i) {
         const bake_detail::seam_piece& p = layout.pieces[i];
         if (!p.coplanar || p.walled) continue;
-        for (const bake_detail::seam_side* side : {&p.a, &p.b}) {
-          const side_read rd = read_side(off, *side, size);
-          without_valid += rd.valid ? 0 : 1;
-          with_invalid += rd.invalid ? 1 : 0;
+        const side_read ra = read_side(off, p.a, size), rb = read_side(off, p.b, size);
+        without_valid += std::size_t(!ra.valid) + std::size_t(!rb.valid);
+        with_invalid += std::size_t(ra.invalid) + std::size_t(rb.invalid);
+        const auto steps_on = piece_steps(on, p, size, m_on.floor);
+        if (ra.valid && rb.valid) {
+          ++clean;
+          clean_length += double(p.length_texels);
+          clean_off.add(piece_steps(off, p, size, m_off.floor));
+          clean_on.add(steps_on);
+          clean_max_on = std::max(clean_max_on, max_step(steps_on));
         }
-        worst.push_back({piece_max_step(on, p, size, m_on.floor), i});
+        worst.push_back({max_step(steps_on), i});
       }
-      std::sort(worst.begin(), worst.end(), [](const worst_piece& a, const worst_piece& b) { return a.step > b.step; });
+      std::sort(worst.begin(), worst.end(), [](const worst_piece& x, const worst_piece& y) { return x.step > y.step; });
 
-      std::fprintf(f, "%s,%s,%d,%zu,%zu,%zu,%zu,%.1f,%zu,%.1f,%zu,%.1f,%s,%s,%s,%.6f,%.6f,%d,%.2f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%zu,%zu,"
-                      "%zu,%zu,%.5f,%.5f,%.4f,%.4f,%d,%d,%.2f,%.2f\n",
+      std::fprintf(f, "%s,%s,%d,%zu,%zu,%zu,%zu,%.1f,%zu,%.1f,%zu,%.1f,%s,%s,%s,%.6f,%.6f,%zu,%.1f,%.6f,%.6f,%.6f,%zu,%zu,"
+                      "%d,%.2f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%zu,%zu,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.4f,%d,%d,%.2f,%.2f\n",
                    s.name.c_str(), s.uvs.c_str(), size, s.mesh.triangle_count(), off.stats.sampled_texels, off.stats.invalid_texels,
                    m_off.coplanar.pieces, m_off.coplanar.length_texels, m_off.walled.pieces, m_off.walled.length_texels,
                    m_off.crease.pieces, m_off.crease.length_texels, figures_csv(m_off.coplanar).c_str(), figures_csv(m_on.coplanar).c_str(),
-                   figures_csv(m_ref.coplanar).c_str(), m_off.walled.rms, m_on.walled.rms, ref_n, ref_seconds, error_off, error_on,
-                   seam_error_off, seam_error_on, interior_change, all_change, seam_change, interior_max, on.stats.seam_texels,
-                   layout.stitched_count, without_valid, with_invalid, median(stitch), layout.seconds, off.stats.seconds, median(sec_on), runs,
+                   figures_csv(m_ref.coplanar).c_str(), m_off.walled.rms, m_on.walled.rms, clean, clean_length, clean_off.rms(),
+                   clean_on.rms(), clean_max_on, without_valid, with_invalid, ref_n, ref_seconds, error_off, error_on, seam_error_off,
+                   seam_error_on, interior_change, all_change, seam_change, interior_max, on.stats.seam_texels, layout.stitched_count,
+                   median(stitch), off.stats.stitch_seconds, parts.search, parts.build, parts.solve, off.stats.seconds, median(sec_on), runs,
                    deterministic ? 1 : 0, load_before, load_after);
       std::fflush(f);
       std::printf("%-16s %-9s %4d^2 %6zu tris: coplanar %zu pieces (%.0f texels), walled %zu (%.0f), crease %zu (%.0f)\n"
                   "  seam RMS %.4f -> %.4f (p95 %.4f -> %.4f, max %.3f -> %.3f, over 2%%: %.3f -> %.3f); reference N = %d: RMS %.4f, "
                   "max %.3f (%.1f s)\n"
+                  "  pieces with a valid texel on both sides: %zu (%.0f texels), RMS %.4f -> %.4f, max after %.3f; sides without a "
+                  "valid texel %zu, with one inside geometry %zu\n"
                   "  error against the reference %.4f / %.4f (seam texels %.4f / %.4f); change: interior %.2e (max %.2e), all %.2e, "
                   "seam texels %.4f\n"
-                  "  seam_texels %zu (rebuilt: %zu), stitch %.3f s of %.2f s (off %.2f s), sides without a valid texel %zu, with "
-                  "an invalid one %zu%s\n",
+                  "  seam_texels %zu (rebuilt: %zu), stitch_seconds %.3f (off: %.3f; search %.4f, build %.4f, solve %.4f) of %.2f s "
+                  "(off %.2f s)%s\n",
                   s.name.c_str(), s.uvs.c_str(), size, s.mesh.triangle_count(), m_off.coplanar.pieces, m_off.coplanar.length_texels,
                   m_off.walled.pieces, m_off.walled.length_texels, m_off.crease.pieces, m_off.crease.length_texels, m_off.coplanar.rms,
                   m_on.coplanar.rms, m_off.coplanar.p95, m_on.coplanar.p95, m_off.coplanar.max, m_on.coplanar.max,
                   m_off.coplanar.step_fraction, m_on.coplanar.step_fraction, ref_n, m_ref.coplanar.rms, m_ref.coplanar.max, ref_seconds,
-                  error_off, error_on, seam_error_off, seam_error_on, interior_change, interior_max, all_change, seam_change,
-                  on.stats.seam_texels, layout.stitched_count, median(stitch), median(sec_on), off.stats.seconds, without_valid, with_invalid,
-                  deterministic ? "" : " NOT DETERMINISTIC");
+                  clean, clean_length, clean_off.rms(), clean_on.rms(), clean_max_on, without_valid, with_invalid, error_off, error_on,
+                  seam_error_off, seam_error_on, interior_change, interior_max, all_change, seam_change, on.stats.seam_texels,
+                  layout.stitched_count, median(stitch), off.stats.stitch_seconds, parts.search, parts.build, parts.solve, median(sec_on),
+                  off.stats.seconds, deterministic ? "" : " NOT DETERMINISTIC");
       for (std::size_t w = 0; w < std::min<std::size_t>(3, worst.size()); ++w) {
         const bake_detail::seam_piece& p = layout.pieces[worst[w].index];
-        const side_read ra = read_side(off, p.a, size), rb = read_side(off, p.b, size);
         const glm::vec3 mid = 0.5f * (p.p0 + p.p1);
         std::printf("    worst after: step %.3f, piece %zu at (%.2f, %.2f, %.2f), %.1f texels, sides at texel (%.1f, %.1f) %s / (%.1f, %.1f) %s\n",
                     worst[w].step, worst[w].index, double(mid.x), double(mid.y), double(mid.z), double(p.length_texels),
-                    double(0.5f * (p.a.t0.x + p.a.t1.x)), double(0.5f * (p.a.t0.y + p.a.t1.y)),
-                    ra.valid ? (ra.invalid ? "valid+inside" : "valid") : (ra.invalid ? "inside only" : "padding only"),
-                    double(0.5f * (p.b.t0.x + p.b.t1.x)), double(0.5f * (p.b.t0.y + p.b.t1.y)),
-                    rb.valid ? (rb.invalid ? "valid+inside" : "valid") : (rb.invalid ? "inside only" : "padding only"));
+                    double(0.5f * (p.a.t0.x + p.a.t1.x)), double(0.5f * (p.a.t0.y + p.a.t1.y)), describe(read_side(off, p.a, size)),
+                    double(0.5f * (p.b.t0.x + p.b.t1.x)), double(0.5f * (p.b.t0.y + p.b.t1.y)), describe(read_side(off, p.b, size)));
       }
     }
   std::fclose(f);
@@ -413,38 +491,38 @@ void run_cost(const std::string& csv, const std::vector<std::string>& cases, int
     std::exit(1);
   }
   std::fprintf(f, "scene,uvs,size,triangles,texels,sampled_texels,coplanar_pieces,coplanar_length,seam_texels,stitch_seconds,"
-                  "stitch_seconds_min,stitch_seconds_max,search_seconds,seconds,runs,load_before,load_after\n");
+                  "stitch_seconds_min,stitch_seconds_max,stitch_seconds_off,search_seconds,build_seconds,solve_seconds,seconds,seconds_off,"
+                  "runs,load_before,load_after\n");
   for (const std::string& c : cases) {
     const std::size_t at = c.find('@');
     const std::string name = c.substr(0, at);
     const int size = at == std::string::npos ? 1024 : std::atoi(c.c_str() + at + 1);
-    {
-      const seam_scene s = make_scene(name, size);
-      bake_input in;
-      in.scene = s.mesh.desc();
-      const double load_before = bench::loadavg();
-      std::vector<double> stitch, search, seconds;
-      bake_result first;
-      const bake_options o = default_bake(size, threads, s.lights, true);
-      for (int run = 0; run < runs; ++run) {
-        bake_result r = bake_lightmap(in, o);
-        stitch.push_back(r.stats.stitch_seconds);
-        seconds.push_back(r.stats.seconds);
-        search.push_back(baker_seams(in, size).seconds);
-        if (run == 0) first = std::move(r);
-      }
-      const double load_after = bench::loadavg();
-      const seam_report m = measure_seams(in, first);
-      std::fprintf(f, "%s,%s,%d,%zu,%zu,%zu,%zu,%.1f,%zu,%.5f,%.5f,%.5f,%.5f,%.4f,%d,%.2f,%.2f\n", s.name.c_str(), s.uvs.c_str(),
-                   size, s.mesh.triangle_count(), first.stats.texels, first.stats.sampled_texels, m.coplanar.pieces,
-                   m.coplanar.length_texels, first.stats.seam_texels, median(stitch), *std::min_element(stitch.begin(), stitch.end()),
-                   *std::max_element(stitch.begin(), stitch.end()), median(search), median(seconds), runs, load_before, load_after);
-      std::fflush(f);
-      std::printf("cost %-22s %4d^2: %zu seam texels (%zu coplanar pieces, %.0f texels long), stitch %.4f s (search %.4f s; medians of "
-                  "%d) of %.2f s\n",
-                  s.name.c_str(), size, first.stats.seam_texels, m.coplanar.pieces, m.coplanar.length_texels, median(stitch),
-                  median(search), runs, median(seconds));
+    const seam_scene s = make_scene(name, size);
+    bake_input in;
+    in.scene = s.mesh.desc();
+    const double load_before = bench::loadavg();
+    const bake_result off = bake_lightmap(in, default_bake(size, threads, s.lights, false));
+    std::vector<double> stitch, seconds;
+    bake_result first;
+    for (int run = 0; run < runs; ++run) {
+      bake_result r = bake_lightmap(in, default_bake(size, threads, s.lights, true));
+      stitch.push_back(r.stats.stitch_seconds);
+      seconds.push_back(r.stats.seconds);
+      if (run == 0) first = std::move(r);
     }
+    const stitch_parts parts = time_stitching(in, off, size, runs);
+    const double load_after = bench::loadavg();
+    const seam_report m = measure_seams(in, first);
+    std::fprintf(f, "%s,%s,%d,%zu,%zu,%zu,%zu,%.1f,%zu,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f,%.4f,%d,%.2f,%.2f\n", s.name.c_str(),
+                 s.uvs.c_str(), size, s.mesh.triangle_count(), first.stats.texels, first.stats.sampled_texels, m.coplanar.pieces,
+                 m.coplanar.length_texels, first.stats.seam_texels, median(stitch), *std::min_element(stitch.begin(), stitch.end()),
+                 *std::max_element(stitch.begin(), stitch.end()), off.stats.stitch_seconds, parts.search, parts.build, parts.solve,
+                 median(seconds), off.stats.seconds, runs, load_before, load_after);
+    std::fflush(f);
+    std::printf("cost %-22s %4d^2: %zu seam texels (%zu coplanar pieces, %.0f texels long), stitch_seconds %.4f (median of %d; off: "
+                "%.4f; search %.4f, build %.4f, solve %.4f) of %.2f s\n",
+                s.name.c_str(), size, first.stats.seam_texels, m.coplanar.pieces, m.coplanar.length_texels, median(stitch), runs,
+                off.stats.stitch_seconds, parts.search, parts.build, parts.solve, median(seconds));
   }
   std::fclose(f);
 }
