@@ -32,6 +32,9 @@ def steps(ax, rows):
     ax.barh(y + 0.27, val("rms_ref"), 0.27, color="tab:gray", label="seam RMS of the reference (N = 128 per texel)")
     ax.scatter(val("error_off"), y, marker="D", color="k", s=22, zorder=3, label="bake's error vs the reference (off)")
     ax.scatter(val("error_on"), y, marker="x", color="tab:purple", s=30, zorder=3, label="bake's error vs the reference (on)")
+    clean = [i for i, r in enumerate(rows) if r["coplanar_pieces"] > 0]
+    ax.scatter([max(rows[i]["rms_on_clean"], floor) for i in clean], [i for i in clean], marker="|", color="darkgreen", s=90,
+               zorder=3, label="seam RMS on, pieces with a valid texel on both sides")
     for i, r in enumerate(rows):
         if int(r["coplanar_pieces"]) == 0:
             ax.annotate("no coplanar seams", (floor * 1.3, i), fontsize=6, va="center", color="0.3")
@@ -42,7 +45,7 @@ def steps(ax, rows):
     ax.invert_yaxis()
     ax.set_xlabel("relative step RMS along coplanar seams; relative RMS error (log)")
     ax.set_title("Coplanar seams before and after stitching, against the bake's own error", fontsize=9)
-    ax.legend(fontsize=6, loc="lower right")
+    ax.legend(fontsize=6, loc="upper right", framealpha=0.95)
 
 
 def fit(x, y):
@@ -69,6 +72,12 @@ def cost(ax, rows, cost_rows):
             slopes[s] = (k, kp)
             lab += f": slope {k:.2f} (parts {kp:.2f})"
         ax.plot(x, y, "o-", color=colors[s], lw=0.9, ms=5, label=lab)
+        spread = [r for r in q if "stitch_seconds_min" in r and r["stitch_seconds_min"] != ""]
+        if spread:  # the cost part's rows: min and max of the runs
+            ax.errorbar([r["seam_texels"] for r in spread], [r["stitch_seconds"] for r in spread],
+                        yerr=[[r["stitch_seconds"] - r["stitch_seconds_min"] for r in spread],
+                              [r["stitch_seconds_max"] - r["stitch_seconds"] for r in spread]],
+                        fmt="none", ecolor=colors[s], elinewidth=0.8, capsize=2)
         ax.plot(x, parts, "o--", color=colors[s], lw=0.7, ms=5, mfc="none")
         for r in q:
             ax.annotate(f"{int(r['size'])}²", (r["seam_texels"], r["stitch_seconds"]), fontsize=6, xytext=(3, 3),
@@ -84,8 +93,8 @@ def cost(ax, rows, cost_rows):
     ax.set_yscale("log")
     ax.set_xlabel("texels set by stitching (bake_stats::seam_texels)")
     ax.set_ylabel("seconds")
-    ax.set_title("Cost of stitching. Filled: bake_stats::stitch_seconds (median of 3; includes the output's\n"
-                 "dilation); hollow: seam search + assembly + one solve, timed apart", fontsize=8)
+    ax.set_title("Cost of stitching. Filled: bake_stats::stitch_seconds (median of 3, bars min-max;\n"
+                 "it includes the output's dilation); hollow: search + assembly + one solve, timed apart", fontsize=8)
     ax.legend(fontsize=6, loc="upper left")
     return slopes
 
