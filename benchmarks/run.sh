@@ -28,7 +28,7 @@
 #                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
 #   bash benchmarks/run.sh seams              seam stitching: the step along coplanar seams before and after against
 #                                     the bake's error, the change of the other texels, the cost (docs/bake.md, "Seams";
-#                                     ~12 min the first time, references kept in build-bench/seams_truth; in the default
+#                                     ~11 min the first time, ~6.5 with the references kept in build-bench/seams_truth; in the default
 #                                     run); SEAMS_FLAGS="--scenes open_street --sizes 256" etc.
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
