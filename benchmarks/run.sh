@@ -26,6 +26,10 @@
 #   bash benchmarks/run.sh raster_levels      a hemicube's cost on the stand-in levels (default size and 1M
 #                                     triangles) over the hexagon room's, culling on and off, paired rounds
 #                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
+#   bash benchmarks/run.sh seams              seam stitching: the step along coplanar seams before and after against
+#                                     the bake's error, the change of the other texels, the cost (docs/bake.md, "Seams";
+#                                     ~11 min the first time, ~6.5 with the references kept in build-bench/seams_truth; in the default
+#                                     run); SEAMS_FLAGS="--scenes open_street --sizes 256" etc.
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -149,6 +153,17 @@ for n in "${names[@]}"; do
         --stride 76 --check-stride 6
     done
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_cache.py docs/bench
+    continue
+  fi
+  if [ "$n" = seams ]; then
+    # Seam stitching on the built-in scenes (unwrapper's UVs) and the stand-in levels (docs/bake.md,
+    # "Seams"): docs/bench/seams.csv and seams_cost.csv; the per-texel references (N = 128) are kept
+    # in build-bench/seams_truth. The flags at the top of benchmarks/sweep_seams.cpp.
+    echo "== sweep_seams"
+    mkdir -p "$build/seams_truth"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_seams" docs/bench/seams.csv --truth-cache "$build/seams_truth" ${SEAMS_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_seams.py docs/bench
     continue
   fi
   if [ "$n" = edge_downstream ]; then
