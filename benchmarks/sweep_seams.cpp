@@ -235,15 +235,25 @@ struct seam_layout {
   std::size_t stitched_count = 0;
 };
 
-seam_layout baker_seams(const bake_input& in, int size) {
+// The unstitched bake's irradiance at its sampled texels (0 elsewhere): what write_outputs hands
+// the stitcher.
+image sampled_irradiance(const bake_result& off, int size) {
+  image img = image::make(size, size, 3);
+  for (std::size_t k = 0; k < off.sampled.size(); ++k)
+    if (off.sampled[k]) std::memcpy(img.pixels.data() + 3 * k, off.irradiance.pixels.data() + 3 * k, 3 * sizeof(float));
+  return img;
+}
+
+// The seams and the texels stitching sets, as the baker finds them (its stitcher on the unstitched
+// bake's values: points on discontinuities dropped).
+seam_layout baker_seams(const bake_input& in, const bake_result& off, int size) {
   seam_layout l;
   const auto sc = scene::create(in.scene);
-  l.pieces = bake_detail::lightmap_seams(in, size, size, seam_options{}.coplanar_degrees, *sc);
+  l.pieces = bake_detail::lightmap_seams(in, size, size, seam_stitch_degrees, *sc);
   const std::vector<bake_detail::page_rect> pages = {bake_detail::page_rect{0, 0, size, size}};
-  const std::vector<bake_detail::stitch_point> points = bake_detail::stitch_points(l.pieces, pages, std::size_t(size));
+  const bake_detail::seam_stitcher stitcher(l.pieces, pages, size, false, sampled_irradiance(off, size), off.sampled, nullptr);
   l.stitched.assign(std::size_t(size) * std::size_t(size), 0);
-  for (const bake_detail::stitch_point& p : points)
-    for (std::size_t k = 0; k < 4; ++k) l.stitched[p.a.texel[k]] = l.stitched[p.b.texel[k]] = 1;
+  for (std::size_t k : stitcher.texels()) l.stitched[k] = 1;
   for (std::uint8_t s : l.stitched) l.stitched_count += s;
   return l;
 }
@@ -262,15 +272,13 @@ stitch_parts time_stitching(const bake_input& in, const bake_result& off, int si
   std::vector<double> search, build, solve;
   for (int run = 0; run < runs; ++run) {
     auto t = std::chrono::steady_clock::now();
-    const std::vector<bake_detail::seam_piece> pieces = bake_detail::lightmap_seams(in, size, size, seam_options{}.coplanar_degrees, *sc);
+    const std::vector<bake_detail::seam_piece> pieces = bake_detail::lightmap_seams(in, size, size, seam_stitch_degrees, *sc);
     search.push_back(bench::seconds_since(t));
-    t = std::chrono::steady_clock::now();
-    const bake_detail::seam_stitcher stitcher(pieces, pages, size, false);
-    build.push_back(bench::seconds_since(t));
-    image img = image::make(size, size, 3);
-    for (std::size_t k = 0; k < off.sampled.size(); ++k)
-      if (off.sampled[k]) std::memcpy(img.pixels.data() + 3 * k, off.irradiance.pixels.data() + 3 * k, 3 * sizeof(float));
+    image img = sampled_irradiance(off, size);
     std::vector<std::uint8_t> filled = off.sampled;
+    t = std::chrono::steady_clock::now();
+    const bake_detail::seam_stitcher stitcher(pieces, pages, size, false, img, filled, nullptr);
+    build.push_back(bench::seconds_since(t));
     t = std::chrono::steady_clock::now();
     stitcher.stitch(img, filled, nullptr, 0.0f, std::numeric_limits<float>::max());
     solve.push_back(bench::seconds_since(t));
@@ -391,7 +399,7 @@ void run_seams(const std::string& csv, const std::vector<std::string>& scenes, c
       double ref_seconds = 0.0;
       const bake_result ref = reference_bake(s, in, size, ref_n, threads, truth_dir, ref_seconds);
       const seam_report m_ref = measure_seams(in, ref);
-      const seam_layout layout = baker_seams(in, size);
+      const seam_layout layout = baker_seams(in, off, size);
 
       const auto valid_both = [&](const bake_result& r) {
         return [&](std::size_t k) { return r.sampled[k] && r.valid[k] && ref.sampled[k] && ref.valid[k]; };

@@ -39,6 +39,12 @@ inline constexpr float seam_position_tolerance = 1e-5f;
 /// rounding of UVs interpolated at a T-junction).
 inline constexpr float seam_uv_tolerance = 1e-3f;
 
+/// The seams the baker stitches (bake_options::stitch_seams): shading normals within this angle
+/// (degrees) of each other at both ends of the piece. Tighter than seam_options::coplanar_degrees:
+/// where flat-shaded faces meet at an angle the lighting legitimately differs across the edge (by
+/// about tan(angle) of a light at grazing incidence), and a converged bake shows that step too.
+inline constexpr float seam_stitch_degrees = 1.0f;
+
 /// Segments across each near-coplanar piece (at 0.1, 0.3, ..., 0.9 of its length) that decide
 /// whether a surface stands on it (walled).
 inline constexpr int seam_wall_points = 5;

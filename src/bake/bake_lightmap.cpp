@@ -410,7 +410,7 @@ bake_result bake_lightmap(const bake_input& input, const bake_options& o) {
   double seam_seconds = 0.0;
   if (o.stitch_seams) {
     const auto ts = std::chrono::steady_clock::now();
-    layout.seams = bake_detail::lightmap_seams(checked.input, o.width, o.height, seam_options{}.coplanar_degrees, *sc);
+    layout.seams = bake_detail::lightmap_seams(checked.input, o.width, o.height, seam_stitch_degrees, *sc);
     layout.seam_pages = {bake_detail::page_rect{0, 0, o.width, o.height}};
     seam_seconds = bake_detail::seconds_since(ts);
   }

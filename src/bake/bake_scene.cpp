@@ -454,7 +454,7 @@ double scene_seams(const scene_bake_input& input, const scene_geometry& g, const
   m.triangle_page = g.triangle_page.data();
   for (std::size_t p = 0; p < input.pages.size(); ++p)
     m.pages.push_back(page_rect{0, atlas.page_y[p], input.pages[p].width, input.pages[p].height});
-  atlas.layout.seams = find_seams(m, seam_options{}.coplanar_degrees, walls);
+  atlas.layout.seams = find_seams(m, seam_stitch_degrees, walls);
   atlas.layout.seam_pages = m.pages;
   return seconds_since(t0);
 }
