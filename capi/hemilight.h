@@ -577,8 +577,8 @@ typedef struct hemilight_bake_options {
   int strict;
   int reserved2;           /* padding, not read: keeps stitch_seams past the earlier layout's sizeof */
   /* Since 0.15; 0 or 1 (default 1). Seam stitching: after the passes, the texels that bilinear
-   * lookups read along seams between near-coplanar faces (two charts of one mesh, two meshes, two
-   * pages) are set by least squares so that both sides agree along the seam, the rest staying near
+   * lookups read along seams between faces whose shading normals agree within 1 degree (two charts
+   * of one mesh, two meshes, two pages) are set by least squares so that both sides agree along the seam, the rest staying near
    * their baked values; every output (irradiance, shadow mask). Seams the two sides cannot see
    * each other across (a wall standing on them), and points where the irradiance jumps across the
    * seam (a hard shadow along it), are left as baked. Counted in

@@ -69,7 +69,8 @@ struct bake_options {
   /// Rings of dilation around every chart, >= 0; -1 fills every empty texel of the lightmap.
   int dilation = 16;
   /// Stitch the seams (seams.hpp): after the passes, the texels that bilinear lookups along
-  /// near-coplanar seams read (both sides, padding included) are set by least squares so that
+  /// seams between faces whose shading normals agree within seam_stitch_degrees (1) read (both
+  /// sides, padding included) are set by least squares so that
   /// both sides agree along the seam while staying close to their baked values; dilation follows.
   /// Seams with a wall standing on them and points where the irradiance jumps across the seam
   /// (more than the two sides' gradients explain: a hard shadow along it) are left as baked.
