@@ -94,7 +94,7 @@ def cost(ax, rows, cost_rows):
     ax.set_xlabel("texels set by stitching (bake_stats::seam_texels)")
     ax.set_ylabel("seconds")
     ax.set_title("Cost of stitching. Filled: bake_stats::stitch_seconds (median of 3, bars min-max;\n"
-                 "it includes the output's dilation); hollow: search + assembly + one solve, timed apart", fontsize=8)
+                 "every output's solves); hollow: search + assembly + one solve, timed apart", fontsize=8)
     ax.legend(fontsize=6, loc="upper left")
     return slopes
 
