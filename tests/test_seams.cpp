@@ -384,6 +384,19 @@ TEST_CASE("measure_seams rejects bad options and results that do not match the i
   bake_result grey = r;
   grey.irradiance = image::make(size, size, 4);
   fails_with(seam_options{}, grey, "result.irradiance");
+  uv_mesh far = m;
+  far.uvs[0].x = 1.5f;
+  try {
+    measure_seams(far.input(), r);
+    FAIL("no error for a UV outside [0, 1]");
+  } catch (const error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("lightmap_uvs[0].u = 1.5"));
+  }
+  // A huge triangle among small ones (edges 1e15 times the cells of the T-junction search): the
+  // search stays bounded and finds the one seam.
+  uv_mesh huge = m;
+  huge.add({-1e15f, 0, -1e15f}, {1e15f, 0, -1e15f}, {0, 1e15f, -1e15f}, uv(0.5f, 0.5f), uv(1.5f, 0.5f), uv(0.5f, 1.5f));
+  CHECK(measure_seams(huge.input(), r).coplanar.pieces == 1);
   uv_mesh bad = m;
   bad.indices[4] = 99;
   try {

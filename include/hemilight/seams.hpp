@@ -96,7 +96,7 @@ struct seam_report {
 /// (input.normals for the coplanar test), result.irradiance, result.sampled and result.valid
 /// (may be empty). Builds the scene's rays for the walled test.
 /// Errors (error(invalid_argument), naming the argument): options out of range; no lightmap UVs,
-/// an index out of range; a result whose irradiance is not an RGB image or whose sampled array
+/// an index out of range, a UV more than lightmap_uv_tolerance outside [0, 1]; a result whose irradiance is not an RGB image or whose sampled array
 /// does not match it, a valid array neither empty nor of that size. Non-finite texels are read as
 /// they are (the bake writes none).
 /// Cost: O(E log E) for E triangle edges (sorting, a grid of the vertices for T-junctions), the

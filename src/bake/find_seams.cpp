@@ -132,7 +132,7 @@ vertex_table make_vertex_table(const seam_mesh& m, const std::vector<edge>& edge
 // queries.
 class vertex_grid {
  public:
-  vertex_grid(const vertex_table& v, float cell) : cell_(cell) {
+  vertex_grid(const vertex_table& v, float cell) : cell_(cell), count_(v.position.size()) {
     for (std::size_t i = 0; i < v.position.size(); ++i) cells_[key(cell_of(v.position[i]))].push_back(std::uint32_t(i));
   }
   // Calls f(vertex) for every vertex in the cells that a box lo..hi touches, or, when that box
@@ -144,6 +144,11 @@ class vertex_grid {
     const glm::dvec3 a = cell_of(lo), b = cell_of(hi);
     const double box = (b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1);
     const double steps = std::ceil(2.0 * double(glm::length(q - p)) / double(cell_)) + 1.0;
+    // An edge far longer than the cells (a huge triangle among small ones): every vertex, once.
+    if (!(std::min(box, 27.0 * (steps + 1.0)) <= double(count_))) {
+      for (std::size_t i = 0; i < count_; ++i) f(std::uint32_t(i));
+      return;
+    }
     if (box <= 27.0 * (steps + 1.0)) {
       for (double z = a.z; z <= b.z; ++z)
         for (double y = a.y; y <= b.y; ++y)
@@ -172,6 +177,7 @@ class vertex_grid {
       for (std::uint32_t v : it->second) f(v);
   }
   float cell_;
+  std::size_t count_;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
 };
 

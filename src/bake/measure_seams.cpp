@@ -142,6 +142,14 @@ double step_floor(const std::vector<const bake_result*>& pages) {
   return n > 0 ? 0.05 * sum / double(n) : 0.0;
 }
 
+// A (page) UV within lightmap_uv_tolerance of [0, 1], as the baker takes them: the seams' lengths
+// in texels, and so the sample counts, stay bounded by the page.
+void check_uv_range(const glm::vec2& uv, const std::string& name) {
+  for (int c = 0; c < 2; ++c)
+    if (!(uv[c] >= -lightmap_uv_tolerance && uv[c] <= 1.0f + lightmap_uv_tolerance))
+      throw_invalid_argument("measure_seams: " + name + (c == 0 ? ".u = " : ".v = ") + num(uv[c]) + " is outside [0, 1]");
+}
+
 // What the seam search reads: indices in range, positions, UVs and normals finite.
 void check_geometry(const scene_desc& d, const glm::vec3* normals) {
   if (!d.lightmap_uvs) throw_invalid_argument("measure_seams: the scene has no lightmap UVs (scene_desc::lightmap_uvs is null)");
@@ -158,6 +166,7 @@ void check_geometry(const scene_desc& d, const glm::vec3* normals) {
   for (std::size_t i = 0; i < d.vertex_count; ++i) {
     if (!finite(d.positions[i], 3)) throw_invalid_argument("measure_seams: positions[" + std::to_string(i) + "] is not finite");
     if (!finite(d.lightmap_uvs[i], 2)) throw_invalid_argument("measure_seams: lightmap_uvs[" + std::to_string(i) + "] is not finite");
+    check_uv_range(d.lightmap_uvs[i], "lightmap_uvs[" + std::to_string(i) + "]");
     if (normals && !finite(normals[i], 3)) throw_invalid_argument("measure_seams: normals[" + std::to_string(i) + "] is not finite");
   }
 }
@@ -216,7 +225,11 @@ seam_report measure_seams(const scene_bake_input& input, const scene_bake_result
         throw_invalid_argument("measure_seams: meshes[" + std::to_string(k) + "]: uv_scale or uv_offset is not finite");
     for (std::size_t t = next; t < next + mesh.triangle_count; ++t) {
       page_of[t] = mesh.page;
-      for (std::size_t c = 0; c < 3; ++c) uvs[3 * t + c] = d.lightmap_uvs[d.indices[3 * t + c]] * mesh.uv_scale + mesh.uv_offset;
+      for (std::size_t c = 0; c < 3; ++c) {
+        uvs[3 * t + c] = d.lightmap_uvs[d.indices[3 * t + c]] * mesh.uv_scale + mesh.uv_offset;
+        if (mesh.page >= 0)
+          check_uv_range(uvs[3 * t + c], "meshes[" + std::to_string(k) + "]: the page UV of vertex " + std::to_string(d.indices[3 * t + c]));
+      }
     }
     next += mesh.triangle_count;
   }
