@@ -229,7 +229,7 @@ TEST_CASE("Stitching removes the step along a seam and leaves the rest of the li
   CHECK(rms_relative(stitched.irradiance, raw.irradiance, raw.sampled) <= 0.005);
   // Against converged, texel by texel: stitching moves the texels beside the cut off their point
   // values (so that lookups on the cut agree), here 6 of the 24 sampled columns; the error grows
-  // by less than half (measured: 0.0049 -> 0.0060).
+  // by less than half (measured: 0.0050 -> 0.0061).
   CHECK(rms_relative(stitched.irradiance, reference.irradiance, raw.valid) <= 1.5 * bake_error);
 }
 
