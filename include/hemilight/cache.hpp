@@ -63,7 +63,8 @@ struct cache_record {
   /// The sample's irradiance_sample::backface_fraction (at most invalid_backface_fraction, or it
   /// would not be a record). A record whose value passes a tenth of invalid_backface_fraction
   /// stands at a contact or where surfaces intersect: its radius is limited to its sample's
-  /// min_distance (the nearest hit), so its reach a R never crosses the geometry it touches.
+  /// min_distance (the nearest hit), then raised to min_radius if below it; past clear_distance
+  /// only cache_run::segment_blocked keeps its reach from crossing the geometry it touches.
   float backface_fraction = 0.0f;
   /// The sample's irradiance_sample::min_distance (its hemicube's nearest hit; +inf if none): no
   /// geometry lies nearer in its visible half-space. Beyond it, with cache_run::segment_blocked,
