@@ -23,30 +23,7 @@ namespace {
 
 constexpr double pi = 3.14159265358979323846;
 
-// A mesh with explicit UVs: triangles given as (3D, UV) vertex triples.
-struct uv_mesh {
-  std::vector<glm::vec3> positions;
-  std::vector<glm::vec2> uvs;
-  std::vector<std::uint32_t> indices;
-  std::vector<material> materials;
-  void add(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec2 ua, glm::vec2 ub, glm::vec2 uc, material m = {}) {
-    const auto base = std::uint32_t(positions.size());
-    positions.insert(positions.end(), {a, b, c});
-    uvs.insert(uvs.end(), {ua, ub, uc});
-    indices.insert(indices.end(), {base, base + 1, base + 2});
-    materials.push_back(m);
-  }
-  bake_input input() const {
-    bake_input in;
-    in.scene.positions = positions.data();
-    in.scene.vertex_count = positions.size();
-    in.scene.indices = indices.data();
-    in.scene.triangle_count = indices.size() / 3;
-    in.scene.materials = materials.data();
-    in.scene.lightmap_uvs = uvs.data();
-    return in;
-  }
-};
+using test::uv_mesh;
 
 // The Cornell box with 32 x 32 chart UVs and small bake options (N = 16, 2 bounces): fast.
 struct small_cornell {

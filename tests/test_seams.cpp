@@ -7,6 +7,8 @@
 #include "hemilight/lights.hpp"
 #include "hemilight/seams.hpp"
 
+#include "test_support.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -17,37 +19,7 @@ using namespace hemilight;
 
 namespace {
 
-// A mesh with explicit UVs: triangles given as (3D, UV) vertex triples.
-struct uv_mesh {
-  std::vector<glm::vec3> positions;
-  std::vector<glm::vec2> uvs;
-  std::vector<std::uint32_t> indices;
-  std::vector<material> materials;
-  void add(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec2 ua, glm::vec2 ub, glm::vec2 uc, material m = {}) {
-    const auto base = std::uint32_t(positions.size());
-    positions.insert(positions.end(), {a, b, c});
-    uvs.insert(uvs.end(), {ua, ub, uc});
-    indices.insert(indices.end(), {base, base + 1, base + 2});
-    materials.push_back(m);
-  }
-  // The quad a, b, c, d (counter-clockwise from its front) with UVs ua..ud, as (a, b, c), (a, c, d).
-  void quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec2 ua, glm::vec2 ub, glm::vec2 uc, glm::vec2 ud,
-            material m = {}) {
-    add(a, b, c, ua, ub, uc, m);
-    add(a, c, d, ua, uc, ud, m);
-  }
-  bake_input input(glm::vec3 sky = glm::vec3(1.0f)) const {
-    bake_input in;
-    in.scene.positions = positions.data();
-    in.scene.vertex_count = positions.size();
-    in.scene.indices = indices.data();
-    in.scene.triangle_count = indices.size() / 3;
-    in.scene.materials = materials.data();
-    in.scene.lightmap_uvs = uvs.data();
-    in.scene.sky_radiance = sky;
-    return in;
-  }
-};
+using test::uv_mesh;
 
 constexpr int size = 32;
 
@@ -55,8 +27,10 @@ glm::vec2 uv(float x, float y) { return glm::vec2(x, y) / float(size); }
 
 // A floor (y = 0, facing +y) of two unit quads side by side, x in [0, 1] and [1, 2], z in [0, 1],
 // cut at x = 1 into two charts of a 32 x 32 lightmap: A at u in [2, 14] texels, B at u in
-// [17.3, 28.9] (texel centres of the two sides at other distances from the cut), v in [2, 30].
+// [17.3, 28.9] (texel centres of the two sides at other distances from the cut), v in [2, 30];
+// under a sky of 1.
 void two_chart_floor(uv_mesh& m, const material& mat = material{glm::vec3(0.0f), glm::vec3(0.5f), false}) {
+  m.sky = glm::vec3(1.0f);
   m.quad({0, 0, 1}, {1, 0, 1}, {1, 0, 0}, {0, 0, 0}, uv(2, 2), uv(14, 2), uv(14, 30), uv(2, 30), mat);
   m.quad({1, 0, 1}, {2, 0, 1}, {2, 0, 0}, {1, 0, 0}, uv(17.3f, 2), uv(28.9f, 2), uv(28.9f, 30), uv(17.3f, 30), mat);
 }
@@ -95,6 +69,27 @@ double rms_relative(const image& a, const image& ref, const std::vector<std::uin
     ++n;
   }
   return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+// The two-chart floor with a black wall across it at x = wall_x (1: on the cut).
+uv_mesh floor_and_wall(float wall_x) {
+  uv_mesh m;
+  two_chart_floor(m);
+  wall(m, wall_x);
+  return m;
+}
+
+// A bake with stitching off and one with it on, the rest as `o`.
+struct raw_and_stitched {
+  bake_result raw, stitched;
+};
+raw_and_stitched bake_both(const bake_input& in, bake_options o) {
+  raw_and_stitched r;
+  o.stitch_seams = false;
+  r.raw = bake_lightmap(in, o);
+  o.stitch_seams = true;
+  r.stitched = bake_lightmap(in, o);
+  return r;
 }
 
 bake_options small_options() {
@@ -161,11 +156,7 @@ TEST_CASE("find_seams: one chart has no seam; T-junctions, creases and walls are
     CHECK(s.crease.pieces == 1);
   }
   SECTION("a wall standing on the seam, and one beside it") {
-    uv_mesh on, beside;
-    two_chart_floor(on);
-    wall(on, 1.0f);
-    two_chart_floor(beside);
-    wall(beside, 1.2f);
+    const uv_mesh on = floor_and_wall(1.0f), beside = floor_and_wall(1.2f);
     const seam_report s_on = measure_seams(on.input(), r), s_beside = measure_seams(beside.input(), r);
     CHECK(s_on.walled.pieces == 1);
     CHECK(s_on.coplanar.pieces == 0);
@@ -177,15 +168,11 @@ TEST_CASE("find_seams: one chart has no seam; T-junctions, creases and walls are
 TEST_CASE("Stitching removes the step along a seam and leaves the rest of the lightmap as baked", "[seams][bake]") {
   // The two-chart floor with a black wall 0.6 beyond the cut: the irradiance falls towards the
   // wall, so the two sides' texel centres (at other distances from the cut) differ.
-  uv_mesh m;
-  two_chart_floor(m);
-  wall(m, 1.6f);
+  const uv_mesh m = floor_and_wall(1.6f);
   const bake_input in = m.input();
   bake_options o = small_options();
-  o.stitch_seams = false;
-  const bake_result raw = bake_lightmap(in, o);
-  o.stitch_seams = true;
-  const bake_result stitched = bake_lightmap(in, o);
+  const raw_and_stitched both = bake_both(in, o);
+  const bake_result &raw = both.raw, &stitched = both.stitched;
   // The converged reference: a hemicube at every texel, N = 256, unstitched.
   bake_options ro = small_options();
   ro.use_cache = false;
@@ -236,9 +223,7 @@ TEST_CASE("Stitching removes the step along a seam and leaves the rest of the li
 TEST_CASE("Stitching joins charts on different pages of a scene bake", "[seams][bake]") {
   // The two-chart floor as two meshes, A on page 0 and B on page 1 (each chart moved to u in
   // [2, 14] / [17.3, 28.9] of its own page), with the wall beside the cut.
-  uv_mesh m;
-  two_chart_floor(m);
-  wall(m, 1.6f);
+  const uv_mesh m = floor_and_wall(1.6f);
   scene_bake_input in;
   in.geometry = m.input();
   in.pages = {lightmap_page{}, lightmap_page{}};
@@ -262,9 +247,7 @@ TEST_CASE("Stitching joins charts on different pages of a scene bake", "[seams][
 TEST_CASE("Stitching covers the directional maps and the shadow mask", "[seams][bake]") {
   // A soft sun over the wall: the penumbra of the wall's top (x from about 0.93 to 1.17) and the
   // sky's gradient straddle the cut.
-  uv_mesh m;
-  two_chart_floor(m);
-  wall(m, 1.6f);
+  const uv_mesh m = floor_and_wall(1.6f);
   const bake_input in = m.input();
   bake_options o = small_options();
   o.output_sh_l1 = true;
@@ -276,10 +259,8 @@ TEST_CASE("Stitching covers the directional maps and the shadow mask", "[seams][
   sun.radius = 0.2f;
   o.lights = {sun};
   o.shadow_mask_lights = {0, -1, -1, -1};
-  o.stitch_seams = false;
-  const bake_result raw = bake_lightmap(in, o);
-  o.stitch_seams = true;
-  const bake_result stitched = bake_lightmap(in, o);
+  const raw_and_stitched both = bake_both(in, o);
+  const bake_result &raw = both.raw, &stitched = both.stitched;
   // Each map seen as an irradiance image (a scalar per texel in all three channels) and measured
   // along the seam: the step falls to a tenth or less.
   const auto as_rgb = [](const image& img, int channel) {
@@ -320,17 +301,16 @@ TEST_CASE("A hard shadow edge along a seam is kept, not blurred", "[seams][bake]
   two_chart_floor(m);
   const material black{glm::vec3(0.0f), glm::vec3(0.0f), true};
   m.quad({0, 0.5f, 0}, {1, 0.5f, 0}, {1, 0.5f, 1}, {0, 0.5f, 1}, uv(0, 0), uv(0, 0), uv(0, 0), uv(0, 0), black);
-  const bake_input in = m.input(glm::vec3(0.0f));
+  m.sky = glm::vec3(0.0f);
+  const bake_input in = m.input();
   bake_options o = small_options();
   light sun;
   sun.type = light_type::directional;
   sun.direction = glm::vec3(0.0f, -1.0f, 0.0f);
   sun.color = glm::vec3(2.0f);
   o.lights = {sun};
-  o.stitch_seams = false;
-  const bake_result raw = bake_lightmap(in, o);
-  o.stitch_seams = true;
-  const bake_result stitched = bake_lightmap(in, o);
+  const raw_and_stitched both = bake_both(in, o);
+  const bake_result &raw = both.raw, &stitched = both.stitched;
   CHECK(stitched.stats.seam_texels == 0);
   CHECK(std::memcmp(raw.irradiance.pixels.data(), stitched.irradiance.pixels.data(), raw.irradiance.pixels.size() * sizeof(float)) == 0);
   const seam_report s = measure_seams(in, stitched);
@@ -341,15 +321,11 @@ TEST_CASE("A hard shadow edge along a seam is kept, not blurred", "[seams][bake]
 TEST_CASE("A seam under a wall is not stitched", "[seams][bake]") {
   // The wall stands on the cut: its two sides see different halves of the sky, and stitching
   // them together would carry light under the wall (a leak).
-  uv_mesh m;
-  two_chart_floor(m);
-  wall(m, 1.0f);
+  const uv_mesh m = floor_and_wall(1.0f);
   const bake_input in = m.input();
   bake_options o = small_options();
-  o.stitch_seams = false;
-  const bake_result raw = bake_lightmap(in, o);
-  o.stitch_seams = true;
-  const bake_result stitched = bake_lightmap(in, o);
+  const raw_and_stitched both = bake_both(in, o);
+  const bake_result &raw = both.raw, &stitched = both.stitched;
   CHECK(stitched.stats.seam_texels == 0);
   CHECK(std::memcmp(raw.irradiance.pixels.data(), stitched.irradiance.pixels.data(), raw.irradiance.pixels.size() * sizeof(float)) == 0);
   CHECK(measure_seams(in, stitched).walled.pieces == 1);

@@ -1,11 +1,14 @@
 // Helpers shared by the Catch2 test files (not part of the library).
 #pragma once
 
+#include "hemilight/bake.hpp"
 #include "hemilight/error.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace hemilight::test {
 
@@ -24,5 +27,40 @@ void require_error(F&& f, status code, const std::string& needle) {
     CHECK(std::string(e.what()).find(needle) != std::string::npos);
   }
 }
+
+/// A mesh with explicit lightmap UVs: triangles given as (3D, UV) vertex triples, each with its
+/// own three vertices.
+struct uv_mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::uint32_t> indices;
+  std::vector<material> materials;
+  glm::vec3 sky{0.0f};  ///< the scene's sky radiance
+  void add(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec2 ua, glm::vec2 ub, glm::vec2 uc, material m = {}) {
+    const auto base = std::uint32_t(positions.size());
+    positions.insert(positions.end(), {a, b, c});
+    uvs.insert(uvs.end(), {ua, ub, uc});
+    indices.insert(indices.end(), {base, base + 1, base + 2});
+    materials.push_back(m);
+  }
+  /// The quad a, b, c, d (counter-clockwise from its front) with UVs ua..ud, as (a, b, c), (a, c, d).
+  void quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec2 ua, glm::vec2 ub, glm::vec2 uc, glm::vec2 ud,
+            material m = {}) {
+    add(a, b, c, ua, ub, uc, m);
+    add(a, c, d, ua, uc, ud, m);
+  }
+  /// A view of the arrays (valid while the mesh lives and is not modified).
+  bake_input input() const {
+    bake_input in;
+    in.scene.positions = positions.data();
+    in.scene.vertex_count = positions.size();
+    in.scene.indices = indices.data();
+    in.scene.triangle_count = indices.size() / 3;
+    in.scene.materials = materials.data();
+    in.scene.lightmap_uvs = uvs.data();
+    in.scene.sky_radiance = sky;
+    return in;
+  }
+};
 
 }  // namespace hemilight::test
