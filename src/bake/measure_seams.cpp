@@ -38,7 +38,6 @@ void check_result_page(const bake_result& r, const std::string& name) {
                            std::to_string(r.sampled.size()) + " texels");
 }
 
-double luminance(const float* p) { return 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]); }
 
 // A page as the metric reads it: its irradiance and which texels hold a valid sample.
 struct page_view {
@@ -52,12 +51,9 @@ bool lookup(const page_view& page, const glm::vec2& t, double& y) {
   const image& img = *page.irradiance;
   const page_rect r{0, 0, img.width, img.height};
   const footprint f = bilinear_footprint(r, std::size_t(img.width), t);
-  y = 0.0;
+  y = bilinear_luminance(f, [&](std::size_t k) { return img.pixels.data() + 3 * k; });
   bool seen = false;
-  for (std::size_t k = 0; k < 4; ++k) {
-    y += double(f.weight[k]) * luminance(img.pixels.data() + 3 * f.texel[k]);
-    seen = seen || (f.weight[k] > 0.0f && (*page.valid)[f.texel[k]]);
-  }
+  for (std::size_t k = 0; k < 4; ++k) seen = seen || (f.weight[k] > 0.0f && (*page.valid)[f.texel[k]]);
   return seen;
 }
 
@@ -136,7 +132,7 @@ double step_floor(const std::vector<const bake_result*>& pages) {
   for (const bake_result* r : pages)
     for (std::size_t k = 0; k < r->sampled.size(); ++k)
       if (r->sampled[k]) {
-        sum += luminance(r->irradiance.pixels.data() + 3 * k);
+        sum += rgb_luminance(r->irradiance.pixels.data() + 3 * k);
         ++n;
       }
   return n > 0 ? 0.05 * sum / double(n) : 0.0;

@@ -91,4 +91,17 @@ inline footprint bilinear_footprint(const page_rect& r, std::size_t grid_width, 
   return f;
 }
 
+// The luminance of an RGB triple (seams.hpp's Y: 0.2126 R + 0.7152 G + 0.0722 B), in double.
+inline double rgb_luminance(const float* rgb) {
+  return 0.2126 * double(rgb[0]) + 0.7152 * double(rgb[1]) + 0.0722 * double(rgb[2]);
+}
+
+// The luminance of a bilinear lookup through footprint f, texel k's RGB at rgb_of(k).
+template <class F>
+double bilinear_luminance(const footprint& f, F&& rgb_of) {
+  double y = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) y += double(f.weight[k]) * rgb_luminance(rgb_of(f.texel[k]));
+  return y;
+}
+
 }  // namespace hemilight::bake_detail

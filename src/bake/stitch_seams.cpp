@@ -195,14 +195,8 @@ std::vector<float> initial_values(const image& img, const std::vector<std::uint8
 // others sit on a discontinuity.
 std::vector<stitch_point> continuous_points(std::vector<stitch_point> points, const std::vector<std::size_t>& texels,
                                            const std::vector<float>& start) {
-  const auto luminance = [&](std::size_t k) {
-    const float* p = start.data() + 3 * std::size_t(column_of(texels, k));
-    return 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]);
-  };
   const auto lookup = [&](const footprint& f) {
-    double y = 0.0;
-    for (std::size_t k = 0; k < 4; ++k) y += double(f.weight[k]) * luminance(f.texel[k]);
-    return y;
+    return bilinear_luminance(f, [&](std::size_t k) { return start.data() + 3 * std::size_t(column_of(texels, k)); });
   };
   std::vector<stitch_point> kept;
   kept.reserve(points.size());
