@@ -8,7 +8,8 @@
 // Triangles: positions (vec3, scene units) and uint32 indices, three per triangle. The front face
 // winds counter-clockwise: its normal is (v1 - v0) x (v2 - v0). Per triangle a material: emitted
 // radiance (RGB, >= 0), albedo (RGB, kept for the bounce passes; the rasterizer does not use it)
-// and whether it is two-sided. A one-sided triangle seen from behind still occludes, but the
+// whether it is two-sided, and how it lets light through (opaque, alpha-tested with an optional
+// 8-bit alpha texture, or translucent with an RGB transmittance). A one-sided triangle seen from behind still occludes, but the
 // hemicube texel gets radiance 0 and the texel_back_face flag (hemicube.hpp).
 // Optionally per-vertex lightmap UVs: then a radiance texture passed to the render call
 // (raster.hpp) replaces the triangles' emission (it holds emission + albedo E / pi of a bounce).
@@ -36,11 +37,51 @@ struct derived_access;
 struct scene_access;  // the SIMD vertex arrays of the rasterizer and the ray fallback (src/scene/scene_access.hpp)
 }  // namespace detail
 
+/// How a triangle lets light through (material::opacity). docs/materials.md states the rules and
+/// measures their error and cost.
+enum class surface_opacity : std::uint8_t {
+  /// Blocks all light: the hemicubes see it, shadow rays stop at it (the default).
+  opaque = 0,
+  /// Alpha-tested (glTF alphaMode MASK): present where its alpha (material::alpha times the alpha
+  /// texture at the point, if it has one) is >= material::alpha_cutoff, absent elsewhere. Decided
+  /// per hemicube texel at the texel centre and per shadow ray at its hit point.
+  alpha_tested = 1,
+  /// Translucent (glTF BLEND, KHR_materials_transmission): lets material::transmittance of the light
+  /// behind it through (per channel) and adds what it sends itself (emission, or the bounce's
+  /// radiance texture, attenuated by the translucent layers in front of it). Never hides what is
+  /// behind it from a hemicube texel's depth, distance or flags; shadow rays multiply their
+  /// transmittances.
+  translucent = 2,
+};
+
 /// Per-triangle material: what the hemicube sees of a triangle and what a bounce needs.
 struct material {
   glm::vec3 emission{0.0f};  ///< emitted radiance (W m^-2 sr^-1 or any unit), each channel >= 0
   glm::vec3 albedo{0.0f};    ///< diffuse reflectance, each channel in [0, 1] (not used to render)
   bool two_sided = false;    ///< seen from behind, a two-sided triangle looks like its front
+  surface_opacity opacity = surface_opacity::opaque;  ///< opaque, alpha_tested or translucent
+  /// alpha_tested: the alpha factor in [0, 1], multiplied with the alpha texture's value (glTF
+  /// baseColorFactor's alpha). Ignored otherwise.
+  float alpha = 1.0f;
+  /// alpha_tested: present where alpha >= alpha_cutoff; in [0, 1] (glTF alphaCutoff, default 0.5).
+  float alpha_cutoff = 0.5f;
+  /// alpha_tested: index into scene_desc::alpha_textures, or -1: the alpha factor alone (the whole
+  /// triangle present or absent). With a texture the scene needs scene_desc::texcoords.
+  int alpha_texture = -1;
+  /// translucent: the fraction of the light passing through, per channel in [0, 1] (glTF: the
+  /// transmission factor times the base colour, or 1 - alpha for BLEND without it). Ignored
+  /// otherwise.
+  glm::vec3 transmittance{0.0f};
+};
+
+/// A single-channel 8-bit alpha texture (value / 255) for alpha-tested materials, sampled
+/// bilinearly at the triangle's texcoords with repeat wrapping (glTF's default sampler): texel
+/// (x, y) (x = column, y = row of `values`) has its centre at ((x + 0.5) / width,
+/// (y + 0.5) / height). The memory is the caller's; scene::create copies it.
+struct alpha_texture {
+  const std::uint8_t* values = nullptr;  ///< width * height values, row-major
+  int width = 0;                         ///< texels, in [1, 16384]
+  int height = 0;                        ///< texels, in [1, 16384]
 };
 
 /// Largest radiance (any channel, W m^-2 sr^-1) a scene, sky, environment map or light colour may
@@ -84,6 +125,17 @@ struct scene_desc {
   const material* materials = nullptr;     ///< triangle_count materials, or null: all black, one-sided
   const glm::vec2* lightmap_uvs = nullptr; ///< vertex_count lightmap UVs (finite), or null: none
   glm::vec3 sky_radiance{0.0f};            ///< radiance seen where nothing is hit, each channel >= 0
+  /// vertex_count material texture coordinates (finite; glTF TEXCOORD_0), where the alpha textures
+  /// are read; or null. Required when a material has an alpha_texture.
+  const glm::vec2* texcoords = nullptr;
+  const alpha_texture* alpha_textures = nullptr;  ///< alpha_texture_count textures, or null
+  std::size_t alpha_texture_count = 0;
+};
+
+/// An alpha texture that owns its values (scene_mesh::alpha_textures).
+struct alpha_image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> values;  ///< width * height, row-major
 };
 
 /// A mesh that owns its arrays, with helpers to build one; desc() views it as a scene_desc.
@@ -94,11 +146,15 @@ struct scene_mesh {
   std::vector<material> materials;       ///< one per triangle
   std::vector<glm::vec2> lightmap_uvs;   ///< empty, or one per vertex
   glm::vec3 sky_radiance{0.0f};
+  std::vector<glm::vec2> texcoords;      ///< empty, or one per vertex (alpha textures' coordinates)
+  std::vector<alpha_image> alpha_textures;
+  mutable std::vector<alpha_texture> alpha_views;  ///< desc()'s views of alpha_textures (set by desc())
 
   std::size_t triangle_count() const noexcept { return indices.size() / 3; }
 
-  /// A view of the arrays (valid while the mesh lives and is not modified).
-  scene_desc desc() const noexcept;
+  /// A view of the arrays (valid while the mesh lives and is not modified, and until the next
+  /// desc() call: the alpha textures' views are kept in the mesh).
+  scene_desc desc() const;
 
   /// Appends the triangle (a, b, c) with its own three vertices; front face counter-clockwise.
   void add_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const material& m);
@@ -132,7 +188,8 @@ struct bvh_node {
 /// radiance and a bounding-volume hierarchy, shared by every thread that renders hemicubes.
 class scene {
  public:
-  /// A drawable (non-degenerate) triangle as the rasterizer reads it, in BVH order.
+  /// A drawable (non-degenerate) triangle as the rasterizer reads it, in BVH order (opaque ones;
+  /// see_through_triangles(): the others, in scene_desc order).
   struct triangle {
     glm::vec3 v0, v1, v2;  ///< world positions, front face counter-clockwise
     std::uint32_t index;   ///< the triangle's number in the scene_desc
@@ -143,7 +200,11 @@ class scene {
   /// Errors (hemilight::error, the message names the argument and the index):
   ///   invalid_argument: a null array with a nonzero count; a NaN/Inf position or UV
   ///     ("positions[4].y is nan"); an index >= vertex_count ("indices[17] = 900 is out of range:
-  ///     12 vertices"); a negative or non-finite emission, albedo or sky radiance.
+  ///     12 vertices"); a negative or non-finite emission, albedo or sky radiance; an unknown
+  ///     opacity, an alpha, alpha_cutoff or transmittance outside [0, 1], an alpha_texture that is
+  ///     not -1 or an index into alpha_textures ("materials[3].alpha_texture = 2: 1 alpha
+  ///     texture"), a texture size outside [1, 16384] or null values, a texture used without
+  ///     texcoords, a NaN/Inf texcoord.
   ///   out_of_memory: more than max_scene_elements vertices or triangles, or an allocation failure.
   /// Degenerate triangles (is_degenerate_triangle: repeated indices, collinear or coincident
   /// positions, up to float rounding) are accepted and never drawn. Cost: O(T log^2 T) for T triangles; memory about 140 bytes per triangle. The
@@ -155,8 +216,22 @@ class scene {
   /// Number of triangles in the scene_desc (drawable or not).
   std::size_t triangle_count() const noexcept { return materials_.size(); }
   /// Number of non-degenerate triangles (is_degenerate_triangle: the ones the rasterizer draws and
-  /// rays hit).
-  std::size_t drawable_triangle_count() const noexcept { return triangles_.size(); }
+  /// rays hit), opaque or not.
+  std::size_t drawable_triangle_count() const noexcept { return triangles_.size() + see_through_.size(); }
+
+  /// The drawable triangles whose material is alpha_tested or translucent, in scene_desc order:
+  /// they are not in triangles() nor in the BVH. The rasterizer draws them after the opaque ones;
+  /// the ray queries test them apart (rays.hpp). An alpha-tested triangle whose alpha factor is
+  /// below its cutoff and that has no texture is left out (it is never present).
+  const std::vector<triangle>& see_through_triangles() const noexcept { return see_through_; }
+  /// True when alpha-tested triangle i (scene_desc numbering) is present at the point with
+  /// barycentric coordinates (b1, b2) (the point is v0 + b1 (v1 - v0) + b2 (v2 - v0)): its alpha
+  /// factor times its texture's bilinear value at the interpolated texcoord is >= its cutoff.
+  /// True for triangles that are not alpha-tested. Precondition: i < triangle_count(). Cost: O(1),
+  /// four texel reads.
+  bool alpha_present(std::size_t i, float b1, float b2) const noexcept;
+  /// The material texture coordinates (empty if the scene has none, or no material reads them).
+  const std::vector<glm::vec2>& texcoords() const noexcept { return texcoords_; }
 
   const std::vector<glm::vec3>& positions() const noexcept { return positions_; }
   const std::vector<std::uint32_t>& indices() const noexcept { return indices_; }
@@ -191,6 +266,7 @@ class scene {
  private:
   scene() = default;
   void index_emissions();
+  void copy_opacity(const scene_desc& desc);
   void build_bvh();
 
   std::vector<glm::vec3> positions_;
@@ -199,6 +275,9 @@ class scene {
   std::vector<glm::vec3> emissions_;            // distinct emissions (bitwise)
   std::vector<std::uint32_t> emission_index_;   // per triangle: its entry in emissions_
   std::vector<glm::vec2> uvs_;
+  std::vector<glm::vec2> texcoords_;
+  std::vector<alpha_image> alpha_textures_;
+  std::vector<triangle> see_through_;
   glm::vec3 sky_{0.0f};
   glm::vec3 lo_{0.0f}, hi_{0.0f};
   float size_ = 0.0f;

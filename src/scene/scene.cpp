@@ -35,7 +35,7 @@ bool is_degenerate_triangle(const glm::vec3& a, const glm::vec3& b, const glm::v
   return !(twice_area > degenerate_height_tolerance * longest * m) || !std::isfinite(twice_area + m);
 }
 
-scene_desc scene_mesh::desc() const noexcept {
+scene_desc scene_mesh::desc() const {
   scene_desc d;
   d.positions = positions.data();
   d.vertex_count = positions.size();
@@ -44,6 +44,11 @@ scene_desc scene_mesh::desc() const noexcept {
   d.materials = materials.data();
   d.lightmap_uvs = lightmap_uvs.empty() ? nullptr : lightmap_uvs.data();
   d.sky_radiance = sky_radiance;
+  d.texcoords = texcoords.empty() ? nullptr : texcoords.data();
+  alpha_views.clear();
+  for (const alpha_image& a : alpha_textures) alpha_views.push_back({a.values.data(), a.width, a.height});
+  d.alpha_textures = alpha_views.empty() ? nullptr : alpha_views.data();
+  d.alpha_texture_count = alpha_views.size();
   return d;
 }
 
@@ -151,6 +156,7 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     s->materials_.assign(desc.triangle_count, material{});
   }
   s->index_emissions();
+  s->copy_opacity(desc);
 
   s->triangles_.reserve(desc.triangle_count);
   for (std::size_t i = 0; i < desc.triangle_count; ++i) {
@@ -158,11 +164,103 @@ std::shared_ptr<const scene> scene::create(const scene_desc& desc) {
     const glm::vec3& b = s->positions_[s->indices_[3 * i + 1]];
     const glm::vec3& c = s->positions_[s->indices_[3 * i + 2]];
     if (is_degenerate_triangle(a, b, c)) continue;  // no area at float precision: never drawn
-    s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
+    const material& m = s->materials_[i];
+    if (m.opacity == surface_opacity::opaque)
+      s->triangles_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
+    else if (m.opacity == surface_opacity::translucent || m.alpha_texture >= 0 || m.alpha >= m.alpha_cutoff)
+      s->see_through_.push_back({a, b, c, static_cast<std::uint32_t>(i)});
   }
   s->build_bvh();
   for (auto& slot : s->derived_) slot = std::make_shared<detail::lazy_slot>();  // filled on first use (scene_access.hpp)
   return s;
+}
+
+void scene::copy_opacity(const scene_desc& desc) {
+  // Checks first: the textures, then each material's opacity fields.
+  if (desc.alpha_texture_count > 0 && !desc.alpha_textures)
+    throw_invalid_argument("scene::create: alpha_textures is null but alpha_texture_count is " +
+                           std::to_string(desc.alpha_texture_count));
+  for (std::size_t t = 0; t < desc.alpha_texture_count; ++t) {
+    const alpha_texture& a = desc.alpha_textures[t];
+    const std::string name = "scene::create: alpha_textures[" + std::to_string(t) + "]";
+    if (a.width < 1 || a.height < 1 || a.width > 16384 || a.height > 16384)
+      throw_invalid_argument(name + " size " + std::to_string(a.width) + " x " + std::to_string(a.height) +
+                             " is invalid; each side must be in [1, 16384]");
+    if (!a.values) throw_invalid_argument(name + ".values is null");
+  }
+  bool reads_texcoords = false;
+  for (std::size_t i = 0; i < materials_.size(); ++i) {
+    const material& m = materials_[i];
+    const std::string name = "scene::create: materials[" + std::to_string(i) + "]";
+    const auto unit = [&](const char* field, float v) {
+      if (!(v >= 0.0f && v <= 1.0f))
+        throw_invalid_argument(name + "." + field + " is " + std::to_string(v) + "; it must be in [0, 1]");
+    };
+    switch (m.opacity) {
+      case surface_opacity::opaque: break;
+      case surface_opacity::alpha_tested:
+        unit("alpha", m.alpha);
+        unit("alpha_cutoff", m.alpha_cutoff);
+        if (m.alpha_texture < -1 || (m.alpha_texture >= 0 && std::size_t(m.alpha_texture) >= desc.alpha_texture_count))
+          throw_invalid_argument(name + ".alpha_texture = " + std::to_string(m.alpha_texture) +
+                                 " is not -1 or an index into alpha_textures (" +
+                                 std::to_string(desc.alpha_texture_count) + " alpha textures)");
+        if (m.alpha_texture >= 0) reads_texcoords = true;
+        break;
+      case surface_opacity::translucent:
+        unit("transmittance.r", m.transmittance.x);
+        unit("transmittance.g", m.transmittance.y);
+        unit("transmittance.b", m.transmittance.z);
+        break;
+      default:
+        throw_invalid_argument(name + ".opacity is " + std::to_string(static_cast<int>(m.opacity)) +
+                               "; it must be opaque (0), alpha_tested (1) or translucent (2)");
+    }
+  }
+  if (!reads_texcoords) return;
+  if (!desc.texcoords)
+    throw_invalid_argument("scene::create: texcoords is null but a material reads an alpha texture");
+  texcoords_.assign(desc.texcoords, desc.texcoords + desc.vertex_count);
+  for (std::size_t i = 0; i < texcoords_.size(); ++i)
+    for (int c = 0; c < 2; ++c)
+      if (!std::isfinite(texcoords_[i][c]))
+        throw_invalid_argument("scene::create: texcoords[" + std::to_string(i) + "]." + "uv"[c] + " is " +
+                               std::to_string(texcoords_[i][c]) + "; texcoords must be finite");
+  alpha_textures_.resize(desc.alpha_texture_count);
+  for (std::size_t t = 0; t < desc.alpha_texture_count; ++t) {
+    const alpha_texture& a = desc.alpha_textures[t];
+    alpha_textures_[t].width = a.width;
+    alpha_textures_[t].height = a.height;
+    alpha_textures_[t].values.assign(a.values, a.values + std::size_t(a.width) * std::size_t(a.height));
+  }
+}
+
+bool scene::alpha_present(std::size_t i, float b1, float b2) const noexcept {
+  const material& m = materials_[i];
+  if (m.opacity != surface_opacity::alpha_tested) return true;
+  if (m.alpha_texture < 0) return m.alpha >= m.alpha_cutoff;
+  const std::uint32_t* v = indices_.data() + 3 * i;
+  const glm::vec2& t0 = texcoords_[v[0]];
+  const glm::vec2 uv = t0 + b1 * (texcoords_[v[1]] - t0) + b2 * (texcoords_[v[2]] - t0);
+  const alpha_image& a = alpha_textures_[static_cast<std::size_t>(m.alpha_texture)];
+  // Repeat wrap: continuous texel coordinates (centres at integers) reduced into [0, size).
+  const auto wrap = [](float x, int size) {
+    const double s = static_cast<double>(size);
+    double r = std::fmod(static_cast<double>(x) * s - 0.5, s);
+    if (!(r >= 0.0)) r = r < 0.0 ? r + s : 0.0;  // negative, or NaN: 0
+    return r >= s ? 0.0 : r;
+  };
+  const double px = wrap(uv.x, a.width), py = wrap(uv.y, a.height);
+  const int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
+  const int x1 = x0 + 1 == a.width ? 0 : x0 + 1, y1 = y0 + 1 == a.height ? 0 : y0 + 1;
+  const double fx = px - x0, fy = py - y0;
+  const auto at = [&](int x, int y) {
+    return static_cast<double>(a.values[static_cast<std::size_t>(y) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(x)]);
+  };
+  const double top = (1.0 - fx) * at(x0, y0) + fx * at(x1, y0);
+  const double bottom = (1.0 - fx) * at(x0, y1) + fx * at(x1, y1);
+  const double value = ((1.0 - fy) * top + fy * bottom) / 255.0;
+  return static_cast<double>(m.alpha) * value >= static_cast<double>(m.alpha_cutoff);
 }
 
 void scene::index_emissions() {
