@@ -110,6 +110,7 @@ struct scene_geometry {
   std::string clamped_warning;  // naming the first of them
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> page_uvs;
+  std::vector<glm::vec2> texcoords;  // the alpha textures' coordinates, per vertex (when the input has them)
   std::vector<std::uint32_t> indices;
   std::vector<int> triangle_page;  // per triangle: page, or -1 (occluder)
   std::vector<material> occluder_materials;
@@ -160,6 +161,7 @@ scene_geometry make_scene_geometry(const char* who, const scene_bake_input& in) 
   const auto add_vertex = [&](std::uint32_t v, const glm::vec2& page_uv) {
     g.positions.push_back(d.positions[v]);
     if (in.geometry.normals) g.normals.push_back(in.geometry.normals[v]);
+    if (d.texcoords) g.texcoords.push_back(d.texcoords[v]);
     g.page_uvs.push_back(page_uv);
     return std::uint32_t(g.positions.size() - 1);
   };
@@ -273,6 +275,7 @@ std::shared_ptr<const scene> combined_scene(const scene_desc& d, const scene_geo
   combined.vertex_count = g.positions.size();
   combined.indices = g.indices.data();
   combined.lightmap_uvs = uvs.data();
+  combined.texcoords = d.texcoords ? g.texcoords.data() : nullptr;
   return scene::create(combined);
 }
 
