@@ -147,8 +147,14 @@ struct light_sample {
   glm::vec3 unoccluded{0.0f};  ///< E without shadows, the closed form (RGB, W/m^2)
   /// Weighted fraction of the light that reaches the point (see the top of this header), in
   /// [0, 1]; 1 for lights that do not cast shadows; 0 where the light is entirely below the
-  /// horizon or behind a rect (unoccluded = 0: no ray is traced).
+  /// horizon or behind a rect (unoccluded = 0: no ray is traced). Through translucent surfaces
+  /// (scene.hpp's surface_opacity): the mean of visibility_rgb's channels.
   float visibility = 0.0f;
+  /// The visibility per channel: translucent surfaces on the shadow rays multiply their
+  /// transmittance in (rays.hpp's transmittance()); alpha-tested ones block where present. Equal
+  /// to visibility in every channel when no translucent surface is in the way. irradiance =
+  /// unoccluded x visibility_rgb.
+  glm::vec3 visibility_rgb{0.0f};
   /// Unit direction from the point towards the light: the direction of the vector irradiance
   /// (integral of L V w d omega) of its visible part above the horizon, for a directional map's
   /// L1 term. Hard lights: the direction to the light. Soft lights fully visible: the closed

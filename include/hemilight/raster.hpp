@@ -144,6 +144,9 @@ struct raster_statistics {
   std::size_t face_triangles_occluded = 0;  ///< occlusion culling: big (triangle, face) pairs found hidden before their spans
   std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
   std::size_t lod_nodes = 0;           ///< level of detail: nodes drawn from their proxies
+  std::size_t see_through_tested = 0;     ///< see-through (alpha-tested, translucent) triangles tested
+  std::size_t see_through_fragments = 0;  ///< texels tested for them (their boxes on each face)
+  std::size_t translucent_fragments = 0;  ///< translucent layers composited over the texels
 };
 
 namespace raster_detail {

@@ -10,8 +10,12 @@
 // hit, at the price of hits in the last 1e-6 of the segment. Zero or non-finite directions,
 // non-finite origins, NaN or non-positive t_max are answered "no hit" here, before Embree sees them.
 //
-// Every drawable triangle (non-zero area) is hit from either side: materials, one-sidedness and
-// emission play no part (lights are occluded by the back of a wall as by its front). Should an
+// Every drawable triangle (non-zero area) is hit from either side: one-sidedness and emission play
+// no part (lights are occluded by the back of a wall as by its front). See-through triangles
+// (scene.hpp's surface_opacity): an alpha-tested one is hit only where it is present
+// (scene::alpha_present at the hit point, decided by an Embree filter function); a translucent one
+// is a surface to occluded(), occluded_many() and intersect(), and multiplies its transmittance
+// into transmittance() (the shadow rays of lights.hpp). Should an
 // Embree built with backface culling be installed, the build fails (status unsupported) rather
 // than miss back faces.
 //
@@ -46,7 +50,9 @@ namespace hemilight {
 struct ray_hit {
   float distance = 0.0f;         ///< t of the hit (units of |direction|), in (0, t_max)
   std::uint32_t triangle = 0;    ///< the triangle's number in the scene_desc
-  std::uint32_t drawable = 0;    ///< its index in scene::triangles() (BVH order)
+  /// Its index in scene::triangles() (BVH order), or for a see-through triangle
+  /// scene::triangles().size() + its index in scene::see_through_triangles().
+  std::uint32_t drawable = 0;
   bool front_face = false;       ///< the ray arrives on the front side (direction . normal < 0)
 };
 
@@ -77,6 +83,16 @@ bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& directio
 /// (docs/lights.md). Thread-safe, no allocation.
 void occluded_many(const scene& s, const glm::vec3& origin, const glm::vec3* directions, const float* t_max,
                    std::size_t count, bool* out) noexcept;
+
+/// Transmittance query (shadow rays through see-through surfaces): per channel, the fraction of
+/// light that passes from origin to origin + t_max direction: 0 if an opaque triangle, or an
+/// alpha-tested one where present, is hit at 0 < t < t_max; otherwise the product of the
+/// transmittances of the translucent triangles hit (each once), (1, 1, 1) when nothing is. Inputs
+/// as occluded() (an invalid query gives (1, 1, 1)). Equals 1 - occluded() in every channel for a
+/// scene without see-through triangles. Cost: one traversal that does not stop at translucent hits
+/// (an Embree filter function multiplies them in; at most 16 distinct panes are remembered per ray,
+/// a pane hit again beyond that counts twice); thread-safe, no allocation.
+glm::vec3 transmittance(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
 
 /// Closest-hit query: the nearest drawable triangle hit at 0 < t < t_max, written to `hit`
 /// (untouched when there is none). Returns whether one was found. Triangles hit at exactly the

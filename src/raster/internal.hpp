@@ -203,6 +203,8 @@ class alignas(64) rasterizer_impl {
   void raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw, const frame& basis,
                    const scene::triangle& tri);
   std::uint32_t commit_record(float plane, const scene::triangle& tri, const draw_record* rec, const frame& basis);
+  // commit_record, out of line (commit_record is inlined into the set-up; see_through.cpp calls this).
+  std::uint32_t commit_draw(float plane, const scene::triangle& tri, const draw_record* rec, const frame& basis);
   template <mode M>
   void draw_fixed(int face, const std::int64_t (&px)[3], const std::int64_t (&py)[3], face_setup& fs,
                   draw_record& rec, std::uint32_t& draw, const frame& basis, const scene::triangle& tri,
@@ -301,6 +303,34 @@ class alignas(64) rasterizer_impl {
   // A logged tie holds its texel's final depth between fragments the buffer can tell apart (other
   // shades, or a textured render), or the log overflowed.
   bool ties_decide_order() const;
+  // See-through triangles (scene::see_through_triangles(); see_through.cpp): drawn after the
+  // opaque ones, alpha-tested into depth_ and ids_, translucent as fragments composited over the
+  // resolved buffer.
+  struct translucent_fragment {
+    std::uint32_t texel;
+    float z;             // 1/w at the texel centre
+    std::uint32_t draw;  // its entry in translucent_draws_
+  };
+  struct translucent_draw {
+    glm::vec3 v0, grad_b1, grad_b2;  // local frame, as draw_record's
+    std::uint32_t index;             // scene triangle
+    bool front;                      // seen from its front (or two-sided): sends its own radiance
+  };
+  struct kept_texel {
+    std::uint32_t texel;
+    float r, g, b, distance;
+    std::uint8_t flags;
+  };
+  void draw_see_through(const glm::vec3& position, const frame& basis);
+  void draw_see_through_triangle(const scene::triangle& tri, bool translucent, const glm::vec3& position, const frame& basis);
+  void keep_cutouts(const hemicube_buffer& out);
+  void restore_cutouts(hemicube_buffer& out) const;
+  void composite_translucent(hemicube_buffer& out, const radiance_texture* texture);
+  std::vector<translucent_fragment> translucent_;
+  std::vector<translucent_draw> translucent_draws_;
+  std::vector<std::uint32_t> cutouts_;  // texels an alpha-tested fragment won when drawn
+  std::vector<kept_texel> kept_cutouts_;
+
   // Level of detail (raster_options::lod_texels; lod.cpp): a node spanning under lod_texels_
   // texels is drawn from its proxy.
   bool lod_draw(const bvh_node& node, std::uint32_t node_index, unsigned mask, const glm::vec3& position, const frame& basis);

@@ -689,6 +689,11 @@ inline std::uint32_t raster_detail::rasterizer_impl::commit_record(float plane, 
   return key_bits_ ? draw << key_bits_ | key : draw;
 }
 
+std::uint32_t raster_detail::rasterizer_impl::commit_draw(float plane, const scene::triangle& tri, const draw_record* rec,
+                                                         const frame& basis) {
+  return commit_record(plane, tri, rec, basis);
+}
+
 template <rasterizer_impl::mode M>
 void raster_detail::rasterizer_impl::raster_face(int face, const glm::vec3 (&local)[3], draw_record& rec, std::uint32_t& draw,
                                       const frame& basis, const scene::triangle& tri) {
@@ -1139,6 +1144,8 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
   textured_ = texture && scene_->has_lightmap_uvs();
   if (edge_) edge_mark_hard(position, basis);
   draw_all<mode::depth>(position, basis);
+  const bool see_through = !scene_->see_through_triangles().empty();
+  if (see_through) draw_see_through(position, basis);
 
   // Resolve. Distance along the unit centre direction d = D / |D| (D = a + u c + v r): the hit
   // point is D / (1/w), so t = |D| / (1/w); a miss has 1/w = 0 and gets +inf. 1/w is the
@@ -1199,9 +1206,13 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
     }
   }
   if (edge_) {
+    // A texel an alpha-tested triangle wins keeps what its centre sees (no partial coverage).
+    if (see_through) keep_cutouts(out);
     edge_group_fragments();
     edge_blend(out, basis, textured_ ? texture : nullptr);
+    if (see_through) restore_cutouts(out);
   }
+  if (see_through) composite_translucent(out, textured_ ? texture : nullptr);
 }
 
 void raster_detail::rasterizer_impl::render_coverage(const glm::vec3& position, const frame& basis, int resolution,

@@ -177,12 +177,12 @@ struct probe {
   glm::vec3 d{0.0f};          // unit direction (for the mean direction)
   glm::vec3 ray{0.0f};        // shadow ray direction, when `trace`
   float t_max = 0.0f;
-  bool trace = false;         // visibility = !occluded(o, ray, t_max)
+  bool trace = false;         // visibility = transmittance(o, ray, t_max) (!occluded(...) without see-through triangles)
   bool visible = false;       // the visibility when not traced
 };
 
 struct visibility_result {
-  float visibility = 0.0f;
+  glm::vec3 visibility{0.0f};  // per channel: translucent surfaces tint it (transmittance())
   glm::vec3 direction{0.0f};  // sum of V * radiance weight * direction (not normalised)
   bool any_traced = false;
 };
@@ -200,22 +200,32 @@ constexpr outline cone_outline{{{1.0f - inset, 0.0625f}, {1.0f - inset, 0.1875f}
                                 {1.0f - inset, 0.4375f}, {1.0f - inset, 0.5625f}, {1.0f - inset, 0.6875f},
                                 {1.0f - inset, 0.8125f}, {1.0f - inset, 0.9375f}}};
 
+// The scalar visibility of a per-channel one: their mean (exactly the value when all agree).
+float mean_visibility(const glm::vec3& v) noexcept {
+  return v.x == v.y && v.y == v.z ? v.x : (v.x + v.y + v.z) / 3.0f;
+}
+
 template <class Sample>
 visibility_result estimate(const scene& sc, const glm::vec3& origin, const direct_options& o, std::uint64_t seed,
                            const outline& edge, Sample&& sample) {
   const auto s0 = static_cast<std::uint32_t>(seed), s1 = static_cast<std::uint32_t>(seed >> 32);
-  double sum_w = 0.0, sum_wv = 0.0;
+  double sum_w = 0.0;
+  glm::dvec3 sum_wv(0.0);
   glm::dvec3 dir(0.0);
-  int traced = 0, seen = 0;
+  int traced = 0;
+  bool uniform = true;  // every probe so far saw the same visibility
+  glm::vec3 first(0.0f);
   constexpr int chunk = 16;
   probe pr[chunk];
   glm::vec3 rays[chunk];
   float t_max[chunk];
   bool hit[chunk];
+  glm::vec3 through[chunk];
+  const bool see_through = !sc.see_through_triangles().empty();
   // Samples [first, last) of the sequence "outline points (0-7), then the (0, 2)-sequence": each
   // chunk's probes first, their shadow rays in one batch, then accumulated in order.
-  const auto run = [&](int first, int last) {
-    for (int base = first; base < last; base += chunk) {
+  const auto run = [&](int first_sample, int last) {
+    for (int base = first_sample; base < last; base += chunk) {
       const int n = std::min(chunk, last - base);
       int m = 0;
       for (int j = 0; j < n; ++j) {
@@ -228,20 +238,23 @@ visibility_result estimate(const scene& sc, const glm::vec3& origin, const direc
           ++m;
         }
       }
-      occluded_many(sc, origin, rays, t_max, static_cast<std::size_t>(m), hit);
+      if (see_through) {
+        for (int j = 0; j < m; ++j) through[j] = transmittance(sc, origin, rays[j], t_max[j]);
+      } else {
+        occluded_many(sc, origin, rays, t_max, static_cast<std::size_t>(m), hit);
+        for (int j = 0; j < m; ++j) through[j] = glm::vec3(hit[j] ? 0.0f : 1.0f);
+      }
       m = 0;
       for (int j = 0; j < n; ++j) {
         const probe& p = pr[j];
         if (!(p.w > 0.0f)) continue;
-        const bool visible = p.trace ? !hit[m++] : p.visible;
-        ++traced;
-        seen += visible ? 1 : 0;
+        const glm::vec3 v = p.trace ? through[m++] : glm::vec3(p.visible ? 1.0f : 0.0f);
+        if (traced++ == 0) first = v;
+        uniform = uniform && v == first;
         if (base + j < 8) continue;  // the outline decides only
         sum_w += double(p.w);
-        if (visible) {
-          sum_wv += double(p.w);
-          dir += double(p.rw) * glm::dvec3(p.d);
-        }
+        sum_wv += double(p.w) * glm::dvec3(v);
+        dir += double(p.rw) * double(mean_visibility(v)) * glm::dvec3(p.d);
       }
     }
   };
@@ -249,15 +262,16 @@ visibility_result estimate(const scene& sc, const glm::vec3& origin, const direc
   // edges) and the sequence's first probe_samples samples (kept).
   run(0, 8 + o.probe_samples);
   visibility_result r;
-  if (traced > 0 && (seen == 0 || seen == traced)) {
+  if (traced > 0 && uniform && (first == glm::vec3(0.0f) || first == glm::vec3(1.0f) || see_through)) {
+    // Every probe agrees (wholly lit, wholly shadowed, or behind the same panes): that is the answer.
     r.any_traced = true;
-    r.visibility = seen == 0 ? 0.0f : 1.0f;
+    r.visibility = first;
     r.direction = glm::vec3(dir);
     return r;
   }
   run(8 + o.probe_samples, 8 + o.penumbra_samples);
   r.any_traced = sum_w > 0.0;
-  r.visibility = r.any_traced ? static_cast<float>(sum_wv / sum_w) : 0.0f;
+  r.visibility = r.any_traced ? glm::vec3(sum_wv / sum_w) : glm::vec3(0.0f);
   r.direction = glm::vec3(dir);
   return r;
 }
@@ -278,12 +292,19 @@ float ray_offset(const scene& s, const glm::vec3& p, const direct_options& o) no
   return o.offset_scale * s.size() + 0x1p-18f * m;
 }
 
-// A shadow ray from o to the point q, stopping `off` short of q; true if it arrives.
-bool reaches(const scene& s, const glm::vec3& o, const glm::vec3& q, float off) noexcept {
+// What a shadow ray along d up to t_max lets through: 0 or 1, or per channel through translucent
+// surfaces (transmittance(); the plain any-hit query when the scene has no see-through triangle).
+glm::vec3 shadow_ray(const scene& s, const glm::vec3& o, const glm::vec3& d, float t_max) noexcept {
+  if (!s.see_through_triangles().empty()) return transmittance(s, o, d, t_max);
+  return glm::vec3(occluded(s, o, d, t_max) ? 0.0f : 1.0f);
+}
+
+// A shadow ray from o to the point q, stopping `off` short of q: what arrives (shadow_ray).
+glm::vec3 reaches(const scene& s, const glm::vec3& o, const glm::vec3& q, float off) noexcept {
   const glm::vec3 d = q - o;
   const float len = glm::length(d);
-  if (!(len > off)) return true;
-  return !occluded(s, o, d, 1.0f - off / len);
+  if (!(len > off)) return glm::vec3(1.0f);
+  return shadow_ray(s, o, d, 1.0f - off / len);
 }
 
 // The unoccluded closed form with the geometry the sampling needs.
@@ -474,12 +495,11 @@ visibility_result rect_visibility(const scene& s, const light_set::prepared& L, 
       }
     }
   });
-  closed_direction = v.visibility == 1.0f;
+  closed_direction = v.visibility == glm::vec3(1.0f);
   if (!v.any_traced) {  // a sliver above the horizon: one ray to the clipped polygon's centroid
     const glm::vec3 q = p + glm::vec3(g.rect.centroid);
-    const bool visible = !shadows || reaches(s, o, q, off);
-    v.visibility = visible ? 1.0f : 0.0f;
-    closed_direction = visible;
+    v.visibility = shadows ? reaches(s, o, q, off) : glm::vec3(1.0f);
+    closed_direction = v.visibility == glm::vec3(1.0f);
   }
   if (closed_direction) out.direction = glm::vec3(glm::normalize(g.rect.phi));
   return v;
@@ -499,7 +519,7 @@ visibility_result cone_visibility(const scene& s, const light_set::prepared& L, 
   const bool above = double(cos_axis) > 0.0 && double(cos_axis) * double(cos_axis) >= double(g.sin2a);
   if (g.inside) {
     // p inside a sphere light: no ray can leave the light; it is taken as visible.
-    v.visibility = 1.0f;
+    v.visibility = glm::vec3(1.0f);
     v.any_traced = true;
     out.direction = g.axis;
     closed_direction = true;
@@ -537,19 +557,19 @@ visibility_result cone_visibility(const scene& s, const light_set::prepared& L, 
         const float gamma = std::max(0.0f, theta - 0.999f * a);
         d = std::cos(gamma) * n + std::sin(gamma) * (across / len);
       }
-      bool visible = true;
+      glm::vec3 visible(1.0f);
       if (shadows) {
         if (sun) {
-          visible = !occluded(s, o, d, std::numeric_limits<float>::infinity());
+          visible = shadow_ray(s, o, d, std::numeric_limits<float>::infinity());
         } else {
           const float t = sphere_distance(o, d, L.l.position, r) - off;
-          visible = !(t > 0.0f) || !occluded(s, o, d, t);
+          if (t > 0.0f) visible = shadow_ray(s, o, d, t);
         }
       }
-      v.visibility = visible ? 1.0f : 0.0f;
-      v.direction = visible ? d : glm::vec3(0.0f);
+      v.visibility = visible;
+      v.direction = visible != glm::vec3(0.0f) ? d : glm::vec3(0.0f);
     }
-    closed_direction = above && v.visibility == 1.0f;
+    closed_direction = above && v.visibility == glm::vec3(1.0f);
     if (closed_direction) out.direction = g.axis;
   }
   return v;
@@ -571,16 +591,17 @@ light_sample direct_light_unchecked(const scene& s, const light_set& lights, std
   const glm::vec3 o = p + off * n;
   const bool hard = L.l.type != light_type::rect && L.l.radius == 0.0f;
   if (hard) {
-    bool visible = true;
+    glm::vec3 visible(1.0f);
     if (shadows) {
       if (L.l.type == light_type::directional)
-        visible = !occluded(s, o, g.axis, std::numeric_limits<float>::infinity());
+        visible = shadow_ray(s, o, g.axis, std::numeric_limits<float>::infinity());
       else
         visible = reaches(s, o, L.l.position, off);
     }
-    out.visibility = visible ? 1.0f : 0.0f;
-    out.irradiance = visible ? g.e : glm::vec3(0.0f);
-    out.direction = visible ? g.axis : glm::vec3(0.0f);
+    out.visibility_rgb = visible;
+    out.visibility = mean_visibility(visible);
+    out.irradiance = g.e * visible;
+    out.direction = out.irradiance != glm::vec3(0.0f) ? g.axis : glm::vec3(0.0f);
     return out;
   }
   const std::uint64_t seed = point_seed(p, n, i);
@@ -590,7 +611,8 @@ light_sample direct_light_unchecked(const scene& s, const light_set& lights, std
     v = rect_visibility(s, L, g, p, n, o, off, seed, options, out, closed_direction);
   else
     v = cone_visibility(s, L, g, n, o, off, seed, options, out, closed_direction);
-  out.visibility = v.visibility;
+  out.visibility_rgb = v.visibility;
+  out.visibility = mean_visibility(v.visibility);
   out.irradiance = g.e * v.visibility;
   if (!closed_direction) {
     const float len = glm::length(v.direction);

@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 
@@ -24,6 +26,25 @@ struct ray_accel;  // defined in rays.cpp
 bool occluded_bvh(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
 bool intersect_bvh(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
                    ray_hit& hit) noexcept;
+
+/// The see-through triangles' share of the fallback queries (see_through_rays.cpp): any present hit
+/// (alpha-tested where present, translucent always); the product of the translucent hits'
+/// transmittances, 0 at a present alpha-tested hit; the nearest present hit (hit.drawable =
+/// triangles().size() + its index in see_through_triangles()). Brute force over those triangles.
+bool see_through_occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
+glm::vec3 see_through_transmittance(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept;
+bool see_through_closest(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
+                         ray_hit& hit) noexcept;
+
+/// Whether translucent hits at t_a on triangle a and t_b on triangle b are one crossing of one
+/// surface (a ray through an edge that two of its triangles share): the same material, t within
+/// 1e-5 relative. transmittance() counts such a pair once.
+inline bool same_layer(const scene& s, std::uint32_t a, float t_a, std::uint32_t b, float t_b) noexcept {
+  const material& ma = s.triangle_material(a);
+  const material& mb = s.triangle_material(b);
+  return ma.transmittance == mb.transmittance && ma.emission == mb.emission &&
+         std::fabs(t_a - t_b) <= 1e-5f * std::max(std::fabs(t_a), std::fabs(t_b));
+}
 
 /// Whether the scene's queries go through Embree: builds the Embree scene first if it is not built
 /// yet (as a query would) and returns false if that failed (the queries then use the fallback).

@@ -147,6 +147,57 @@ void set_ray(RTCRay& r, const glm::vec3& o, const glm::vec3& d, float t_max) noe
   r.flags = 0;
 }
 
+// The context of every query: Embree hands it to the see-through geometry's filter functions
+// (the first member is Embree's own context, so a pointer to one is a pointer to the other).
+struct filter_context {
+  RTCIntersectContext base;
+  const scene* s = nullptr;
+  bool transmit = false;     // a transmittance query: translucent hits are multiplied in and passed
+  glm::vec3 through{1.0f};   // the product so far
+  static constexpr int max_seen = 16;
+  // The translucent layers already multiplied in: (primitive, t, triangle). Embree may report a
+  // primitive twice, and a ray through an edge two triangles of one pane share hits both.
+  struct layer {
+    std::uint32_t prim;
+    float t;
+    std::uint32_t triangle;
+  };
+  layer seen[max_seen];
+  int seen_count = 0;
+
+  filter_context(const scene& sc, bool transmittance) noexcept : s(&sc), transmit(transmittance) { rtcInitIntersectContext(&base); }
+  bool first_time(std::uint32_t prim, float t, std::uint32_t triangle) noexcept {
+    for (int k = 0; k < seen_count; ++k)
+      if (seen[k].prim == prim || same_layer(*s, seen[k].triangle, seen[k].t, triangle, t)) return false;
+    if (seen_count < max_seen) seen[seen_count++] = {prim, t, triangle};
+    return true;
+  }
+};
+
+// The filter function of the see-through geometry (1), for intersect and occluded queries: an
+// alpha-tested hit stands only where the triangle is present; a translucent hit stands (a surface),
+// except in a transmittance query, where it multiplies its transmittance in and is passed while
+// some light still gets through.
+void see_through_filter(const RTCFilterFunctionNArguments* args) {
+  auto* ctx = reinterpret_cast<filter_context*>(args->context);
+  const scene& s = *ctx->s;
+  const std::vector<scene::triangle>& tris = s.see_through_triangles();
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const std::uint32_t t = tris[prim].index;
+    const material& m = s.triangle_material(t);
+    if (m.opacity != surface_opacity::translucent) {
+      // Embree's (u, v) are the barycentrics of v1 and v2: scene::alpha_present's (b1, b2).
+      if (!s.alpha_present(t, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i))) args->valid[i] = 0;
+      continue;
+    }
+    if (!ctx->transmit) continue;
+    if (ctx->first_time(prim, RTCRayN_tfar(args->ray, args->N, i), t)) ctx->through *= m.transmittance;
+    if (ctx->through != glm::vec3(0.0f)) args->valid[i] = 0;
+  }
+}
+
 }  // namespace
 
 struct ray_accel {
@@ -164,10 +215,44 @@ struct ray_accel {
 
 namespace {
 
-// Builds a's Embree scene from s's drawable triangles (geometry 0, primitive i = triangles()[i]).
-// Never throws: a failure is kept in a (status, message) and the queries use the fallback.
+// Attaches `tris` (scene::triangle entries over s's vertices) to rtc as geometry `id`, primitive
+// i = tris[i]; with `filter`, the see-through filter function and the scene as its user data.
+// False when Embree could not allocate its buffers (its error code says why).
+bool attach_triangles(RTCDevice device, RTCScene rtc, const scene& s, const std::vector<scene::triangle>& tris, unsigned id,
+                      bool filter) {
+  const std::vector<glm::vec3>& positions = s.positions();
+  const std::vector<std::uint32_t>& indices = s.indices();
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  float* vb = g ? static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                              3 * sizeof(float), positions.size()))
+                : nullptr;
+  unsigned* ib = vb ? static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                    3 * sizeof(unsigned), tris.size()))
+                    : nullptr;
+  if (ib) {
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      vb[3 * i] = positions[i].x;
+      vb[3 * i + 1] = positions[i].y;
+      vb[3 * i + 2] = positions[i].z;
+    }
+    for (std::size_t i = 0; i < tris.size(); ++i)
+      for (std::size_t k = 0; k < 3; ++k) ib[3 * i + k] = indices[3 * std::size_t(tris[i].index) + k];
+    if (filter) {
+      rtcSetGeometryIntersectFilterFunction(g, see_through_filter);
+      rtcSetGeometryOccludedFilterFunction(g, see_through_filter);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(rtc, g, id);
+  }
+  if (g) rtcReleaseGeometry(g);
+  return ib != nullptr;
+}
+
+// Builds a's Embree scene from s's drawable triangles (geometry 0, primitive i = triangles()[i];
+// geometry 1, primitive j = see_through_triangles()[j]). Never throws: a failure is kept in a
+// (status, message) and the queries use the fallback.
 void build(const scene& s, ray_accel& a) noexcept {
-  if (s.triangles().empty()) return;  // nothing to hit: no Embree at all
+  if (s.drawable_triangle_count() == 0) return;  // nothing to hit: no Embree at all
   try {
     if (fail_builds.load()) {
       a.failure = status::out_of_memory;
@@ -178,6 +263,11 @@ void build(const scene& s, ray_accel& a) noexcept {
     if (!d.device) {
       a.failure = d.failure;
       a.message = "prepare_rays: " + d.message;
+      return;
+    }
+    if (!s.see_through_triangles().empty() && rtcGetDeviceProperty(d.device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0) {
+      a.failure = status::unsupported;
+      a.message = "prepare_rays: this Embree was built without filter functions, which see-through triangles need";
       return;
     }
     last_embree_message.clear();
@@ -192,31 +282,13 @@ void build(const scene& s, ray_accel& a) noexcept {
     }
     rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(rtc, build_quality);
-    const std::vector<scene::triangle>& tris = s.triangles();
-    const std::vector<glm::vec3>& positions = s.positions();
-    const std::vector<std::uint32_t>& indices = s.indices();
-    RTCGeometry g = rtcNewGeometry(d.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float* vb = g ? static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                3 * sizeof(float), positions.size()))
-                  : nullptr;
-    unsigned* ib = vb ? static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                      3 * sizeof(unsigned), tris.size()))
-                      : nullptr;
-    if (ib) {
-      for (std::size_t i = 0; i < positions.size(); ++i) {
-        vb[3 * i] = positions[i].x;
-        vb[3 * i + 1] = positions[i].y;
-        vb[3 * i + 2] = positions[i].z;
-      }
-      for (std::size_t i = 0; i < tris.size(); ++i)
-        for (std::size_t k = 0; k < 3; ++k) ib[3 * i + k] = indices[3 * std::size_t(tris[i].index) + k];
-      rtcCommitGeometry(g);
-      rtcAttachGeometryByID(rtc, g, 0);
-    }
-    if (g) rtcReleaseGeometry(g);
-    if (ib) rtcCommitScene(rtc);
+    // Geometry 0: the opaque triangles; geometry 1: the see-through ones, with the filter function.
+    const bool opaque_ok = s.triangles().empty() || attach_triangles(d.device, rtc, s, s.triangles(), 0, false);
+    const bool see_ok = opaque_ok && (s.see_through_triangles().empty() ||
+                                      attach_triangles(d.device, rtc, s, s.see_through_triangles(), 1, true));
+    if (see_ok) rtcCommitScene(rtc);
     e = rtcGetDeviceError(d.device);
-    if (!ib || e != RTC_ERROR_NONE) {
+    if (!see_ok || e != RTC_ERROR_NONE) {
       rtcReleaseScene(rtc);
       if (e == RTC_ERROR_NONE) e = RTC_ERROR_OUT_OF_MEMORY;
       a.failure = status_of(e);
@@ -268,18 +340,43 @@ void prepare_rays(const scene& s) {
     throw error(a->failure, a->message.empty() ? std::string("prepare_rays: out of memory") : a->message);
 }
 
+namespace detail {
+namespace {
+// The fallback's answers: the opaque BVH, then the see-through triangles.
+bool occluded_fallback(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
+  return occluded_bvh(s, origin, direction, t_max) || see_through_occluded(s, origin, direction, t_max);
+}
+}  // namespace
+}  // namespace detail
+
 bool occluded(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
-  if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
+  if (!detail::valid_query(origin, direction, t_max) || s.drawable_triangle_count() == 0) return false;
   const detail::ray_accel* a = detail::built(s);
   glm::vec3 d = direction;
   float t = t_max;
-  if (!a || !a->rtc || detail::fit_embree_range(origin, d, t) == 0.0f) return detail::occluded_bvh(s, origin, direction, t_max);
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  if (!a || !a->rtc || detail::fit_embree_range(origin, d, t) == 0.0f)
+    return detail::occluded_fallback(s, origin, direction, t_max);
+  detail::filter_context context(s, false);
   RTCRay r;
   detail::set_ray(r, origin, d, t);
-  rtcOccluded1(a->rtc, &context, &r);
+  rtcOccluded1(a->rtc, &context.base, &r);
   return r.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+glm::vec3 transmittance(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max) noexcept {
+  if (!detail::valid_query(origin, direction, t_max) || s.drawable_triangle_count() == 0) return glm::vec3(1.0f);
+  const detail::ray_accel* a = detail::built(s);
+  glm::vec3 d = direction;
+  float t = t_max;
+  if (!a || !a->rtc || detail::fit_embree_range(origin, d, t) == 0.0f) {
+    if (detail::occluded_bvh(s, origin, direction, t_max)) return glm::vec3(0.0f);
+    return detail::see_through_transmittance(s, origin, direction, t_max);
+  }
+  detail::filter_context context(s, true);
+  RTCRay r;
+  detail::set_ray(r, origin, d, t);
+  rtcOccluded1(a->rtc, &context.base, &r);
+  return r.tfar < 0.0f ? glm::vec3(0.0f) : context.through;
 }
 
 namespace {
@@ -287,7 +384,7 @@ namespace {
 // One Embree packet of up to N rays from `origin` (N = 4 or 8: RTCRay4 / RTCRay8), lanes past
 // `count` and invalid rays inactive (valid mask 0, answered false without tracing).
 template <std::size_t N, class Packet>
-void occluded_packet(const scene& s, RTCScene rtc, RTCIntersectContext& context, const glm::vec3& origin,
+void occluded_packet(const scene& s, RTCScene rtc, RTCIntersectContext* context, const glm::vec3& origin,
                      const glm::vec3* directions, const float* t_max, std::size_t count, bool* out) noexcept {
   alignas(32) int valid[N];
   Packet r;
@@ -324,12 +421,12 @@ void occluded_packet(const scene& s, RTCScene rtc, RTCIntersectContext& context,
   }
   if (live > 0) {
     if constexpr (N == 8)
-      rtcOccluded8(valid, rtc, &context, &r);
+      rtcOccluded8(valid, rtc, context, &r);
     else
-      rtcOccluded4(valid, rtc, &context, &r);
+      rtcOccluded4(valid, rtc, context, &r);
   }
   for (std::size_t j = 0; j < count; ++j)
-    out[j] = outside[j] ? detail::occluded_bvh(s, origin, directions[j], t_max[j])
+    out[j] = outside[j] ? detail::occluded_fallback(s, origin, directions[j], t_max[j])
                         : valid[j] != 0 && r.tfar[j] < 0.0f;  // tfar = -inf on a hit
 }
 
@@ -338,7 +435,7 @@ void occluded_packet(const scene& s, RTCScene rtc, RTCIntersectContext& context,
 void occluded_many(const scene& s, const glm::vec3& origin, const glm::vec3* directions, const float* t_max,
                    std::size_t count, bool* out) noexcept {
   if (count == 0) return;
-  if (s.triangles().empty() || !detail::finite3(origin)) {
+  if (s.drawable_triangle_count() == 0 || !detail::finite3(origin)) {
     for (std::size_t i = 0; i < count; ++i) out[i] = false;
     return;
   }
@@ -346,41 +443,43 @@ void occluded_many(const scene& s, const glm::vec3& origin, const glm::vec3* dir
   if (!a || !a->rtc) {
     for (std::size_t i = 0; i < count; ++i)
       out[i] = detail::valid_query(origin, directions[i], t_max[i]) &&
-               detail::occluded_bvh(s, origin, directions[i], t_max[i]);
+               detail::occluded_fallback(s, origin, directions[i], t_max[i]);
     return;
   }
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  detail::filter_context context(s, false);
   for (std::size_t base = 0; base < count; base += 8) {
     const std::size_t n = std::min<std::size_t>(8, count - base);
     if (n <= 4)
-      occluded_packet<4, RTCRay4>(s, a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+      occluded_packet<4, RTCRay4>(s, a->rtc, &context.base, origin, directions + base, t_max + base, n, out + base);
     else
-      occluded_packet<8, RTCRay8>(s, a->rtc, context, origin, directions + base, t_max + base, n, out + base);
+      occluded_packet<8, RTCRay8>(s, a->rtc, &context.base, origin, directions + base, t_max + base, n, out + base);
   }
 }
 
 bool intersect(const scene& s, const glm::vec3& origin, const glm::vec3& direction, float t_max,
                ray_hit& hit) noexcept {
-  if (!detail::valid_query(origin, direction, t_max) || s.triangles().empty()) return false;
+  if (!detail::valid_query(origin, direction, t_max) || s.drawable_triangle_count() == 0) return false;
   const detail::ray_accel* a = detail::built(s);
   glm::vec3 d = direction;
   float t = t_max;
   const float back = a && a->rtc ? detail::fit_embree_range(origin, d, t) : 0.0f;
-  if (back == 0.0f) return detail::intersect_bvh(s, origin, direction, t_max, hit);
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  if (back == 0.0f) {
+    const bool opaque = detail::intersect_bvh(s, origin, direction, t_max, hit);
+    return detail::see_through_closest(s, origin, direction, opaque ? hit.distance : t_max, hit) || opaque;
+  }
+  detail::filter_context context(s, false);
   RTCRayHit rh;
   detail::set_ray(rh.ray, origin, d, t);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(a->rtc, &context, &rh);
+  rtcIntersect1(a->rtc, &context.base, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   const std::uint32_t i = rh.hit.primID;
+  const bool see_through = rh.hit.geomID == 1;
   hit.distance = back == 1.0f ? rh.ray.tfar : rh.ray.tfar * back;  // in units of the caller's direction
-  hit.drawable = i;
-  hit.triangle = s.triangles()[i].index;
+  hit.drawable = see_through ? static_cast<std::uint32_t>(s.triangles().size()) + i : i;
+  hit.triangle = see_through ? s.see_through_triangles()[i].index : s.triangles()[i].index;
   // Embree's Ng is (v1 - v0) x (v2 - v0) up to scale: our front normal.
   hit.front_face = rh.hit.Ng_x * direction.x + rh.hit.Ng_y * direction.y + rh.hit.Ng_z * direction.z < 0.0f;
   return true;

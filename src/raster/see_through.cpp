@@ -1,0 +1,221 @@
+// See-through triangles in a hemicube (raster.hpp, "See-through surfaces"): the alpha-tested and
+// translucent triangles of scene::see_through_triangles(), drawn after the opaque ones by a
+// per-texel ray test of their own, as a chain of steps:
+//   draw_see_through   -> each triangle's faces and texel boxes (see_through_faces)
+//                      -> per texel: inside (watertight triple products), depth (the opaque
+//                         paths' plane formula), near plane, depth test, alpha test
+//                      -> alpha-tested: depth and id written like an opaque fragment;
+//                         translucent: a fragment kept for the composite;
+//   keep_cutouts / restore_cutouts (exact edge coverage: a texel an alpha-tested triangle wins
+//                         keeps what its centre sees);
+//   composite_translucent -> per texel, the translucent layers in front of what it sees, far to
+//                         near: L = transmittance L + the layer's own radiance.
+// The depth and the texel ids are the opaque paths' (internal.hpp), so the resolve, the UV pass
+// and seen_triangle() treat an alpha-tested fragment as any other.
+#include "internal.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
+namespace hemilight {
+
+using namespace raster_detail;
+
+namespace {
+
+// det(a, b, d) = (a x b) . d in double, for the edge a -> b, computed from the edge's endpoints in
+// a canonical order (lexicographic) and negated when reversed: two triangles sharing the edge get
+// exactly opposite values for every direction, the base of the watertight inside test.
+inline double edge_side(const glm::vec3& a, const glm::vec3& b, const glm::dvec3& d, bool& canonical) noexcept {
+  const auto less = [](const glm::vec3& p, const glm::vec3& q) {
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    return p.z < q.z;
+  };
+  canonical = !less(b, a);
+  const glm::dvec3 p(canonical ? a : b), q(canonical ? b : a);
+  const double s = glm::dot(glm::cross(p, q), d);
+  return canonical ? s : -s;
+}
+
+// Whether the ray from the origin along d passes through triangle l (local frame, either side).
+// A ray exactly on an edge belongs to the triangle that runs along the edge in its canonical
+// direction: of two triangles sharing an edge (the same winding seen from the point), exactly one.
+inline bool ray_inside(const glm::vec3 (&l)[3], const glm::dvec3& d) noexcept {
+  bool pos = false, neg = false;
+  for (int k = 0; k < 3; ++k) {
+    bool canonical;
+    const double s = edge_side(l[k], l[(k + 1) % 3], d, canonical);
+    if (s > 0.0 || (s == 0.0 && canonical)) pos = true;
+    if (s < 0.0 || (s == 0.0 && !canonical)) neg = true;
+  }
+  return pos != neg;
+}
+
+// The texels of face `face` (columns x0..x1, rows y0..y1) whose centre rays may meet the triangle
+// with local vertices l: its projection's box where all three lie in front of the near plane,
+// the whole face otherwise. False when the triangle cannot reach the face.
+bool see_through_box(int face, const glm::vec3 (&l)[3], int n, double step, double first, float near, int& x0, int& x1,
+                     int& y0, int& y1) noexcept {
+  const int rows = face == 0 ? n : n / 2;
+  const clip_vertex c[3] = {to_clip(face, l[0]), to_clip(face, l[1]), to_clip(face, l[2])};
+  // Wholly behind the near plane, or wholly beyond one side of the face's frustum.
+  const auto all = [&](auto outside) { return outside(c[0]) && outside(c[1]) && outside(c[2]); };
+  if (all([&](const clip_vertex& v) { return v.w < near; })) return false;
+  if (all([](const clip_vertex& v) { return v.u > v.w; }) || all([](const clip_vertex& v) { return v.u < -v.w; }) ||
+      all([](const clip_vertex& v) { return v.v > v.w; }) ||
+      all([&](const clip_vertex& v) { return face == 0 ? v.v < -v.w : v.v < 0.0f; }))
+    return false;
+  x0 = 0, x1 = n - 1, y0 = 0, y1 = rows - 1;
+  if (!(c[0].w >= near && c[1].w >= near && c[2].w >= near)) return true;
+  double umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
+  for (const clip_vertex& v : c) {
+    const double u = double(v.u) / double(v.w), w = double(v.v) / double(v.w);
+    umin = std::min(umin, u), umax = std::max(umax, u), vmin = std::min(vmin, w), vmax = std::max(vmax, w);
+  }
+  // Texel centres: u = first + x step; v = first + y step (top) or (y + 1/2) step (sides). One
+  // texel of margin covers the rounding of the projection.
+  const double v_first = face == 0 ? first : 0.5 * step;
+  const auto lo = [&](double a, double f, int count) {
+    return static_cast<int>(std::max(0.0, std::min(double(count - 1), std::floor((a - f) / step) - 1.0)));
+  };
+  const auto hi = [&](double a, double f, int count) {
+    return static_cast<int>(std::max(0.0, std::min(double(count - 1), std::ceil((a - f) / step) + 1.0)));
+  };
+  if (umax < first - step || vmax < v_first - step || umin > 1.0 + step || vmin > 1.0 + step) return false;
+  x0 = lo(umin, first, n), x1 = hi(umax, first, n);
+  y0 = lo(vmin, v_first, rows), y1 = hi(vmax, v_first, rows);
+  return true;
+}
+
+}  // namespace
+
+void raster_detail::rasterizer_impl::draw_see_through(const glm::vec3& position, const frame& basis) {
+  translucent_.clear();
+  translucent_draws_.clear();
+  cutouts_.clear();
+  const std::vector<scene::triangle>& tris = scene_->see_through_triangles();
+  // Alpha-tested triangles first: the translucent ones are tested against the final depths.
+  for (int pass = 0; pass < 2; ++pass)
+    for (const scene::triangle& tri : tris) {
+      const bool translucent = scene_->triangle_material(tri.index).opacity == surface_opacity::translucent;
+      if (translucent != (pass == 1)) continue;
+      draw_see_through_triangle(tri, translucent, position, basis);
+    }
+}
+
+void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::triangle& tri, bool translucent,
+                                                               const glm::vec3& position, const frame& basis) {
+  ++stats_.see_through_tested;
+  const glm::vec3 local[3] = {basis.to_local(tri.v0 - position), basis.to_local(tri.v1 - position),
+                              basis.to_local(tri.v2 - position)};
+  // The record as draw_triangle makes it: the same plane, so the same depths as an opaque
+  // triangle in that plane.
+  draw_record rec;
+  rec.normal = basis.to_local(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+  rec.v0 = local[0];
+  rec.plane = glm::dot(rec.normal, rec.v0);
+  if (!(rec.plane != 0.0f) || !std::isfinite(rec.plane)) return;  // seen edge-on
+  rec.index = tri.index;
+  const float nn = glm::dot(rec.normal, rec.normal);
+  const glm::vec3 le1 = local[1] - local[0], le2 = local[2] - local[0];
+  // Barycentrics of a local point q: b1 = grad_b1 . (q - v0), b2 = grad_b2 . (q - v0) (the UV pass's).
+  const glm::vec3 grad_b1 = glm::cross(le2, rec.normal) / nn, grad_b2 = glm::cross(rec.normal, le1) / nn;
+  const bool back = rec.plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
+  const float far_limit = 1.0f / near_;  // 1/w of the near plane
+  std::uint32_t draw = 0;
+  for (int f = 0; f < 5; ++f) {
+    int x0, x1, y0, y1;
+    if (!see_through_box(f, local, n_, texel_step_, first_centre_, near_, x0, x1, y0, y1)) continue;
+    if (edge_) draw = 0;  // one draw per (triangle, face), as the opaque paths number them
+    face_setup fs;
+    fs.prepare(f, texel_step_, first_centre_, rec);
+    const std::size_t offset = hemicube_face_offset(n_, static_cast<hemicube_face>(f));
+    for (int y = y0; y <= y1; ++y) {
+      const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * y);
+      for (int x = x0; x <= x1; ++x) {
+        const std::size_t i = offset + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_) + static_cast<std::size_t>(x);
+        ++stats_.see_through_fragments;
+        const float z = zrow + fs.dzdx * static_cast<float>(x);
+        // In front of the point, behind the near plane's distance, nearer than what is there
+        // (an opaque fragment at the same depth wins).
+        if (!(z > 0.0f && z <= far_limit && z > depth_[i])) continue;
+        const glm::vec3& d = directions_[i];
+        if (!ray_inside(local, glm::dvec3(d))) continue;
+        const glm::vec3 q = (lengths_[i] / z) * d - rec.v0;
+        if (translucent) {
+          if (translucent_draws_.empty() || translucent_draws_.back().index != tri.index)
+            translucent_draws_.push_back({rec.v0, grad_b1, grad_b2, tri.index, !back});
+          translucent_.push_back({static_cast<std::uint32_t>(i), z, static_cast<std::uint32_t>(translucent_draws_.size() - 1)});
+          continue;
+        }
+        if (!scene_->alpha_present(tri.index, glm::dot(grad_b1, q), glm::dot(grad_b2, q))) continue;
+        if (draw == 0) draw = commit_draw(rec.plane, tri, &rec, basis);
+        depth_[i] = z;
+        ids_[i] = draw;
+        cutouts_.push_back(static_cast<std::uint32_t>(i));
+      }
+    }
+  }
+}
+
+void raster_detail::rasterizer_impl::keep_cutouts(const hemicube_buffer& out) {
+  // The texels an alpha-tested fragment still holds after every draw, with what the resolve gave them.
+  kept_cutouts_.clear();
+  const std::size_t count = out.texel_count();
+  std::sort(cutouts_.begin(), cutouts_.end());
+  cutouts_.erase(std::unique(cutouts_.begin(), cutouts_.end()), cutouts_.end());
+  for (const std::uint32_t i : cutouts_) {
+    const std::uint32_t draw = ids_[i] >> key_bits_;
+    const std::uint32_t tri = draw_triangles_[draw];
+    if (tri == no_triangle || scene_->triangle_material(tri).opacity != surface_opacity::alpha_tested) continue;
+    kept_cutouts_.push_back({i, out.radiance[i], out.radiance[count + i], out.radiance[2 * count + i], out.distance[i], out.flags[i]});
+  }
+}
+
+void raster_detail::rasterizer_impl::restore_cutouts(hemicube_buffer& out) const {
+  const std::size_t count = out.texel_count();
+  for (const kept_texel& k : kept_cutouts_) {
+    out.radiance[k.texel] = k.r;
+    out.radiance[count + k.texel] = k.g;
+    out.radiance[2 * count + k.texel] = k.b;
+    out.distance[k.texel] = k.distance;
+    out.flags[k.texel] = k.flags;
+  }
+}
+
+void raster_detail::rasterizer_impl::composite_translucent(hemicube_buffer& out, const radiance_texture* texture) {
+  if (translucent_.empty()) return;
+  stats_.translucent_fragments = translucent_.size();
+  // Per texel, far to near (1/w ascending); equal depths in drawing order, the later drawn nearer.
+  std::sort(translucent_.begin(), translucent_.end(), [](const translucent_fragment& a, const translucent_fragment& b) {
+    if (a.texel != b.texel) return a.texel < b.texel;
+    if (a.z != b.z) return a.z < b.z;
+    return a.draw < b.draw;
+  });
+  const std::size_t count = out.texel_count();
+  const bool textured = texture && scene_->has_lightmap_uvs();
+  const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
+  const std::vector<std::uint32_t>& indices = scene_->indices();
+  for (const translucent_fragment& f : translucent_) {
+    const translucent_draw& rec = translucent_draws_[f.draw];
+    const material& m = scene_->triangle_material(rec.index);
+    glm::vec3 own(0.0f);
+    if (rec.front) {
+      if (textured) {
+        const glm::vec3 q = (lengths_[f.texel] / f.z) * directions_[f.texel] - rec.v0;
+        const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
+        const std::uint32_t* v = indices.data() + 3 * static_cast<std::size_t>(rec.index);
+        const glm::vec2& uv0 = uvs[v[0]];
+        own = texture->sample(uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0));
+      } else {
+        own = m.emission;
+      }
+    }
+    float* l[3] = {&out.radiance[f.texel], &out.radiance[count + f.texel], &out.radiance[2 * count + f.texel]};
+    for (int c = 0; c < 3; ++c) *l[c] = m.transmittance[c] * *l[c] + own[c];
+  }
+}
+
+}  // namespace hemilight
