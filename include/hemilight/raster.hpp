@@ -16,6 +16,15 @@
 //     perspective-correct lightmap UV (texel_hit_front); one-sided triangles seen from behind
 //     occlude with radiance 0 (texel_back_face); texels that see nothing give the sky (+inf,
 //     texel_miss). Only the z >= 0 half of the side faces is drawn.
+//   - See-through triangles (scene::see_through_triangles(); docs/materials.md) are drawn after
+//     the opaque ones by a per-texel ray test (watertight: a texel centre on an edge two of them
+//     share belongs to one): an alpha-tested one covers a texel where it is nearer and present at
+//     the centre (scene::alpha_present; also with edge_coverage, no partial coverage), and loses a
+//     depth tie to an opaque one; translucent ones never set depth, distance or flags: per texel
+//     the layers in front of what it sees are composited far to near, L = transmittance L + the
+//     layer's own radiance (emission, or the texture at its lightmap UV; 0 seen from behind a
+//     one-sided one). Neither takes part in occlusion culling or level of detail, nor in
+//     render_coverage's counts.
 //   - Near plane: everything within `near` of the point along a face's axis is invisible (default
 //     1e-4 of the scene's diagonal). A point on a surface does not see that surface.
 //   - Deterministic: every buffer is bitwise the same on every code path (scalar, SSE2, AVX2,
