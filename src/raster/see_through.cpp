@@ -24,34 +24,43 @@ using namespace raster_detail;
 
 namespace {
 
-// det(a, b, d) = (a x b) . d in double, for the edge a -> b, computed from the edge's endpoints in
-// a canonical order (lexicographic) and negated when reversed: two triangles sharing the edge get
-// exactly opposite values for every direction, the base of the watertight inside test.
-inline double edge_side(const glm::vec3& a, const glm::vec3& b, const glm::dvec3& d, bool& canonical) noexcept {
-  const auto less = [](const glm::vec3& p, const glm::vec3& q) {
-    if (p.x != q.x) return p.x < q.x;
-    if (p.y != q.y) return p.y < q.y;
-    return p.z < q.z;
-  };
-  canonical = !less(b, a);
-  const glm::dvec3 p(canonical ? a : b), q(canonical ? b : a);
-  const double s = glm::dot(glm::cross(p, q), d);
-  return canonical ? s : -s;
-}
+// The edges of a triangle for the inside test: per edge a -> b, the normal a x b of the plane
+// through the point and the edge, in double, computed from the endpoints in a canonical order
+// (lexicographic) and negated when reversed. Two triangles sharing an edge get exactly opposite
+// normals, so (a x b) . d has exactly opposite values for every direction d: the base of the
+// watertight inside test.
+struct edge_planes {
+  glm::dvec3 normal[3];
+  bool canonical[3];
 
-// Whether the ray from the origin along d passes through triangle l (local frame, either side).
-// A ray exactly on an edge belongs to the triangle that runs along the edge in its canonical
-// direction: of two triangles sharing an edge (the same winding seen from the point), exactly one.
-inline bool ray_inside(const glm::vec3 (&l)[3], const glm::dvec3& d) noexcept {
-  bool pos = false, neg = false;
-  for (int k = 0; k < 3; ++k) {
-    bool canonical;
-    const double s = edge_side(l[k], l[(k + 1) % 3], d, canonical);
-    if (s > 0.0 || (s == 0.0 && canonical)) pos = true;
-    if (s < 0.0 || (s == 0.0 && !canonical)) neg = true;
+  explicit edge_planes(const glm::vec3 (&l)[3]) noexcept {
+    const auto less = [](const glm::vec3& p, const glm::vec3& q) {
+      if (p.x != q.x) return p.x < q.x;
+      if (p.y != q.y) return p.y < q.y;
+      return p.z < q.z;
+    };
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& a = l[k];
+      const glm::vec3& b = l[(k + 1) % 3];
+      canonical[k] = !less(b, a);
+      const glm::dvec3 c = glm::cross(glm::dvec3(canonical[k] ? a : b), glm::dvec3(canonical[k] ? b : a));
+      normal[k] = canonical[k] ? c : -c;
+    }
   }
-  return pos != neg;
-}
+
+  // Whether the ray from the point along d passes through the triangle (either side). A ray
+  // exactly on an edge belongs to the triangle that runs along the edge in its canonical
+  // direction: of two triangles sharing an edge (the same winding seen from the point), one.
+  bool inside(const glm::dvec3& d) const noexcept {
+    bool pos = false, neg = false;
+    for (int k = 0; k < 3; ++k) {
+      const double s = glm::dot(normal[k], d);
+      if (s > 0.0 || (s == 0.0 && canonical[k])) pos = true;
+      if (s < 0.0 || (s == 0.0 && !canonical[k])) neg = true;
+    }
+    return pos != neg;
+  }
+};
 
 // The texels of face `face` (columns x0..x1, rows y0..y1) whose centre rays may meet the triangle
 // with local vertices l: its projection's box where all three lie in front of the near plane,
@@ -124,6 +133,7 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
   const glm::vec3 grad_b1 = glm::cross(le2, rec.normal) / nn, grad_b2 = glm::cross(rec.normal, le1) / nn;
   const bool back = rec.plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
   const float far_limit = 1.0f / near_;  // 1/w of the near plane
+  const edge_planes edges(local);
   std::uint32_t draw = 0;
   for (int f = 0; f < 5; ++f) {
     int x0, x1, y0, y1;
@@ -142,7 +152,7 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
         // (an opaque fragment at the same depth wins).
         if (!(z > 0.0f && z <= far_limit && z > depth_[i])) continue;
         const glm::vec3& d = directions_[i];
-        if (!ray_inside(local, glm::dvec3(d))) continue;
+        if (!edges.inside(glm::dvec3(d))) continue;
         const glm::vec3 q = (lengths_[i] / z) * d - rec.v0;
         if (translucent) {
           if (translucent_draws_.empty() || translucent_draws_.back().index != tri.index)
