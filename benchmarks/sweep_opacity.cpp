@@ -168,7 +168,10 @@ int main(int argc, char** argv) {
       std::size_t card = 0, total = 0;
       for (const glm::vec3& p : points) {
         r.render(p, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, resolution, buf);
-        for (std::size_t t = 0; t < buf.texel_count(); ++t) card += r.seen_triangle(t) != hemicube_rasterizer::no_triangle && r.seen_triangle(t) >= 800 ? 1 : 0;
+        for (std::size_t t = 0; t < buf.texel_count(); ++t) {
+          const std::uint32_t seen = r.seen_triangle(t);
+          if (seen != hemicube_rasterizer::no_triangle && seen >= 800u) ++card;
+        }
         total += buf.texel_count();
       }
       share[m] = double(card) / double(total);

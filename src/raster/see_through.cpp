@@ -27,8 +27,10 @@ namespace {
 // The edges of a triangle for the inside test: per edge a -> b, the normal a x b of the plane
 // through the point and the edge, in double, computed from the endpoints in a canonical order
 // (lexicographic) and negated when reversed. Two triangles sharing an edge get exactly opposite
-// normals, so (a x b) . d has exactly opposite values for every direction d: the base of the
-// watertight inside test.
+// normals; on a face, n . D for the texel centre D = a + u c + v r (the face's axes, components
+// 0 or +-1) is A + v C + u B with A, B, C exact components of n, evaluated row by row in the same
+// operations for every triangle: exactly opposite values for the two, the base of the watertight
+// inside test.
 struct edge_planes {
   glm::dvec3 normal[3];
   bool canonical[3];
@@ -47,18 +49,58 @@ struct edge_planes {
       normal[k] = canonical[k] ? c : -c;
     }
   }
+};
 
-  // Whether the ray from the point along d passes through the triangle (either side). A ray
-  // exactly on an edge belongs to the triangle that runs along the edge in its canonical
-  // direction: of two triangles sharing an edge (the same winding seen from the point), one.
-  bool inside(const glm::dvec3& d) const noexcept {
+// The edge functions of one face: s_k(u, v) = a[k] + v c[k] + u b[k] (n_k . D, see above).
+struct face_edges {
+  double a[3], b[3], c[3];
+  bool canonical[3];
+  face_edges(int face, const edge_planes& e) noexcept {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3& n = e.normal[k];
+      // to_clip's permutation and signs: (c . n, r . n, a . n).
+      switch (face) {
+        case 0: b[k] = n.x, c[k] = n.y, a[k] = n.z; break;
+        case 1: b[k] = n.y, c[k] = n.z, a[k] = n.x; break;
+        case 2: b[k] = -n.y, c[k] = n.z, a[k] = -n.x; break;
+        case 3: b[k] = -n.x, c[k] = n.z, a[k] = n.y; break;
+        default: b[k] = n.x, c[k] = n.z, a[k] = -n.y; break;
+      }
+      canonical[k] = e.canonical[k];
+    }
+  }
+  // Whether the centre ray passes through the triangle (either side), from the row's values
+  // row[k] = a[k] + v c[k]. A ray exactly on an edge belongs to the triangle that runs along the
+  // edge in its canonical direction: of two triangles sharing an edge (the same winding seen from
+  // the point), exactly one.
+  bool inside(const double (&row)[3], double u) const noexcept {
     bool pos = false, neg = false;
     for (int k = 0; k < 3; ++k) {
-      const double s = glm::dot(normal[k], d);
+      const double s = row[k] + u * b[k];
       if (s > 0.0 || (s == 0.0 && canonical[k])) pos = true;
       if (s < 0.0 || (s == 0.0 && !canonical[k])) neg = true;
     }
     return pos != neg;
+  }
+  // The columns [x0, x1] of a row that may pass the test with the sign `sign` (the triangle's
+  // orientation seen from the point: the sign of its plane offset), widened by a column for the
+  // rounding of the bounds; false when none can.
+  bool span(const double (&row)[3], double sign, double first, double step, int& x0, int& x1) const noexcept {
+    double lo = -1e300, hi = 1e300;
+    for (int k = 0; k < 3; ++k) {
+      const double sb = sign * b[k], sr = sign * row[k];
+      if (sb > 0.0) lo = std::max(lo, -sr / sb);
+      else if (sb < 0.0) hi = std::min(hi, -sr / sb);
+      else if (sr < 0.0) return false;  // the whole row is outside this edge
+    }
+    if (lo > hi) {  // empty, or a single point within the rounding of the bounds
+      if (lo - hi > 1e-9 * (std::fabs(lo) + std::fabs(hi))) return false;
+      hi = lo;
+    }
+    const double c0 = std::floor((lo - first) / step) - 1.0, c1 = std::ceil((hi - first) / step) + 1.0;
+    x0 = static_cast<int>(std::max(c0, double(x0)));
+    x1 = static_cast<int>(std::min(c1, double(x1)));
+    return x0 <= x1;
   }
 };
 
@@ -134,6 +176,10 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
   const bool back = rec.plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
   const float far_limit = 1.0f / near_;  // 1/w of the near plane
   const edge_planes edges(local);
+  // The triangle's orientation seen from the point (det(v0, v1, v2): the sign of every edge
+  // function on the rays that meet it in front).
+  const double orientation = glm::dot(glm::dvec3(local[0]), glm::cross(glm::dvec3(local[1]), glm::dvec3(local[2])));
+  if (!(orientation != 0.0)) return;
   std::uint32_t draw = 0;
   for (int f = 0; f < 5; ++f) {
     int x0, x1, y0, y1;
@@ -142,17 +188,24 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
     face_setup fs;
     fs.prepare(f, texel_step_, first_centre_, rec);
     const std::size_t offset = hemicube_face_offset(n_, static_cast<hemicube_face>(f));
+    const face_edges fe(f, edges);
+    const double sign = orientation > 0.0 ? 1.0 : -1.0;
+    const double v_first = f == 0 ? first_centre_ : 0.5 * texel_step_;
     for (int y = y0; y <= y1; ++y) {
+      const double v = v_first + texel_step_ * y;
+      const double row[3] = {fe.a[0] + v * fe.c[0], fe.a[1] + v * fe.c[1], fe.a[2] + v * fe.c[2]};
+      int xa = x0, xb = x1;
+      if (!fe.span(row, sign, first_centre_, texel_step_, xa, xb)) continue;
       const auto zrow = static_cast<float>(fs.z00 + fs.dzdy * y);
-      for (int x = x0; x <= x1; ++x) {
+      for (int x = xa; x <= xb; ++x) {
         const std::size_t i = offset + static_cast<std::size_t>(y) * static_cast<std::size_t>(n_) + static_cast<std::size_t>(x);
         ++stats_.see_through_fragments;
         const float z = zrow + fs.dzdx * static_cast<float>(x);
         // In front of the point, behind the near plane's distance, nearer than what is there
-        // (an opaque fragment at the same depth wins).
+        // (an opaque fragment at the same depth wins), and the centre ray inside.
         if (!(z > 0.0f && z <= far_limit && z > depth_[i])) continue;
+        if (!fe.inside(row, first_centre_ + texel_step_ * x)) continue;
         const glm::vec3& d = directions_[i];
-        if (!edges.inside(glm::dvec3(d))) continue;
         const glm::vec3 q = (lengths_[i] / z) * d - rec.v0;
         if (translucent) {
           if (translucent_draws_.empty() || translucent_draws_.back().index != tri.index)

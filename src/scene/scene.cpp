@@ -245,10 +245,10 @@ bool scene::alpha_present(std::size_t i, float b1, float b2) const noexcept {
   const alpha_image& a = alpha_textures_[static_cast<std::size_t>(m.alpha_texture)];
   // Repeat wrap: continuous texel coordinates (centres at integers) reduced into [0, size).
   const auto wrap = [](float x, int size) {
-    const double s = static_cast<double>(size);
-    double r = std::fmod(static_cast<double>(x) * s - 0.5, s);
-    if (!(r >= 0.0)) r = r < 0.0 ? r + s : 0.0;  // negative, or NaN: 0
-    return r >= s ? 0.0 : r;
+    const double s = static_cast<double>(size), c = static_cast<double>(x) * s - 0.5;
+    double r = c - s * std::floor(c / s);
+    if (!(r >= 0.0 && r < s)) r = 0.0;  // rounding at the top end, or NaN
+    return r;
   };
   const double px = wrap(uv.x, a.width), py = wrap(uv.y, a.height);
   const int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
