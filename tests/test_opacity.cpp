@@ -215,6 +215,33 @@ TEST_CASE("opacity: see-through renders are bitwise the same on every path and w
   }
 }
 
+TEST_CASE("opacity: with exact edge coverage a texel an alpha-tested card wins keeps what its centre sees", "[opacity]") {
+  const auto s = scene::create(checker_scene().desc());
+  raster_options edge;
+  edge.edge_coverage = true;
+  hemicube_rasterizer point_sampled(s), covered(s, edge);
+  hemicube_buffer a, b;
+  point_sampled.render({0.05f, -0.03f, 0.0f}, up, 64, a);
+  covered.render({0.05f, -0.03f, 0.0f}, up, 64, b);
+  std::size_t card = 0, blended = 0;
+  const auto cutout = [&](std::uint32_t t) {
+    return t != hemicube_rasterizer::no_triangle && s->triangle_material(t).opacity == surface_opacity::alpha_tested;
+  };
+  for (std::size_t i = 0; i < a.texel_count(); ++i) {
+    const bool on_card = cutout(point_sampled.seen_triangle(i));
+    CHECK(on_card == cutout(covered.seen_triangle(i)));
+    if (on_card) {
+      ++card;
+      CHECK(b.radiance_at(i) == a.radiance_at(i));
+      CHECK(b.distance[i] == a.distance[i]);
+    } else if (b.radiance_at(i) != a.radiance_at(i)) {
+      ++blended;  // the ceiling's own edges (and the card's geometric edges) may be blended
+    }
+  }
+  CHECK(card > 100);
+  CHECK(blended < a.texel_count() / 10);
+}
+
 TEST_CASE("opacity: an always-present alpha-tested box renders bitwise as the opaque box (watertight)", "[opacity]") {
   // A closed room of 6 x 6 grids around the point: the see-through pass must cover every texel
   // centre exactly where the opaque paths do (the same planes, so the same depths).
