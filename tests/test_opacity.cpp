@@ -194,6 +194,11 @@ TEST_CASE("opacity: see-through renders are bitwise the same on every path and w
   pane.transmittance = glm::vec3(0.5f, 0.25f, 1.0f);
   pane.emission = glm::vec3(0.1f, 0.0f, 0.0f);
   add_card(mesh, 0.6f, 0.5f, pane);
+  // An opaque wall at x = 0.5 hides part of the card and the pane from points at x < 0.5.
+  material wall;
+  wall.emission = glm::vec3(0.3f);
+  mesh.add_grid({0.5f, -3, 0.1f}, {0.5f, 3, 0.1f}, {0.5f, 3, 3}, {0.5f, -3, 3}, 4, 4, wall);
+  mesh.texcoords.resize(mesh.positions.size());
   const auto s = scene::create(mesh.desc());
   const glm::vec3 p(0.3f, -0.2f, 0.0f);
   const frame tilted = make_frame(glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f)));
@@ -209,8 +214,10 @@ TEST_CASE("opacity: see-through renders are bitwise the same on every path and w
       if (variant == 1) o.diagnostics.avx2 = false;
       if (variant == 2) o.diagnostics.occlusion_culling = false;
       hemicube_buffer got;
-      hemicube_rasterizer(s, o).render(p, f, 64, got);
+      hemicube_rasterizer r(s, o);
+      r.render(p, f, 64, got);
       CHECK(same_buffer(want, got));
+      if (variant == 0 && f.n.z == 1.0f) CHECK(r.statistics().see_through_occluded > 0);
     }
   }
 }

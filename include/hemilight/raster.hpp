@@ -23,8 +23,8 @@
 //     depth tie to an opaque one; translucent ones never set depth, distance or flags: per texel
 //     the layers in front of what it sees are composited far to near, L = transmittance L + the
 //     layer's own radiance (emission, or the texture at its lightmap UV; 0 seen from behind a
-//     one-sided one). Neither takes part in occlusion culling or level of detail, nor in
-//     render_coverage's counts.
+//     one-sided one). They occlude nothing in the occlusion culling (they are tested against it),
+//     have no level of detail, and render_coverage does not count them.
 //   - Near plane: everything within `near` of the point along a face's axis is invisible (default
 //     1e-4 of the scene's diagonal). A point on a surface does not see that surface.
 //   - Deterministic: every buffer is bitwise the same on every code path (scalar, SSE2, AVX2,
@@ -154,7 +154,8 @@ struct raster_statistics {
   std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
   std::size_t lod_nodes = 0;           ///< level of detail: nodes drawn from their proxies
   std::size_t see_through_tested = 0;     ///< see-through (alpha-tested, translucent) triangles tested
-  std::size_t see_through_fragments = 0;  ///< texels tested for them (their boxes on each face)
+  std::size_t see_through_fragments = 0;  ///< texels tested for them (their rows' spans on each face)
+  std::size_t see_through_occluded = 0;   ///< occlusion culling: (see-through triangle, face) pairs found hidden
   std::size_t translucent_fragments = 0;  ///< translucent layers composited over the texels
 };
 

@@ -294,6 +294,7 @@ class alignas(64) rasterizer_impl {
   bool triangle_hidden(int face, const clip_vertex (&c)[3]);  // a triangle before clipping
   bool texel_rect(int face, float u0, float u1, float v0, float v1, int& x0, int& x1, int& y0, int& y1) const;
   bool culling_ = false;  // a traversal with occlusion tests is drawing (draw_fixed tests big triangles too)
+  bool tiles_ready_ = false;  // this render's tiles hold (a lower bound of) the opaque depths: see-through triangles are tested too
   template <mode M>
   void traverse(const glm::vec3& position, const frame& basis, bool cull);
   void traverse_front_to_back(const glm::vec3& position, const frame& basis);

@@ -385,6 +385,7 @@ void raster_detail::rasterizer_impl::prepare(int resolution) {
   stats_ = {};
   ties_.clear();
   ties_.limit = 2 * count;
+  tiles_ready_ = false;
   tie_sink_ = nullptr;  // set by draw_all while occlusion culling draws front to back
   if (edge_) edge_prepare(count, resolution);
 }
@@ -472,6 +473,7 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     // that order, culled against the depths found (final: a node behind them neither wins nor
     // ties). Either way the buffer is the one the unculled reference order gives, bit for bit.
     occlusion_prepare();
+    tiles_ready_ = true;
     tie_sink_ = &ties_;
     culling_ = true;
     traverse_front_to_back(position, basis);

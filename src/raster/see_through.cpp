@@ -184,6 +184,15 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
   for (int f = 0; f < 5; ++f) {
     int x0, x1, y0, y1;
     if (!see_through_box(f, local, n_, texel_step_, first_centre_, near_, x0, x1, y0, y1)) continue;
+    // Hidden on this face behind what is drawn (the occlusion culling's tiles, when it ran): a
+    // conservative test, so no texel changes.
+    if (tiles_ready_) {
+      const clip_vertex c[3] = {to_clip(f, local[0]), to_clip(f, local[1]), to_clip(f, local[2])};
+      if (triangle_hidden(f, c)) {
+        ++stats_.see_through_occluded;
+        continue;
+      }
+    }
     if (edge_) draw = 0;  // one draw per (triangle, face), as the opaque paths number them
     face_setup fs;
     fs.prepare(f, texel_step_, first_centre_, rec);
