@@ -18,7 +18,7 @@ namespace hemilight::capi {
 
 namespace {
 
-// The shortest decimal form that reads back as v ("1.5", "1.00000012", "nan"): a value just
+// The shortest decimal form that reads back as v ("1.5", "1.0000001", "nan"): a value just
 // outside a range is shown as such, not rounded onto its bound.
 std::string shortest(float v) {
   char text[32];
