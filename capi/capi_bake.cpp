@@ -213,6 +213,10 @@ struct gathered_scene {
   std::vector<std::uint32_t> indices;
   std::vector<hemilight::material> materials;
   bool any_normals = false;
+  // Scene bakes with see-through triangles (add_opacity): the texcoords of every vertex (when a
+  // triangle reads an alpha texture) and the views of the caller's alpha textures.
+  std::vector<glm::vec2> texcoords;
+  std::vector<hemilight::alpha_texture> alpha_textures;
 };
 
 hemilight_status gather_meshes(const char* fn, const hemilight_bake_mesh* meshes, size_t mesh_count,
@@ -264,6 +268,9 @@ hemilight::bake_input input_of(const gathered_scene& g, const hemilight_bake_opt
   in.scene.materials = g.materials.data();
   in.scene.lightmap_uvs = g.uvs.data();
   in.scene.sky_radiance = glm::vec3(o.sky_radiance[0], o.sky_radiance[1], o.sky_radiance[2]);
+  in.scene.texcoords = g.texcoords.empty() ? nullptr : g.texcoords.data();
+  in.scene.alpha_textures = g.alpha_textures.empty() ? nullptr : g.alpha_textures.data();
+  in.scene.alpha_texture_count = g.alpha_textures.size();
   in.normals = g.any_normals ? g.normals.data() : nullptr;
   return in;
 }
@@ -485,6 +492,61 @@ hemilight_status placement_targets(const char* fn, const hemilight_bake_scene_de
   return HEMILIGHT_OK;
 }
 
+// The scene's opacities (scene->mesh_opacity, scene->alpha_textures), checked in the caller's
+// terms before anything is allocated for them; reads_texture: some triangle reads an alpha
+// texture. With more vertices or triangles than a scene holds nothing is read here (gather_meshes
+// refuses them next).
+hemilight_status check_opacity(const char* fn, const hemilight_bake_scene_desc& sd, bool& reads_texture) {
+  reads_texture = false;
+  if (std::string p = hemilight::capi::alpha_textures_problem(sd.alpha_textures, sd.alpha_texture_count, "scene->alpha_textures");
+      !p.empty())
+    return invalid(fn, p);
+  if (!sd.mesh_opacity) return HEMILIGHT_OK;
+  size_t total_vertices = 0, total_triangles = 0;
+  for (size_t m = 0; m < sd.mesh_count; ++m) {
+    total_vertices += sd.meshes[m].vertex_count;
+    total_triangles += sd.meshes[m].triangle_count;
+    if (total_vertices > hemilight::max_scene_elements || total_triangles > hemilight::max_scene_elements) return HEMILIGHT_OK;
+  }
+  for (size_t m = 0; m < sd.mesh_count; ++m) {
+    const hemilight_mesh_opacity& mo = sd.mesh_opacity[m];
+    const std::string name = "scene->mesh_opacity[" + std::to_string(m) + "]";
+    if (std::string p = hemilight::capi::texcoords_problem(mo.texcoords, sd.meshes[m].vertex_count, name + ".texcoords"); !p.empty())
+      return invalid(fn, p);
+    const auto check = [&](const hemilight_opacity& o, const std::string& field) {
+      reads_texture = reads_texture || (o.mode == HEMILIGHT_ALPHA_TESTED && o.alpha_texture >= 0);
+      return hemilight::capi::opacity_problem(o, name + field, sd.alpha_texture_count, "scene->alpha_textures",
+                                              mo.texcoords != nullptr, name + ".texcoords");
+    };
+    if (!mo.opacities) {
+      if (std::string p = check(mo.opacity, ".opacity"); !p.empty()) return invalid(fn, p);
+      continue;
+    }
+    for (size_t t = 0; t < sd.meshes[m].triangle_count; ++t)
+      if (std::string p = check(mo.opacities[t], ".opacities[" + std::to_string(t) + "]"); !p.empty()) return invalid(fn, p);
+  }
+  return HEMILIGHT_OK;
+}
+
+// The checked opacities onto the gathered triangles' materials, with the texcoords of every
+// vertex (zero for meshes without: none of their triangles reads a texture) when a triangle reads
+// a texture, and the textures' views.
+void add_opacity(const hemilight_bake_scene_desc& sd, bool reads_texture, gathered_scene& g) {
+  g.alpha_textures = hemilight::capi::alpha_texture_views(sd.alpha_textures, sd.alpha_texture_count);
+  if (!sd.mesh_opacity) return;
+  if (reads_texture) g.texcoords.reserve(g.positions.size());
+  size_t first = 0;
+  for (size_t m = 0; m < sd.mesh_count; ++m) {
+    const hemilight_bake_mesh& mesh = sd.meshes[m];
+    const hemilight_mesh_opacity& mo = sd.mesh_opacity[m];
+    for (size_t t = 0; t < mesh.triangle_count; ++t)
+      hemilight::capi::apply_opacity(mo.opacities ? mo.opacities[t] : mo.opacity, g.materials[first + t]);
+    first += mesh.triangle_count;
+    for (size_t v = 0; reads_texture && v < mesh.vertex_count; ++v)
+      g.texcoords.push_back(mo.texcoords ? glm::vec2(mo.texcoords[2 * v], mo.texcoords[2 * v + 1]) : glm::vec2(0.0f));
+  }
+}
+
 // The C++ scene bake's input: the concatenated meshes, the pages' sizes and material images, each
 // mesh's triangle range and placement.
 hemilight::scene_bake_input scene_input_of(const hemilight_bake_scene_desc& sd, const gathered_scene& g,
@@ -539,11 +601,14 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
     }
     std::vector<hemilight::light> lights;
     if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
-    // Step 2: the placements, then the meshes (checked against their pages) concatenated.
+    // Step 2: the placements, the opacities, then the meshes (checked against their pages) concatenated.
     std::vector<uv_target> targets;
     if (const hemilight_status st = placement_targets(fn, sd, targets)) return st;
+    bool reads_texture = false;
+    if (const hemilight_status st = check_opacity(fn, sd, reads_texture)) return st;
     gathered_scene g;
     if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, o.strict == 1, g, "scene->")) return st;
+    add_opacity(sd, reads_texture, g);
     // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
     const hemilight::bake_options bo = hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
     const hemilight::scene_bake_result r = hemilight::bake_scene(scene_input_of(sd, g, o), bo);

@@ -100,6 +100,25 @@ std::string positions_problem(const float* positions, std::size_t vertex_count, 
 std::string indices_problem(const std::uint32_t* indices, std::size_t triangle_count, std::size_t vertex_count,
                             const std::string& name);
 
+/// The largest side of an alpha texture (scene.hpp, alpha_texture: each side in [1, 16384]).
+inline constexpr int max_alpha_texture_size = 16384;
+
+/// The checks of the C opacities (hemilight.h, "opacity") that hemilight_scene_with_opacity and
+/// hemilight_bake_scene share, in the caller's terms (capi_opacity.cpp; the mapping to the C++
+/// material: capi_options.hpp, apply_opacity). Each check returns "" or what is wrong.
+/// `count` textures named `name` ("alpha_textures", "scene->alpha_textures"): NULL with a count,
+/// a side outside [1, 16384], NULL values ("<name>[1]: width x height = 0 x 4 is invalid ...").
+std::string alpha_textures_problem(const hemilight_alpha_texture* textures, std::size_t count, const std::string& name);
+/// One opacity named `name` ("opacities[5]"): the fields its mode uses ("<name>.alpha_cutoff = 1.5
+/// is outside [0, 1]"), its texture index against alpha_texture_count (the textures named
+/// `textures_name`), a texture without texcoords (named `texcoords_name`), an unknown mode.
+std::string opacity_problem(const hemilight_opacity& o, const std::string& name, std::size_t alpha_texture_count,
+                            const std::string& textures_name, bool has_texcoords, const std::string& texcoords_name);
+/// NULL, or 2 * vertex_count finite floats named `name` ("<name>[7] (vertex 3, v) = nan; it must be finite").
+std::string texcoords_problem(const float* texcoords, std::size_t vertex_count, const std::string& name);
+/// The C++ views of checked C alpha textures (the caller's memory).
+std::vector<alpha_texture> alpha_texture_views(const hemilight_alpha_texture* textures, std::size_t count);
+
 /// True if all `count` floats are finite.
 inline bool all_finite(const float* v, std::size_t count) noexcept {
   for (std::size_t i = 0; i < count; ++i)

@@ -349,9 +349,14 @@ const span bake_scene_desc_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, struct_size), HEMILIGHT_SPAN(hemilight_bake_scene_desc, meshes),
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, mesh_count), HEMILIGHT_SPAN(hemilight_bake_scene_desc, placements),
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, pages), HEMILIGHT_SPAN(hemilight_bake_scene_desc, page_count),
-    HEMILIGHT_SPAN(hemilight_bake_scene_desc, occluder_radiance)};
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, occluder_radiance), HEMILIGHT_SPAN(hemilight_bake_scene_desc, mesh_opacity),
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_textures), HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_texture_count)};
 #undef HEMILIGHT_SPAN
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_scene_desc) == 56, "hemilight_bake_scene_desc changed: see above");
+// The opacity fields were appended to the description of 56 bytes (the pointer's alignment puts
+// mesh_opacity at 56, past occluder_radiance's tail padding, on LP64).
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_scene_desc) == 80, "hemilight_bake_scene_desc changed: see above");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_scene_desc, mesh_opacity) >= 56,
+              "hemilight_bake_scene_desc: mesh_opacity must start past the earlier layout's sizeof");
 
 }  // namespace
 
@@ -359,6 +364,9 @@ hemilight_bake_scene_desc default_bake_scene_desc() {
   hemilight_bake_scene_desc d = zeroed<hemilight_bake_scene_desc>();
   d.struct_size = sizeof d;
   d.occluder_radiance = HEMILIGHT_OCCLUDER_EMISSION;
+  d.mesh_opacity = nullptr;  // every triangle opaque
+  d.alpha_textures = nullptr;
+  d.alpha_texture_count = 0;
   return d;
 }
 
@@ -369,7 +377,34 @@ std::string read_sized(const hemilight_bake_scene_desc* in, hemilight_bake_scene
   return {};
 }
 
+void apply_opacity(const hemilight_opacity& o, material& m) {
+  const material defaults;
+  m.alpha = defaults.alpha;
+  m.alpha_cutoff = defaults.alpha_cutoff;
+  m.alpha_texture = defaults.alpha_texture;
+  m.transmittance = defaults.transmittance;
+  switch (o.mode) {
+    case HEMILIGHT_ALPHA_TESTED:
+      m.opacity = surface_opacity::alpha_tested;
+      m.alpha = o.alpha;
+      m.alpha_cutoff = o.alpha_cutoff;
+      m.alpha_texture = o.alpha_texture;
+      break;
+    case HEMILIGHT_TRANSLUCENT:
+      m.opacity = surface_opacity::translucent;
+      m.transmittance = glm::vec3(o.transmittance[0], o.transmittance[1], o.transmittance[2]);
+      break;
+    default: m.opacity = surface_opacity::opaque; break;
+  }
+}
+
 }  // namespace hemilight::capi
+
+extern "C" void hemilight_opacity_init(hemilight_opacity* opacity) {
+  if (!opacity) return;
+  const hemilight_opacity defaults = HEMILIGHT_OPACITY_DEFAULT;
+  *opacity = defaults;
+}
 
 extern "C" void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* scene, size_t struct_size) {
   hemilight::capi::init_sized(scene, struct_size, hemilight::capi::default_bake_scene_desc(),

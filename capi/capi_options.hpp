@@ -56,10 +56,16 @@ filter_options to_cpp(const hemilight_cubemap_irradiance_options& c, edge_fixup 
 
 namespace hemilight::capi {
 
-/// hemilight_bake_scene_desc: the defaults (all NULL and 0, emission-only occluders), and the
-/// caller's fields within its struct_size over them (returns "" or what is wrong with struct_size).
+/// hemilight_bake_scene_desc: the defaults (all NULL and 0, emission-only occluders, every triangle
+/// opaque), and the caller's fields within its struct_size over them (returns "" or what is wrong
+/// with struct_size).
 hemilight_bake_scene_desc default_bake_scene_desc();
 std::string read_sized(const hemilight_bake_scene_desc* in, hemilight_bake_scene_desc& out);
+
+/// Sets the opacity fields of `m` (opacity, alpha, alpha_cutoff, alpha_texture, transmittance) from
+/// a checked C opacity (capi_internal.hpp, opacity_problem); the fields its mode does not use take
+/// the C++ defaults. Its other fields are left as they are.
+void apply_opacity(const hemilight_opacity& o, material& m);
 
 }  // namespace hemilight::capi
 

@@ -43,7 +43,8 @@
  *   - A struct_size below sizeof(size_t) (not initialised) or above what the library knows (a
  *     program built against a newer header than the library) is refused with INVALID_ARGUMENT.
  *   - Structs passed in arrays (hemilight_bake_mesh, hemilight_bake_material, hemilight_light,
- *     hemilight_irradiance, hemilight_bake_placement, hemilight_bake_page) and every function signature stay as they are for an SOVERSION; new
+ *     hemilight_irradiance, hemilight_bake_placement, hemilight_bake_page, hemilight_opacity,
+ *     hemilight_alpha_texture, hemilight_mesh_opacity) and every function signature stay as they are for an SOVERSION; new
  *     data would come through new functions or arrays. The SOVERSION changes only when that
  *     promise is broken.
  */
@@ -206,6 +207,97 @@ HEMILIGHT_API hemilight_status hemilight_scene_with_environment(const hemilight_
  * sampler) sorts the scene's edges, O(T log T) for T triangles. */
 HEMILIGHT_API hemilight_status hemilight_scene_with_edge_coverage(const hemilight_scene* scene, int edge_coverage,
                                                                   hemilight_scene** out);
+
+/* ---- opacity: alpha-tested and translucent triangles --------------------------------------------
+ * Since 0.15. Each triangle lets light through in one of three ways (include/hemilight/scene.hpp,
+ * surface_opacity): opaque (the default: hemicubes see it, shadow rays stop at it), alpha-tested
+ * (glTF alphaMode MASK: present where its alpha is at least its cutoff, absent elsewhere; decided
+ * per hemicube texel at the texel's centre and per shadow ray at its hit point) or translucent
+ * (glTF BLEND, KHR_materials_transmission: lets `transmittance` of the light behind it through,
+ * per channel, and adds its own radiance, attenuated by the translucent layers in front of it; it
+ * never hides what lies behind it from a texel's depth, distances or back-face flags; shadow rays
+ * multiply the transmittances they cross). Scenes take opacity through
+ * hemilight_scene_with_opacity, scene bakes through hemilight_bake_scene_desc::mesh_opacity;
+ * hemilight_bake_lightmap(_directional) bakes opaque triangles (its mesh struct does not grow: a
+ * scene bake with one page holding every mesh gives bitwise the same bake, with opacity).
+ * Cost: see-through triangles are kept out of the culling hierarchy and drawn after the opaque
+ * ones (alpha-tested: four texel reads per covered hemicube texel); an alpha-tested triangle
+ * whose alpha is below its cutoff and that reads no texture is left out altogether (it is never
+ * present). */
+/* Since 0.15. The opacity modes (hemilight_opacity::mode). */
+typedef enum hemilight_opacity_mode {
+  HEMILIGHT_OPAQUE = 0,       /* blocks all light (the default) */
+  HEMILIGHT_ALPHA_TESTED = 1, /* present where alpha x the alpha texture's value >= alpha_cutoff, absent elsewhere */
+  HEMILIGHT_TRANSLUCENT = 2   /* lets transmittance of the light behind it through */
+} hemilight_opacity_mode;
+
+/* Since 0.15. How one triangle lets light through. Fields its mode does not use are ignored (not
+ * checked), so a zeroed struct is a valid opaque one. Initialise with HEMILIGHT_OPACITY_DEFAULT or
+ * hemilight_opacity_init (opaque, alpha 1, alpha_cutoff 0.5, alpha_texture -1, transmittance 0). */
+typedef struct hemilight_opacity {
+  int mode;               /* a hemilight_opacity_mode value (an int: any value is checked) */
+  float alpha;            /* ALPHA_TESTED: the alpha factor, in [0, 1] (glTF baseColorFactor's alpha), multiplied by
+                             the alpha texture's value where there is one (default 1) */
+  float alpha_cutoff;     /* ALPHA_TESTED: present where alpha (x texture) >= alpha_cutoff, in [0, 1] (glTF
+                             alphaCutoff; default 0.5) */
+  int alpha_texture;      /* ALPHA_TESTED: index of its alpha texture (the alpha_textures passed with it), or -1 (default):
+                             the factor alone decides, for the whole triangle. A texture needs texcoords. */
+  float transmittance[3]; /* TRANSLUCENT: the fraction of the light behind it that passes, per channel (RGB), each in
+                             [0, 1] (default 0) */
+} hemilight_opacity;
+
+/* Since 0.15. The defaults of hemilight_opacity, as an initialiser:
+ *   hemilight_opacity o = HEMILIGHT_OPACITY_DEFAULT; */
+#define HEMILIGHT_OPACITY_DEFAULT { HEMILIGHT_OPAQUE, 1.0f, 0.5f, -1, { 0.0f, 0.0f, 0.0f } }
+
+/* Since 0.15. Fills *opacity with the defaults (HEMILIGHT_OPACITY_DEFAULT). NULL is ignored. */
+HEMILIGHT_API void hemilight_opacity_init(hemilight_opacity* opacity);
+
+/* Since 0.15. An 8-bit single-channel alpha texture (value / 255) for alpha-tested triangles,
+ * read bilinearly with repeat wrapping (glTF's default sampler) at the texture coordinates
+ * interpolated over the triangle: texel (x, y) (x the column, y the row of `values`) has its
+ * centre at ((x + 0.5) / width, (y + 0.5) / height): u grows with the column, v with the row
+ * (glTF's convention: v = 0 is the image's first row). Copied (scenes) or read during the call
+ * only (bakes). */
+typedef struct hemilight_alpha_texture {
+  const uint8_t* values; /* width x height values, row-major, row 0 first */
+  int width, height;     /* texels, each in [1, 16384] */
+} hemilight_alpha_texture;
+
+/* Since 0.15. The opacity of one mesh of a scene bake (hemilight_bake_scene_desc::mesh_opacity).
+ * A zeroed struct is an opaque mesh. */
+typedef struct hemilight_mesh_opacity {
+  const hemilight_opacity* opacities; /* the mesh's triangle_count opacities, or NULL: `opacity` for every triangle */
+  hemilight_opacity opacity;
+  const float* texcoords;             /* NULL, or 2 * vertex_count floats (u, v), finite: where the mesh's alpha textures are
+                                         read (glTF TEXCOORD_0; not the lightmap UVs). Required when a triangle of the mesh
+                                         names an alpha texture. */
+} hemilight_mesh_opacity;
+
+/* Since 0.15. A new scene handle with the triangles, sky or environment, lights and edge coverage
+ * of `scene`, whose triangle i lets light through as opacities[i] says (triangle_count entries:
+ * the count given to hemilight_scene_create; NULL only when it is 0). Any opacity `scene` had is
+ * replaced; `scene` is unchanged and releasing either handle keeps the other valid. Unlike the
+ * other scene_with_* entries the geometry is not shared: a new scene is built, and the lights' ray
+ * structure for it when `scene` has lights.
+ *   texcoords          NULL, or 2 * vertex_count floats (u, v) per vertex, finite: where the alpha
+ *                      textures are read; required when an opacity names a texture, copied then
+ *   alpha_textures     alpha_texture_count textures (NULL when the count is 0), copied
+ * Applies to every entry that takes the scene: hemilight_sample_irradiance, the samplers, the
+ * batch, the probes, hemilight_cache_irradiance.
+ * Errors (nothing written to *out; the message names the argument, the index and the field, e.g.
+ * "hemilight_scene_with_opacity: opacities[5].alpha_cutoff = 1.5 is outside [0, 1]"):
+ * INVALID_ARGUMENT for NULL scene or out, NULL opacities with triangles, NULL alpha_textures with a
+ * count, a mode that is not 0, 1 or 2, an alpha, alpha_cutoff or transmittance outside [0, 1] or
+ * NaN, an alpha_texture that is not -1 or below alpha_texture_count, a texture named without
+ * texcoords, a NaN or infinite texcoord, a texture of a side outside [1, 16384] or with NULL
+ * values; OUT_OF_MEMORY; with lights, as hemilight_scene_with_lights when Embree fails.
+ * Cost: as hemilight_scene_create (O(T log^2 T) for T triangles), plus copies of the textures
+ * (width x height bytes each) and the texcoords (8 bytes per vertex), plus the ray structure with
+ * lights (hemilight_scene_with_lights). */
+HEMILIGHT_API hemilight_status hemilight_scene_with_opacity(const hemilight_scene* scene, const hemilight_opacity* opacities,
+                                                            const float* texcoords, const hemilight_alpha_texture* alpha_textures,
+                                                            size_t alpha_texture_count, hemilight_scene** out);
 
 /* ---- lights ------------------------------------------------------------------------------------ */
 
@@ -820,9 +912,17 @@ typedef struct hemilight_bake_scene_desc {
   const hemilight_bake_page* pages;            /* page_count pages; their output buffers are written */
   size_t page_count;
   int occluder_radiance;                       /* HEMILIGHT_OCCLUDER_* (default HEMILIGHT_OCCLUDER_EMISSION) */
+  /* Since 0.15: see-through triangles ("opacity" above; default NULL, NULL, 0: every triangle
+   * opaque, also for a program built against an older header). Read during the call only. */
+  const hemilight_mesh_opacity* mesh_opacity;  /* NULL, or mesh_count entries: mesh_opacity[i] for meshes[i] (occluder-only
+                                                  meshes too) */
+  const hemilight_alpha_texture* alpha_textures; /* alpha_texture_count textures, the ones hemilight_opacity::alpha_texture
+                                                    indexes (NULL when the count is 0) */
+  size_t alpha_texture_count;
 } hemilight_bake_scene_desc;
 
-/* As hemilight_cache_options_init_sized, for scene descriptions (all NULL and 0, emission-only occluders). */
+/* As hemilight_cache_options_init_sized, for scene descriptions (all NULL and 0, emission-only
+ * occluders, every triangle opaque). */
 HEMILIGHT_API void hemilight_bake_scene_desc_init_sized(hemilight_bake_scene_desc* scene, size_t struct_size);
 static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* scene) {
   hemilight_bake_scene_desc_init_sized(scene, sizeof *scene);
@@ -842,11 +942,16 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
  * non-finite scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9]
  * (vertex 4, v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in
  * its page (without: counted, as hemilight_bake_lightmap does), everything hemilight_bake_lightmap
- * rejects in the meshes and options, no texel sampled in any page, a result that overflows float;
+ * rejects in the meshes and options, a bad opacity (as hemilight_scene_with_opacity refuses it,
+ * named in the scene's terms: "scene->mesh_opacity[2].opacities[5].alpha_cutoff = 1.5 is outside
+ * [0, 1]", "scene->mesh_opacity[0].texcoords[7] (vertex 3, v) = nan", "scene->alpha_textures[1]:
+ * width x height = 0 x 4 is invalid"; checked before anything is allocated for them), no texel
+ * sampled in any page, a result that overflows float;
  * OUT_OF_MEMORY, CANCELLED as there, and OUT_OF_MEMORY when the pages' atlas (the widest page x
  * the sum of the heights and two guard rows between pages) passes 2^28 texels (checked before it
  * is allocated).
- * Cost: as hemilight_bake_lightmap over the sum of the pages' texels. */
+ * Cost: as hemilight_bake_lightmap over the sum of the pages' texels; see-through triangles as
+ * "opacity" above says, and 8 bytes per vertex for the texcoords when a texture is read. */
 HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
                                                     hemilight_bake_stats* stats);
 /* Irradiance methods of hemilight_cubemap_irradiance (measured error against a brute-force cosine

@@ -32,7 +32,12 @@
 // base colour (glTF baseColorFactor x baseColorTexture, or Kd x map_Kd) = albedo (clamped to
 // [0, 1]), emissive colour x emissive texture = emitted radiance, two-sided flag; textures are
 // decoded by stb_image and averaged over each lightmap texel's footprint into per-page albedo and
-// emission images (bake_scene). A texture that cannot be read is an error. All meshes share one
+// emission images (bake_scene). A texture that cannot be read (missing, undecodable) is an error
+// naming the material and the file, also when only its alpha is wanted. Opacity (glTF; the rules
+// in model_import.hpp): alphaMode MASK is alpha-tested (the base colour alpha factor, alphaCutoff,
+// the base colour texture's alpha channel read at its TEXCOORD set), BLEND translucent (1 - alpha),
+// KHR_materials_transmission translucent (factor x base colour); one line lists the see-through
+// materials; --ignore-opacity bakes them opaque. All meshes share one
 // lightmap page, except instances: instance k of a mesh is baked into page k (NAME_pageK_*).
 // The sky (constant radiance) is --sky.
 //
@@ -116,6 +121,9 @@ const char* usage =
     "                     (default: the density that fills one page)\n"
     "  --strict           a triangle with 3D area but no lightmap UV area is an error (default: a\n"
     "                     warning; it still casts shadows)\n"
+    "  --ignore-opacity   bake glTF alpha-tested (MASK) and translucent (BLEND, transmission) materials\n"
+    "                     as opaque (default: they let light through; a texture that cannot be read is\n"
+    "                     an error naming the material and the file, for its alpha too)\n"
     "  --no-stitch-seams  leave the seams as baked (default: texels along seams between near-coplanar\n"
     "                     faces set so that both sides agree under bilinear filtering; docs/bake.md)\n"
     "  --quiet            no progress bar\n"
@@ -148,6 +156,7 @@ struct settings {
   glm::vec3 sky{1.0f};
   bool quiet = false, shadow_mask = false;
   unsigned lightmap_uv = 1;  // --lightmap-uv: the model's UV channel holding the lightmap UVs
+  bool ignore_opacity = false;  // --ignore-opacity: every material opaque
   bool generate_uvs = false; // --generate-uvs (also when a mesh has no lightmap UVs)
   float texels_per_unit = 0.0f;  // --texels-per-unit: generated UVs' density (0: fill one page)
   bool preview = false;      // --preview: a rendered picture of each baked model (built-in scenes: always)
@@ -268,6 +277,8 @@ settings parse(int argc, char** argv) {
       s.texels_per_unit = parse_float("--texels-per-unit", value(), 0.0f, 1e6f, true);
     } else if (a == "--strict") {
       s.options.strict = true;
+    } else if (a == "--ignore-opacity") {
+      s.ignore_opacity = true;
     } else if (a == "--no-stitch-seams") {
       s.options.stitch_seams = false;
     } else if (a == "--quiet") {
@@ -354,10 +365,15 @@ struct scene_arrays {
   std::vector<glm::vec2> uvs;
   std::vector<std::uint32_t> indices;
   std::vector<material> materials;
+  std::vector<glm::vec2> texcoords;            // where alpha textures are read (when a material has one)
+  std::vector<alpha_texture> alpha_textures;   // views of the model's
 };
 
 scene_bake_input model_scene(const model_import::model& m, const settings& s, scene_arrays& a) {
   scene_bake_input in;
+  const bool alpha_textured = std::any_of(m.meshes.begin(), m.meshes.end(), [&](const model_import::mesh& me) {
+    return m.materials[me.material].alpha_texture >= 0;
+  });
   for (const model_import::mesh& me : m.meshes) {
     bake_mesh bm;
     bm.first_triangle = a.indices.size() / 3;
@@ -371,7 +387,15 @@ scene_bake_input model_scene(const model_import::model& m, const settings& s, sc
     for (std::uint32_t i : me.indices) a.indices.push_back(base + i);
     const material flat = m.materials[me.material].flat(m.textures);
     a.materials.insert(a.materials.end(), me.indices.size() / 3, flat);
+    if (!alpha_textured) continue;
+    std::vector<glm::vec2> tc = model_import::mesh_texcoords(m, me);  // empty: its material reads no alpha texture
+    tc.resize(me.positions.size(), glm::vec2(0.0f));
+    a.texcoords.insert(a.texcoords.end(), tc.begin(), tc.end());
   }
+  for (const alpha_image& t : m.alpha_textures) a.alpha_textures.push_back({t.values.data(), t.width, t.height});
+  in.geometry.scene.texcoords = alpha_textured ? a.texcoords.data() : nullptr;
+  in.geometry.scene.alpha_textures = a.alpha_textures.empty() ? nullptr : a.alpha_textures.data();
+  in.geometry.scene.alpha_texture_count = a.alpha_textures.size();
   in.geometry.scene.positions = a.positions.data();
   in.geometry.scene.vertex_count = a.positions.size();
   in.geometry.scene.indices = a.indices.data();
@@ -617,6 +641,7 @@ void run_scenes(const settings& s) {
     io.lightmap_channel = s.lightmap_uv;
     io.allow_missing_lightmap_uvs = true;
     io.strict = s.options.strict;
+    io.ignore_opacity = s.ignore_opacity;
     m = model_import::import_model(s.model, io);
   } catch (const std::runtime_error& e) {
     fail(e.what());
@@ -624,6 +649,7 @@ void run_scenes(const settings& s) {
   std::string name = std::filesystem::path(s.model).stem().string();
   if (name.empty()) name = "model";
   const bool generated = s.generate_uvs || !m.without_lightmap_uvs.empty();
+  if (const std::string line = model_import::opacity_summary(m); !line.empty()) std::printf("%s: %s\n", name.c_str(), line.c_str());
   if (generated) generate_model_uvs(m, s, name);
   scene_arrays arrays;
   const scene_bake_input in = model_scene(m, s, arrays);

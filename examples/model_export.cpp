@@ -1,6 +1,7 @@
 // A scene_mesh as glTF binary through assimp's exporter (model_export.hpp).
 #include "model_export.hpp"
 
+#include <assimp/GltfMaterial.h>
 #include <assimp/material.h>
 #include <assimp/scene.h>
 #include <assimp/Exporter.hpp>
@@ -140,13 +141,21 @@ void write_glb(const scene_mesh& mesh, const std::string& path) {
 
 namespace {
 
-// The material of an imported one: factors, two-sided, and a base colour texture read from a file.
+// The material of an imported one: factors, two-sided, a base colour texture read from a file, and
+// what the file said of its opacity (glTF alphaMode, alphaCutoff, the base colour's alpha,
+// KHR_materials_transmission's factor).
 aiMaterial* make_material(const model_import::material& mat, const std::vector<model_import::texture>& textures,
                           const std::string& out_dir) {
   auto* am = new aiMaterial();
   const aiString name(mat.name);
   am->AddProperty(&name, AI_MATKEY_NAME);
-  const aiColor4D base(mat.base_color.x, mat.base_color.y, mat.base_color.z, 1.0f);
+  const aiColor4D base(mat.base_color.x, mat.base_color.y, mat.base_color.z, mat.base_alpha);
+  if (!mat.alpha_mode.empty()) {
+    const aiString mode(mat.alpha_mode);
+    am->AddProperty(&mode, AI_MATKEY_GLTF_ALPHAMODE);
+    am->AddProperty(&mat.gltf_alpha_cutoff, 1, AI_MATKEY_GLTF_ALPHACUTOFF);
+  }
+  if (mat.transmission > 0.0f) am->AddProperty(&mat.transmission, 1, AI_MATKEY_TRANSMISSION_FACTOR);
   am->AddProperty(&base, 1, AI_MATKEY_BASE_COLOR);
   const aiColor3D diffuse(mat.base_color.x, mat.base_color.y, mat.base_color.z), emissive(mat.emissive.x, mat.emissive.y, mat.emissive.z);
   am->AddProperty(&diffuse, 1, AI_MATKEY_COLOR_DIFFUSE);

@@ -27,9 +27,10 @@ void write_glb(const scene_mesh& mesh, const std::string& path);
 /// glTF binary, so that an engine renders with the layout that was baked: one node per mesh at the
 /// origin (world-space positions, as imported), its normals, its UV channels (TEXCOORD_0 ...) with
 /// the lightmap UVs as TEXCOORD_1 (channel 0 a copy of them when the mesh had none), and per
-/// material the base colour and emissive factors, two-sided, and a base colour texture read from
-/// a file (referenced by its path relative to `path`'s folder; embedded textures and lights are not
-/// written). The lightmap UVs are stored as the baker reads them (import_model gives them back to
+/// material the base colour (with its alpha) and emissive factors, two-sided, glTF's alphaMode,
+/// alphaCutoff and KHR_materials_transmission factor as the file had them, and a base colour
+/// texture read from a file (referenced by its path relative to `path`'s folder; embedded textures,
+/// and so their alpha, and lights are not written). The lightmap UVs are stored as the baker reads them (import_model gives them back to
 /// float rounding of 1 - v). Throws std::runtime_error naming the file when a mesh has no lightmap
 /// UVs or the export fails. Cost: O(V + T) plus assimp's export.
 void write_glb(const model_import::model& m, const std::string& path);

@@ -2,6 +2,7 @@
 // textures decoded by stb_image, per-texel materials averaged over lightmap texel footprints.
 #include "model_import.hpp"
 
+#include <assimp/GltfMaterial.h>
 #include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -23,8 +25,9 @@ namespace {
 
 float srgb_to_linear(float s) { return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f); }
 
-// 8-bit RGBA (row 0 = top) to a linear texture.
-texture from_rgba8(const unsigned char* p, int w, int h, std::string source) {
+// 8-bit RGBA (row 0 = top) to a linear texture; the alpha channel kept as it is when the image has
+// one (`has_alpha`) that is not 255 everywhere.
+texture from_rgba8(const unsigned char* p, int w, int h, std::string source, bool has_alpha) {
   texture t;
   t.width = w;
   t.height = h;
@@ -32,9 +35,20 @@ texture from_rgba8(const unsigned char* p, int w, int h, std::string source) {
   float table[256];
   for (int i = 0; i < 256; ++i) table[i] = srgb_to_linear(float(i) / 255.0f);
   t.texels.resize(std::size_t(w) * std::size_t(h));
-  for (std::size_t i = 0; i < t.texels.size(); ++i) t.texels[i] = glm::vec3(table[p[4 * i]], table[p[4 * i + 1]], table[p[4 * i + 2]]);
+  bool varies = false;
+  for (std::size_t i = 0; i < t.texels.size(); ++i) {
+    t.texels[i] = glm::vec3(table[p[4 * i]], table[p[4 * i + 1]], table[p[4 * i + 2]]);
+    varies = varies || p[4 * i + 3] != 255;
+  }
+  if (has_alpha && varies) {
+    t.alpha.resize(t.texels.size());
+    for (std::size_t i = 0; i < t.texels.size(); ++i) t.alpha[i] = p[4 * i + 3];
+  }
   return t;
 }
+
+// stb_image's channel count says whether the file has an alpha channel (grey + alpha, RGBA).
+bool channels_have_alpha(int n) { return n == 2 || n == 4; }
 
 // A texture of the material: embedded ("*N" or a glb's name) or a file next to the model.
 texture load_texture(const aiScene* sc, const std::string& model_path, const std::string& ref, const std::string& who) {
@@ -44,7 +58,7 @@ texture load_texture(const aiScene* sc, const std::string& model_path, const std
       int w = 0, h = 0, n = 0;
       unsigned char* px = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(emb->pcData), int(emb->mWidth), &w, &h, &n, 4);
       if (!px) fail(who + ": " + source + " cannot be decoded: " + stbi_failure_reason());
-      texture t = from_rgba8(px, w, h, source);
+      texture t = from_rgba8(px, w, h, source, channels_have_alpha(n));
       stbi_image_free(px);
       return t;
     }
@@ -55,14 +69,14 @@ texture load_texture(const aiScene* sc, const std::string& model_path, const std
       rgba[4 * i + 2] = emb->pcData[i].b;
       rgba[4 * i + 3] = emb->pcData[i].a;
     }
-    return from_rgba8(rgba.data(), int(emb->mWidth), int(emb->mHeight), source);
+    return from_rgba8(rgba.data(), int(emb->mWidth), int(emb->mHeight), source, true);
   }
   std::filesystem::path p(ref);
   if (p.is_relative()) p = std::filesystem::path(model_path).parent_path() / p;
   int w = 0, h = 0, n = 0;
   unsigned char* px = stbi_load(p.string().c_str(), &w, &h, &n, 4);
   if (!px) fail(who + ": texture '" + p.string() + "' cannot be read: " + stbi_failure_reason());
-  texture t = from_rgba8(px, w, h, p.string());
+  texture t = from_rgba8(px, w, h, p.string(), channels_have_alpha(n));
   stbi_image_free(px);
   return t;
 }
@@ -117,9 +131,74 @@ std::vector<light> model_lights(const aiScene* sc, const std::map<std::string, a
   return out;
 }
 
-// A material's factors, textures (loaded once per reference) and UV channels.
+// The opacity of a material whose factors and textures are read (the rules in model_import.hpp):
+// alpha_mode and transmission as the file says; opacity, alpha, alpha_cutoff, alpha_texture and
+// transmittance as the scene takes them. The alpha texture of a base colour texture is made once
+// (alpha_of: texture index -> alpha texture index).
+void read_opacity(const aiMaterial* am, float base_alpha, material& mat, model& m, std::map<int, int>& alpha_of, bool ignore) {
+  aiString mode;
+  if (am->Get(AI_MATKEY_GLTF_ALPHAMODE, mode) == AI_SUCCESS) mat.alpha_mode = mode.C_Str();
+  float cutoff = 0.5f, transmission = 0.0f;
+  am->Get(AI_MATKEY_GLTF_ALPHACUTOFF, cutoff);
+  am->Get(AI_MATKEY_TRANSMISSION_FACTOR, transmission);
+  mat.base_alpha = base_alpha;
+  mat.gltf_alpha_cutoff = cutoff;
+  mat.transmission = std::isfinite(transmission) ? std::clamp(transmission, 0.0f, 1.0f) : 0.0f;
+  const bool mask = mat.alpha_mode == "MASK", blend = mat.alpha_mode == "BLEND";
+  const float alpha = std::isfinite(base_alpha) ? std::clamp(base_alpha, 0.0f, 1.0f) : 1.0f;
+  const texture* tex = mat.base_color_texture >= 0 ? &m.textures[std::size_t(mat.base_color_texture)] : nullptr;
+  // What the scene takes, decided first; applied unless `ignore` (then only counted).
+  material see;
+  bool reads_alpha_texture = false;
+  if (mat.transmission > 0.0f || blend) {
+    // The fraction a of the surface that is there (BLEND's coverage; 1 otherwise) passes
+    // transmission x base colour, the rest passes everything.
+    const float a = blend ? alpha * (tex ? tex->mean_alpha() : 1.0f) : 1.0f;
+    const glm::vec3 tint = glm::clamp(mat.base_color * (tex ? tex->mean() : glm::vec3(1.0f)), 0.0f, 1.0f);
+    see.opacity = surface_opacity::translucent;
+    see.transmittance = glm::clamp((1.0f - a) + a * mat.transmission * tint, 0.0f, 1.0f);
+  } else if (mask) {
+    // Present where alpha x the texture's alpha >= cutoff.
+    if (!std::isfinite(cutoff)) cutoff = 0.5f;
+    const bool textured = tex && !tex->alpha.empty();
+    if (cutoff > 1.0f) {  // glTF allows it: never present
+      see.opacity = surface_opacity::alpha_tested;
+      see.alpha = 0.0f;
+      see.alpha_cutoff = 1.0f;
+    } else if (textured || alpha < std::max(cutoff, 0.0f)) {  // else present everywhere: opaque, and drawn as such
+      see.opacity = surface_opacity::alpha_tested;
+      see.alpha = alpha;
+      see.alpha_cutoff = std::max(cutoff, 0.0f);
+      reads_alpha_texture = textured;
+    }
+  }
+  if (see.opacity == surface_opacity::opaque) return;
+  if (ignore) {
+    ++m.ignored_see_through;
+    return;
+  }
+  mat.opacity = see.opacity;
+  mat.alpha = see.alpha;
+  mat.alpha_cutoff = see.alpha_cutoff;
+  mat.transmittance = see.transmittance;
+  if (!reads_alpha_texture) return;
+  auto it = alpha_of.find(mat.base_color_texture);
+  if (it == alpha_of.end()) {
+    alpha_image img;
+    img.width = tex->width;
+    img.height = tex->height;
+    img.values = tex->alpha;
+    m.alpha_textures.push_back(std::move(img));
+    m.alpha_sources.push_back(mat.base_color_texture);
+    it = alpha_of.emplace(mat.base_color_texture, int(m.alpha_textures.size() - 1)).first;
+  }
+  mat.alpha_texture = it->second;
+}
+
+// A material's factors, textures (loaded once per reference) and UV channels, and its opacity.
 material read_material(const aiScene* sc, unsigned index, const std::string& path, std::map<std::string, int>& loaded,
-                       std::vector<texture>& textures) {
+                       std::map<int, int>& alpha_of, model& m, bool ignore_opacity) {
+  std::vector<texture>& textures = m.textures;
   const aiMaterial* am = sc->mMaterials[index];
   material mat;
   mat.name = am->GetName().C_Str();
@@ -155,6 +234,7 @@ material read_material(const aiScene* sc, unsigned index, const std::string& pat
   };
   texture_of({aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}, mat.base_color_texture, mat.base_color_uv);
   texture_of({aiTextureType_EMISSIVE}, mat.emissive_texture, mat.emissive_uv);
+  read_opacity(am, base.a, mat, m, alpha_of, ignore_opacity);
   return mat;
 }
 
@@ -244,6 +324,13 @@ glm::vec3 texture::mean() const noexcept {
   return texels.empty() ? glm::vec3(0.0f) : glm::vec3(s / double(texels.size()));
 }
 
+float texture::mean_alpha() const noexcept {
+  if (alpha.empty()) return 1.0f;
+  double s = 0.0;
+  for (std::uint8_t a : alpha) s += a;
+  return float(s / (255.0 * double(alpha.size())));
+}
+
 hemilight::material material::flat(const std::vector<texture>& textures) const {
   hemilight::material m;
   const glm::vec3 b = base_color_texture >= 0 ? textures[std::size_t(base_color_texture)].mean() : glm::vec3(1.0f);
@@ -251,7 +338,57 @@ hemilight::material material::flat(const std::vector<texture>& textures) const {
   m.albedo = glm::clamp(base_color * b, 0.0f, 1.0f);
   m.emission = glm::max(emissive * e, glm::vec3(0.0f));
   m.two_sided = two_sided;
+  m.opacity = opacity;
+  m.alpha = alpha;
+  m.alpha_cutoff = alpha_cutoff;
+  m.alpha_texture = alpha_texture;
+  m.transmittance = transmittance;
   return m;
+}
+
+std::vector<glm::vec2> mesh_texcoords(const model& m, const mesh& me) {
+  const material& mat = m.materials[me.material];
+  if (mat.opacity != surface_opacity::alpha_tested || mat.alpha_texture < 0 || mat.base_color_uv >= me.uv_channels.size()) return {};
+  std::vector<glm::vec2> out;
+  out.reserve(me.uv_channels[mat.base_color_uv].size());
+  for (const glm::vec2& t : me.uv_channels[mat.base_color_uv]) out.emplace_back(t.x, 1.0f - t.y);
+  return out;
+}
+
+std::string opacity_summary(const model& m) {
+  std::string list;
+  std::size_t count = 0;
+  const auto number = [](float v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", double(v));
+    return std::string(text);
+  };
+  for (const material& mat : m.materials) {
+    if (mat.opacity == surface_opacity::opaque) continue;
+    list += std::string(count++ ? ", " : "") + "'" + mat.name + "' ";
+    if (mat.opacity == surface_opacity::alpha_tested) {
+      list += "alpha-tested (MASK, cutoff " + number(mat.alpha_cutoff);
+      if (mat.alpha < 1.0f) list += ", alpha " + number(mat.alpha);
+      if (mat.alpha_texture >= 0) {
+        const alpha_image& a = m.alpha_textures[std::size_t(mat.alpha_texture)];
+        list += ", alpha texture '" + m.textures[std::size_t(m.alpha_sources[std::size_t(mat.alpha_texture)])].source + "' " +
+                std::to_string(a.width) + " x " + std::to_string(a.height);
+      }
+      list += ")";
+    } else {
+      const glm::vec3 t = mat.transmittance;
+      list += "translucent (" + (mat.transmission > 0.0f ? "transmission " + number(mat.transmission) : mat.alpha_mode) +
+              ": transmittance " + (t.x == t.y && t.y == t.z ? number(t.x) : number(t.x) + ", " + number(t.y) + ", " + number(t.z)) + ")";
+    }
+  }
+  std::string line;
+  if (count > 0)
+    line = std::to_string(count) + " of " + std::to_string(m.materials.size()) + " material" + (m.materials.size() > 1 ? "s" : "") +
+           (count > 1 ? " let" : " lets") + " light through: " + list;
+  if (m.ignored_see_through > 0)
+    line += std::string(line.empty() ? "" : "; ") + std::to_string(m.ignored_see_through) + " see-through material" +
+            (m.ignored_see_through > 1 ? "s" : "") + " baked opaque (opacity ignored)";
+  return line;
 }
 
 model import_model(const std::string& path, unsigned lightmap_channel) {
@@ -287,10 +424,12 @@ model import_model(const std::string& path, const import_options& options) {
          " no lightmap UVs (UV channel " + std::to_string(lightmap_channel) + "): " + missing +
          (lightmap_channel == 1 ? "; give them a second UV set (glTF TEXCOORD_1), or bake UV channel 0 with --lightmap-uv 0" : ""));
 
-  // Step 2: materials and their textures.
+  // Step 2: materials, their textures and their opacity.
   model m;
   std::map<std::string, int> loaded;
-  for (unsigned i = 0; i < sc->mNumMaterials; ++i) m.materials.push_back(read_material(sc, i, path, loaded, m.textures));
+  std::map<int, int> alpha_of;
+  for (unsigned i = 0; i < sc->mNumMaterials; ++i)
+    m.materials.push_back(read_material(sc, i, path, loaded, alpha_of, m, options.ignore_opacity));
   if (m.materials.empty()) m.materials.emplace_back();
 
   // Step 3: every node's meshes in world space.
@@ -342,6 +481,11 @@ model import_model(const std::string& path, const import_options& options) {
         out.indices.insert(out.indices.end(), {face.mIndices[0], mirrored ? face.mIndices[2] : face.mIndices[1],
                                                mirrored ? face.mIndices[1] : face.mIndices[2]});
       }
+      const material& mat = m.materials[out.material];
+      if (mat.alpha_texture >= 0 && mat.base_color_uv >= out.uv_channels.size())
+        fail("'" + path + "' " + out.name + ": its material " + std::to_string(out.material) + " ('" + mat.name +
+             "') reads its alpha texture at UV channel " + std::to_string(mat.base_color_uv) + " (TEXCOORD_" +
+             std::to_string(mat.base_color_uv) + "), which the mesh does not have");
       if (has_lightmap_uvs)
         check_lightmap_uvs(out, path, options.strict);
       else

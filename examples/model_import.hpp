@@ -16,8 +16,21 @@
 //     (glTF baseColorTexture, else the diffuse texture map_Kd), emissive colour (emissiveFactor /
 //     Ke) times its texture, two-sided. Textures are decoded by stb_image (Debian's libstb-dev):
 //     files next to the model or embedded (glb, data URIs); 8-bit values are sRGB and converted to
-//     linear. A texture that cannot be read is an error (not a warning: a bake with a wrong
-//     albedo is worse than none).
+//     linear, the alpha channel is kept as it is (glTF: linear). A texture that cannot be read is
+//     an error naming the material and the file (not a warning: a bake with a wrong albedo, or
+//     with leaves that should be cut out baked solid, is worse than none).
+//   - Opacity (glTF only; scene.hpp, surface_opacity): alphaMode MASK is alpha-tested with
+//     alpha = baseColorFactor's alpha, alphaCutoff (default 0.5) and, when the base colour texture
+//     has an alpha channel that is not everywhere 255, that channel as its alpha texture (read at
+//     the texture's own UV set, TEXCOORD_0 normally; one alpha texture per image, shared by the
+//     materials using it); a MASK material that is present everywhere (alpha >= cutoff, no alpha
+//     texture) is opaque. BLEND is translucent with transmittance 1 - a (grey), a = the factor's
+//     alpha x the texture's mean alpha. KHR_materials_transmission (assimp 5.2's
+//     AI_MATKEY_TRANSMISSION_FACTOR) is translucent with transmittance = factor x base colour
+//     (factor x texture mean), clamped to [0, 1], whatever the alpha mode (with BLEND:
+//     (1 - a) + a x that; a MASK cut-out is then not applied); the transmission texture is not
+//     read. OPAQUE, and every other format (OBJ's dissolve, FBX's opacity), is opaque.
+//     import_options::ignore_opacity makes everything opaque.
 //   - Lights (aiLight), transformed by the node of the same name (assimp's convention).
 // Every error is one line naming the file and the mesh, material or texture (std::runtime_error).
 #pragma once
@@ -35,6 +48,9 @@ namespace hemilight::model_import {
 struct texture {
   int width = 0, height = 0;
   std::vector<glm::vec3> texels;
+  /// The alpha channel (width x height, 0..255 as stored, rows as texels), or empty when the image
+  /// has none or it is 255 everywhere.
+  std::vector<std::uint8_t> alpha;
   std::string source;  ///< file path or "embedded texture N"
 
   /// The texel under uv (assimp's convention: v grows upwards, so row = (1 - v) height), with
@@ -42,6 +58,8 @@ struct texture {
   glm::vec3 lookup(glm::vec2 uv) const noexcept;
   /// The mean of all texels.
   glm::vec3 mean() const noexcept;
+  /// The mean alpha, in [0, 1] (1 without an alpha channel).
+  float mean_alpha() const noexcept;
 };
 
 /// A material as the baker uses it.
@@ -53,8 +71,22 @@ struct material {
   int base_color_texture = -1, emissive_texture = -1;  ///< index into model::textures, or -1
   unsigned base_color_uv = 0, emissive_uv = 0;         ///< UV channel of each texture
 
+  /// How it lets light through (the rules at the top), as the scene takes it: opacity,
+  /// alpha (the factor), alpha_cutoff, alpha_texture (index into model::alpha_textures, read at
+  /// UV channel base_color_uv: mesh_texcoords) and transmittance.
+  surface_opacity opacity = surface_opacity::opaque;
+  float alpha = 1.0f, alpha_cutoff = 0.5f;
+  int alpha_texture = -1;
+  glm::vec3 transmittance{0.0f};
+  /// What the file says (for the import's summary and model_export's writer): glTF's alphaMode
+  /// ("" for other formats), the base colour factor's alpha, alphaCutoff and the
+  /// KHR_materials_transmission factor (0 without), also with import_options::ignore_opacity.
+  std::string alpha_mode;
+  float base_alpha = 1.0f, gltf_alpha_cutoff = 0.5f, transmission = 0.0f;
+
   /// The per-triangle material: albedo = base colour x texture mean (clamped to [0, 1]),
-  /// emission = emissive x texture mean. What hemicubes see where no per-texel image is used.
+  /// emission = emissive x texture mean, two-sided, and the opacity fields above. What hemicubes
+  /// see where no per-texel image is used.
   hemilight::material flat(const std::vector<texture>& textures) const;
 };
 
@@ -75,6 +107,13 @@ struct model {
   std::vector<mesh> meshes;
   std::vector<material> materials;
   std::vector<texture> textures;
+  /// The alpha textures of alpha-tested materials (material::alpha_texture), one per image: the
+  /// alpha channel of textures[alpha_sources[k]] (scene.hpp's alpha texture: row 0 = v = 0).
+  std::vector<alpha_image> alpha_textures;
+  std::vector<int> alpha_sources;
+  /// With import_options::ignore_opacity: how many materials were made opaque though the file
+  /// makes them see-through.
+  std::size_t ignored_see_through = 0;
   std::vector<light> lights;
   /// Lightmap pages: 1 + the largest mesh::page (instance k of every mesh goes to page k, so that
   /// instances, which share their lightmap UVs, never share texels).
@@ -88,16 +127,29 @@ struct import_options {
   unsigned lightmap_channel = 1;            ///< the UV channel of the lightmap UVs, < AI_MAX_NUMBER_OF_TEXTURECOORDS
   bool allow_missing_lightmap_uvs = false;  ///< meshes without the channel: imported without lightmap UVs, not an error
   bool strict = false;                      ///< a triangle with 3D area but no lightmap UV area is an error
+  bool ignore_opacity = false;              ///< every material opaque (alpha modes and transmission not applied)
 };
 
 /// Reads a model file. Throws std::runtime_error with one line naming the file and what is wrong:
 /// no such file, assimp's error, no meshes with triangles, meshes without UV channel
 /// lightmap_channel (all of them named; unless allowed), a lightmap UV more than
 /// lightmap_uv_tolerance outside [0, 1], with strict a triangle with 3D area but no UV area (named
-/// by its mesh and index), a texture that cannot be read. Cost: assimp's import plus one pass over
-/// the vertices and the textures' texels.
+/// by its mesh and index), a texture that cannot be read (naming the material and the file), a
+/// mesh without the UV channel its material's alpha texture is read at (naming both). Cost:
+/// assimp's import plus one pass over the vertices and the textures' texels.
 model import_model(const std::string& path, const import_options& options);
 model import_model(const std::string& path, unsigned lightmap_channel = 1);
+
+/// One line on the model's see-through materials ("2 of 5 materials let light through: 'Leaves'
+/// alpha-tested (MASK, cutoff 0.5, alpha texture 'leaves.png' 64 x 64), 'Glass' translucent
+/// (transmission 0.9: transmittance 0.81, 0.9, 0.9)"), or "" when there is none (and no
+/// ignored_see_through).
+std::string opacity_summary(const model& m);
+
+/// The texcoords at which the alpha texture of mesh `me`'s material is read, per vertex, in the
+/// scene's convention (scene.hpp, alpha_texture: (u, 1 - v) of assimp's v-up UVs, glTF's own
+/// values), or empty when its material reads no alpha texture.
+std::vector<glm::vec2> mesh_texcoords(const model& m, const mesh& me);
 
 /// Gives the model the lightmap UVs of `r`, the unwrap (unwrap_lightmap) of its meshes' world
 /// positions concatenated in order (mesh k's vertices after those of meshes 0..k-1): each mesh's

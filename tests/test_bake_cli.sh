@@ -112,6 +112,54 @@ PY
 expect_ok lamp.gltf --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --sky 0,0,0 --out gltf
 grep -q "1 light from the model" ok.log || { echo "FAIL: the glTF's light was not read:"; cat ok.log; fails=$((fails + 1)); }
 
+# Opacity: a glTF floor (lightmap u in [0, 0.5]) under an alpha-tested card (glTF MASK whose
+# base colour texture leaves.png has an alpha channel; lightmap u in [0.5, 1]): one line names the
+# see-through material, the bake takes the alpha texture and its texcoords (the scene refuses a
+# texture without them), --ignore-opacity bakes it opaque, a missing texture is one error naming
+# the material and the file, and the lightmap_uvs.glb written with generated UVs keeps the mode.
+python3 - <<'PY'
+import base64, json, struct, zlib
+def png_rgba(w, h, rgba):
+    raw = b''.join(b'\x00' + bytes(rgba[4 * w * y:4 * w * (y + 1)]) for y in range(h))
+    chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+    return b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 6, 0, 0, 0)) + \
+           chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b'')
+open('leaves.png', 'wb').write(png_rgba(4, 4, [v for y in range(4) for x in range(4) for v in (40, 160, 40, 255 if x < 2 else 0)]))
+quad = struct.pack('<12f', 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0)
+data = quad + struct.pack('<8f', 0, 0, 0, 1, 1, 1, 1, 0) + struct.pack('<8f', 0, 0, 0, 1, 0.5, 1, 0.5, 0) + \
+       struct.pack('<8f', 0.5, 0, 0.5, 1, 1, 1, 1, 0) + struct.pack('<6H', 0, 1, 2, 0, 2, 3)
+views = [{"buffer": 0, "byteOffset": o, "byteLength": n} for o, n in ((0, 48), (48, 32), (80, 32), (112, 32), (144, 12))]
+gltf = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"name": "floor", "mesh": 0}, {"name": "card", "mesh": 1, "translation": [0, 0.5, 0]}],
+    "meshes": [{"name": "Floor", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "indices": 4, "material": 0}]},
+               {"name": "Card", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 3}, "indices": 4, "material": 1}]}],
+    "materials": [{"name": "Ground"},
+                  {"name": "Leaves", "alphaMode": "MASK", "doubleSided": True, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"uri": "leaves.png"}],
+    "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    "bufferViews": views,
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]}] +
+                 [{"bufferView": k, "componentType": 5126, "count": 4, "type": "VEC2"} for k in (1, 2, 3)] +
+                 [{"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+}
+open('card.gltf', 'w').write(json.dumps(gltf))
+PY
+expect_ok card.gltf --size 16 --resolution 16 --bounces 1 --sun 0,-1,0,2 --out card
+grep -q "card: 1 of [0-9]* materials lets light through: 'Leaves' alpha-tested (MASK, cutoff 0.5, alpha texture '.*leaves.png' 4 x 4)" ok.log ||
+  { echo "FAIL: no opacity line:"; cat ok.log; fails=$((fails + 1)); }
+expect_ok card.gltf --size 16 --resolution 16 --bounces 1 --ignore-opacity --out card_opaque
+grep -q "card: 1 see-through material baked opaque (opacity ignored)" ok.log || { echo "FAIL: --ignore-opacity:"; cat ok.log; fails=$((fails + 1)); }
+grep -q "lets light through" ok.log && { echo "FAIL: --ignore-opacity still lets light through:"; cat ok.log; fails=$((fails + 1)); }
+expect_ok card.gltf --size 16 --resolution 16 --bounces 1 --generate-uvs --out card_uvs
+if ! "$bake" card_uvs/card_lightmap_uvs.glb --size 16 --resolution 16 --bounces 1 --quiet --out card_again > card_again.log 2>&1 ||
+   ! grep -q "'Leaves' alpha-tested (MASK, cutoff 0.5, alpha texture" card_again.log; then
+  echo "FAIL: the written glb lost the card's alpha mode or texture:"; cat card_again.log; fails=$((fails + 1))
+fi
+mv leaves.png leaves_moved.png
+expect_fail "material 1 ('Leaves')" "leaves.png' cannot be read" -- card.gltf --size 16
+mv leaves_moved.png leaves.png
+
 expect_fail "--sun 1,2" "DX,DY,DZ,E" -- quad.obj --lightmap-uv 0 --sun 1,2
 expect_fail "--point 0,0,0,x" "X,Y,Z,I" -- quad.obj --lightmap-uv 0 --point 0,0,0,x
 expect_fail "lights\[0\].direction is zero" -- quad.obj --lightmap-uv 0 --sun 0,0,0,1

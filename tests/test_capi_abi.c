@@ -113,9 +113,76 @@ static void test_bake(void) {
   CHECK(guard_intact(sb.bytes + sizeof(hemilight_bake_stats)));
 }
 
+/* A scene description of the layout before the opacity fields, followed by guard bytes (which,
+ * read as mesh_opacity, would be a wild pointer): the bake reads none of them and every triangle
+ * is opaque. A floor under the sky (radiance 1) with an occluder-only card above it: pi where the
+ * floor sees only the sky, less under the card. */
+static void test_bake_scene(void) {
+  static union {
+    hemilight_bake_scene_desc d;
+    unsigned char bytes[sizeof(hemilight_bake_scene_desc) + guard];
+  } db;
+  static const float floor_positions[] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
+  static const float floor_uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
+  /* 0.25 above the floor, facing down, over x in [0.5, 2.5], z in [-2.5, 1.5]: the floor's right
+   * half is under it. */
+  static const float card_positions[] = {0.5f, 0.25f, 1.5f, 0.5f, 0.25f, -2.5f, 2.5f, 0.25f, -2.5f, 2.5f, 0.25f, 1.5f};
+  static const uint32_t indices[] = {0, 1, 2, 0, 2, 3};
+  enum { W = 8 };
+  static float out[3 * W * W];
+  hemilight_bake_mesh meshes[2];
+  hemilight_bake_placement placements[2];
+  hemilight_bake_page page;
+  hemilight_bake_options o;
+  int x, y, ok_lit = 1, ok_shaded = 1;
+  memset(meshes, 0, sizeof meshes);
+  meshes[0].positions = floor_positions;
+  meshes[0].lightmap_uvs = floor_uvs;
+  meshes[0].vertex_count = 4;
+  meshes[0].indices = indices;
+  meshes[0].triangle_count = 2;
+  meshes[1] = meshes[0];
+  meshes[1].positions = card_positions;
+  meshes[1].lightmap_uvs = NULL;
+  memset(placements, 0, sizeof placements);
+  placements[0].uv_scale[0] = placements[0].uv_scale[1] = 1.0f;
+  placements[1] = placements[0];
+  placements[1].page = -1;
+  memset(&page, 0, sizeof page);
+  page.width = page.height = W;
+  page.irradiance_rgb = out;
+  page.irradiance_capacity = 3 * W * W;
+  memset(db.bytes, guard_byte, sizeof db.bytes);
+  hemilight_bake_scene_desc_init(&db.d);
+  CHECK(guard_intact(db.bytes + sizeof(hemilight_bake_scene_desc)));
+  CHECK(db.d.struct_size == sizeof(hemilight_bake_scene_desc) && db.d.meshes == NULL && db.d.occluder_radiance == 0);
+  db.d.meshes = meshes;
+  db.d.mesh_count = 2;
+  db.d.placements = placements;
+  db.d.pages = &page;
+  db.d.page_count = 1;
+  hemilight_bake_options_init(&o);
+  o.resolution = 16;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+  CHECK(hemilight_bake_scene(&db.d, &o, NULL) == 0);
+  /* Texel columns 0 and 1 (x <= 0.25) see the card only near the horizon (it hides at most 11% of
+   * the sky's projected solid angle: half-plane form factors); columns 6 and 7 (x >= 0.75), under
+   * it, see the sky only past its edges (at most 22%). */
+  for (y = 0; y < W; ++y)
+    for (x = 0; x < W; ++x) {
+      const float e = out[3 * (y * W + x)];
+      if (x < 2 && !(e > 0.85f * 3.14159265f && e <= 3.1416f)) ok_lit = 0;
+      if (x >= 6 && !(e < 0.25f * 3.14159265f)) ok_shaded = 0;
+    }
+  CHECK(ok_lit);
+  CHECK(ok_shaded);
+  CHECK(guard_intact(db.bytes + sizeof(hemilight_bake_scene_desc)));
+}
+
 int main(void) {
   test_cache();
   test_bake();
+  test_bake_scene();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

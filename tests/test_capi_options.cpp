@@ -344,3 +344,107 @@ TEST_CASE("C ABI options: every unwrap option reaches the C++ side, defaults are
   std::memset(&untouched, 0x5a, sizeof untouched);
   CHECK(std::memcmp(&to.seam_texels, &untouched.seam_texels, sizeof to - offsetof(hemilight_unwrap_stats, seam_texels)) == 0);
 }
+
+TEST_CASE("C ABI options: the scene description's opacity fields default to all opaque, also for an older struct_size", "[capi]") {
+  const hemilight_bake_scene_desc d = capi::default_bake_scene_desc();
+  CHECK(d.struct_size == sizeof d);
+  CHECK(d.mesh_opacity == nullptr);
+  CHECK(d.alpha_textures == nullptr);
+  CHECK(d.alpha_texture_count == 0);
+  // hemilight_bake_scene_desc_init_sized fills the same defaults.
+  hemilight_bake_scene_desc inited;
+  std::memset(&inited, 0x01, sizeof inited);
+  hemilight_bake_scene_desc_init_sized(&inited, sizeof inited);
+  CHECK(inited.mesh_opacity == nullptr);
+  CHECK(inited.alpha_textures == nullptr);
+  CHECK(inited.alpha_texture_count == 0);
+  CHECK(inited.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION);
+  // Every field the caller's struct holds is read.
+  const hemilight_mesh_opacity mesh_opacity[1] = {};
+  const std::uint8_t values[1] = {255};
+  const hemilight_alpha_texture texture[1] = {{values, 1, 1}};
+  hemilight_bake_scene_desc full = capi::default_bake_scene_desc();
+  full.mesh_opacity = mesh_opacity;
+  full.alpha_textures = texture;
+  full.alpha_texture_count = 1;
+  hemilight_bake_scene_desc read = capi::default_bake_scene_desc();
+  REQUIRE(capi::read_sized(&full, read).empty());
+  CHECK(read.mesh_opacity == mesh_opacity);
+  CHECK(read.alpha_textures == texture);
+  CHECK(read.alpha_texture_count == 1);
+  // The layout before the opacity fields (up to occluder_radiance and its tail padding: 56 bytes
+  // on LP64): they take their defaults, whatever lies beyond the caller's struct.
+  hemilight_bake_scene_desc older;
+  std::memset(&older, 0x01, sizeof older);
+  older.struct_size = offsetof(hemilight_bake_scene_desc, mesh_opacity);
+  older.occluder_radiance = HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE;
+  CHECK((sizeof(void*) != 8 || older.struct_size == 56));
+  hemilight_bake_scene_desc older_read = capi::default_bake_scene_desc();
+  REQUIRE(capi::read_sized(&older, older_read).empty());
+  CHECK(older_read.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION_PLUS_MEAN_BOUNCE);  // read: within the older size
+  CHECK(older_read.mesh_opacity == nullptr);
+  CHECK(older_read.alpha_textures == nullptr);
+  CHECK(older_read.alpha_texture_count == 0);
+  // An init with the older size writes nothing past it.
+  hemilight_bake_scene_desc guarded;
+  std::memset(&guarded, 0x5a, sizeof guarded);
+  hemilight_bake_scene_desc_init_sized(&guarded, offsetof(hemilight_bake_scene_desc, mesh_opacity));
+  hemilight_bake_scene_desc untouched;
+  std::memset(&untouched, 0x5a, sizeof untouched);
+  CHECK(std::memcmp(&guarded.mesh_opacity, &untouched.mesh_opacity,
+                    sizeof guarded - offsetof(hemilight_bake_scene_desc, mesh_opacity)) == 0);
+  CHECK(guarded.occluder_radiance == HEMILIGHT_OCCLUDER_EMISSION);
+}
+
+TEST_CASE("C ABI options: the opacity defaults are the C++ material's", "[capi]") {
+  const material m;  // the C++ defaults
+  const hemilight_opacity macro = HEMILIGHT_OPACITY_DEFAULT;
+  hemilight_opacity inited;
+  std::memset(&inited, 0x01, sizeof inited);
+  hemilight_opacity_init(&inited);
+  hemilight_opacity_init(nullptr);  // ignored
+  for (const hemilight_opacity& o : {macro, inited}) {
+    CHECK(o.mode == HEMILIGHT_OPAQUE);
+    CHECK(o.alpha == m.alpha);
+    CHECK(o.alpha_cutoff == m.alpha_cutoff);
+    CHECK(o.alpha_texture == m.alpha_texture);
+    for (int c = 0; c < 3; ++c) CHECK(o.transmittance[c] == m.transmittance[c]);
+  }
+  CHECK(m.opacity == surface_opacity::opaque);
+}
+
+TEST_CASE("C ABI options: every opacity field reaches the C++ material, and only the mode's", "[capi]") {
+  material m;
+  m.emission = glm::vec3(2.0f);
+  m.albedo = glm::vec3(0.5f);
+  m.two_sided = true;
+  hemilight_opacity o = HEMILIGHT_OPACITY_DEFAULT;
+  o.mode = HEMILIGHT_ALPHA_TESTED;
+  o.alpha = 0.75f;
+  o.alpha_cutoff = 0.25f;
+  o.alpha_texture = 3;
+  o.transmittance[0] = 0.5f;  // not the mode's: the default
+  capi::apply_opacity(o, m);
+  CHECK(m.opacity == surface_opacity::alpha_tested);
+  CHECK(m.alpha == 0.75f);
+  CHECK(m.alpha_cutoff == 0.25f);
+  CHECK(m.alpha_texture == 3);
+  CHECK(m.transmittance == glm::vec3(0.0f));
+  // The material's other fields are kept.
+  CHECK(m.emission == glm::vec3(2.0f));
+  CHECK(m.albedo == glm::vec3(0.5f));
+  CHECK(m.two_sided);
+  o.mode = HEMILIGHT_TRANSLUCENT;
+  o.transmittance[1] = 0.25f;
+  o.transmittance[2] = 1.0f;
+  capi::apply_opacity(o, m);
+  CHECK(m.opacity == surface_opacity::translucent);
+  CHECK(m.transmittance == glm::vec3(0.5f, 0.25f, 1.0f));
+  CHECK(m.alpha == material{}.alpha);  // not the mode's: the defaults again
+  CHECK(m.alpha_cutoff == material{}.alpha_cutoff);
+  CHECK(m.alpha_texture == -1);
+  o.mode = HEMILIGHT_OPAQUE;
+  capi::apply_opacity(o, m);
+  CHECK(m.opacity == surface_opacity::opaque);
+  CHECK(m.transmittance == glm::vec3(0.0f));
+}

@@ -472,3 +472,375 @@ TEST_CASE("Model import: UVs a hair outside [0, 1] are taken, UV-less triangles 
   CHECK_NOTHROW(model_import::import_model(flat, io));
   import_fails(flat, strict, "mesh 0 ('Floor') at node 'floor' triangle 0 has zero area in lightmap UV space");
 }
+
+// ---- opacity: glTF alpha modes, alpha textures, transmission --------------------------------------
+
+namespace {
+
+// An RGBA (or RGB: channels 3) PNG in memory, made by stb_image_write.
+std::vector<unsigned char> png_bytes(int w, int h, int channels, const std::vector<unsigned char>& pixels) {
+  std::vector<unsigned char> out;
+  const auto append = [](void* context, void* data, int size) {
+    auto* v = static_cast<std::vector<unsigned char>*>(context);
+    v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+  };
+  REQUIRE(stbi_write_png_to_func(append, &out, w, h, channels, pixels.data(), w * channels) != 0);
+  return out;
+}
+
+// 4 x 4 RGBA: alpha 255 in the top-left quadrant (rows 0-1, columns 0-1), 0 elsewhere; red.
+std::vector<unsigned char> quadrants_rgba() {
+  std::vector<unsigned char> p(4 * 4 * 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      unsigned char* t = &p[std::size_t(4 * (4 * y + x))];
+      t[0] = 255, t[1] = 0, t[2] = 0, t[3] = x < 2 && y < 2 ? 255 : 0;
+    }
+  return p;
+}
+
+// 4 x 1 RGBA: alphas 0, 85, 170, 255 (mean 0.5); white.
+std::vector<unsigned char> stripes_rgba() {
+  std::vector<unsigned char> p(4 * 4, 255);
+  for (std::size_t x = 0; x < 4; ++x) p[4 * x + 3] = static_cast<unsigned char>(85 * x);
+  return p;
+}
+
+// A glTF of unit floor quads (x, z in [0, 1] x [-1, 0], facing up), one mesh per entry of
+// `material_of_mesh` (its material), node k at translations[k]. Every mesh has TEXCOORD_0 = (x, 1 + z)
+// (v = 0 at the far edge z = -1: the image's first row there) and TEXCOORD_1 = (x, -z) (the
+// lightmap UVs). `materials` and `images` are the JSON arrays' contents; texture k uses image k.
+std::string write_quads(const std::string& name, const std::string& materials, const std::vector<std::string>& image_uris,
+                        const std::vector<int>& material_of_mesh, const std::vector<glm::vec3>& translations) {
+  const std::string dir = std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name;
+  std::filesystem::create_directories(dir);
+  std::vector<unsigned char> buf;
+  put<float>(buf, {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1});  // 0: positions (48)
+  put<float>(buf, {0, 1, 1, 1, 1, 0, 0, 0});              // 48: TEXCOORD_0 (32)
+  put<float>(buf, {0, 0, 1, 0, 1, 1, 0, 1});              // 80: TEXCOORD_1 (32)
+  put<std::uint16_t>(buf, {0, 1, 2, 0, 2, 3});            // 112: indices (12)
+  std::string meshes, nodes, scene_nodes, textures, images;
+  for (std::size_t k = 0; k < material_of_mesh.size(); ++k) {
+    const std::string sep = k ? ", " : "";
+    meshes += sep + R"({"name": "Quad)" + std::to_string(k) +
+              R"(", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "indices": 3, "material": )" +
+              std::to_string(material_of_mesh[k]) + "}]}";
+    const glm::vec3 t = translations[k];
+    nodes += sep + R"({"name": "quad)" + std::to_string(k) + R"(", "mesh": )" + std::to_string(k) + R"(, "translation": [)" +
+             std::to_string(t.x) + ", " + std::to_string(t.y) + ", " + std::to_string(t.z) + "]}";
+    scene_nodes += sep + std::to_string(k);
+  }
+  for (std::size_t k = 0; k < image_uris.size(); ++k) {
+    const std::string sep = k ? ", " : "";
+    textures += sep + R"({"source": )" + std::to_string(k) + "}";
+    images += sep + R"({"uri": ")" + image_uris[k] + R"("})";
+  }
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [)" + scene_nodes + R"(]}],
+  "extensionsUsed": ["KHR_materials_transmission"],
+  "nodes": [)" + nodes + R"(], "meshes": [)" + meshes + R"(], "materials": [)" + materials + "]," +
+                           (image_uris.empty() ? "" : R"("textures": [)" + textures + R"(], "images": [)" + images + "],") + R"(
+  "buffers": [{"byteLength": )" + std::to_string(buf.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(buf) + R"("}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                  {"buffer": 0, "byteOffset": 80, "byteLength": 32}, {"buffer": 0, "byteOffset": 112, "byteLength": 12}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, -1], "max": [1, 0, 0]},
+                {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+                {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+  const std::string path = dir + "/quads.gltf";
+  std::ofstream(path) << gltf;
+  return path;
+}
+
+// Each mesh at (2k, 0, 0).
+std::vector<glm::vec3> side_by_side(std::size_t n) {
+  std::vector<glm::vec3> t;
+  for (std::size_t k = 0; k < n; ++k) t.emplace_back(2.0f * float(k), 0.0f, 0.0f);
+  return t;
+}
+
+// The files of the opacity tests: quadrants.png (RGBA, next to the model), opaque.png (RGB), the
+// stripes as a data URI (embedded), broken.png (not a PNG).
+struct opacity_files {
+  std::string dir, stripes_uri;
+  explicit opacity_files(const std::string& name) : dir(std::string(HEMILIGHT_TEST_TMPDIR) + "/" + name) {
+    std::filesystem::create_directories(dir);
+    REQUIRE(stbi_write_png((dir + "/quadrants.png").c_str(), 4, 4, 4, quadrants_rgba().data(), 16) != 0);
+    const std::vector<unsigned char> grey(4 * 4 * 3, 128);
+    REQUIRE(stbi_write_png((dir + "/opaque.png").c_str(), 4, 4, 3, grey.data(), 12) != 0);
+    std::ofstream(dir + "/broken.png") << "not a PNG at all";
+    std::filesystem::remove(dir + "/missing.png");
+    stripes_uri = "data:image/png;base64," + base64(png_bytes(4, 1, 4, stripes_rgba()));
+  }
+};
+
+const model_import::material& material_named(const model_import::model& m, const std::string& name) {
+  for (const model_import::material& mat : m.materials)
+    if (mat.name == name) return mat;
+  FAIL("no material '" << name << "'");
+  return m.materials.front();
+}
+
+const model_import::mesh& mesh_with_material(const model_import::model& m, const std::string& name) {
+  for (const model_import::mesh& me : m.meshes)
+    if (m.materials[me.material].name == name) return me;
+  FAIL("no mesh with material '" << name << "'");
+  return m.meshes.front();
+}
+
+// The model's meshes as one scene, as hemilight_bake builds it (examples/bake.cpp, model_scene):
+// flat materials, the texcoords of the meshes whose material reads an alpha texture, the alpha
+// textures.
+struct model_scene_arrays {
+  scene_mesh mesh;
+  std::vector<std::size_t> first_triangle;  // per model mesh
+  explicit model_scene_arrays(const model_import::model& m) {
+    bool textured = false;
+    for (const model_import::mesh& me : m.meshes) textured = textured || m.materials[me.material].alpha_texture >= 0;
+    for (const model_import::mesh& me : m.meshes) {
+      first_triangle.push_back(mesh.triangle_count());
+      const auto base = std::uint32_t(mesh.positions.size());
+      mesh.positions.insert(mesh.positions.end(), me.positions.begin(), me.positions.end());
+      mesh.lightmap_uvs.insert(mesh.lightmap_uvs.end(), me.lightmap_uvs.begin(), me.lightmap_uvs.end());
+      for (std::uint32_t i : me.indices) mesh.indices.push_back(base + i);
+      mesh.materials.insert(mesh.materials.end(), me.indices.size() / 3, m.materials[me.material].flat(m.textures));
+      if (!textured) continue;
+      std::vector<glm::vec2> tc = model_import::mesh_texcoords(m, me);
+      tc.resize(me.positions.size(), glm::vec2(0.0f));
+      mesh.texcoords.insert(mesh.texcoords.end(), tc.begin(), tc.end());
+    }
+    mesh.alpha_textures = m.alpha_textures;
+  }
+};
+
+const char* const opacity_materials = R"(
+  {"name": "Leaves", "alphaMode": "MASK", "alphaCutoff": 0.3,
+   "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.9], "baseColorTexture": {"index": 0}}},
+  {"name": "LeavesToo", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+  {"name": "Cutout", "alphaMode": "MASK", "alphaCutoff": 0.6, "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.5]}},
+  {"name": "Solid mask", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.7], "baseColorTexture": {"index": 1}}},
+  {"name": "Veil", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 0.4]}},
+  {"name": "Striped veil", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.5], "baseColorTexture": {"index": 2}}},
+  {"name": "Glass", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 1, 1, 1]},
+   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.8}}},
+  {"name": "Frosted", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0, 0.5]},
+   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5}}},
+  {"name": "Plain", "alphaMode": "OPAQUE", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]}},
+  {"name": "Leaves1", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}},
+  {"name": "Striped mask", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 2}}}
+)";
+
+}  // namespace
+
+TEST_CASE("Model import: glTF alpha modes, cutoffs, factors, alpha textures and transmission become the scene's opacity",
+          "[model_import]") {
+  const opacity_files files("import_opacity");
+  const std::vector<int> mesh_materials = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  const std::string path =
+      write_quads("import_opacity", opacity_materials, {"quadrants.png", "opaque.png", files.stripes_uri}, mesh_materials,
+                  side_by_side(mesh_materials.size()));
+  const model_import::model m = model_import::import_model(path);
+  REQUIRE(m.meshes.size() == mesh_materials.size());
+  // Alpha-tested: the factor, the cutoff (default 0.5), the image's alpha channel as the texture,
+  // one per image (two materials share the quadrants), decoded exactly.
+  const model_import::material& leaves = material_named(m, "Leaves");
+  CHECK(leaves.opacity == surface_opacity::alpha_tested);
+  CHECK(leaves.alpha == 0.9f);
+  CHECK(leaves.alpha_cutoff == 0.3f);
+  CHECK(leaves.alpha_mode == "MASK");
+  REQUIRE(leaves.alpha_texture == 0);
+  const model_import::material& leaves_too = material_named(m, "LeavesToo");
+  CHECK(leaves_too.opacity == surface_opacity::alpha_tested);
+  CHECK(leaves_too.alpha == 1.0f);
+  CHECK(leaves_too.alpha_cutoff == 0.5f);
+  CHECK(leaves_too.alpha_texture == 0);
+  const model_import::material& striped_mask = material_named(m, "Striped mask");
+  REQUIRE(striped_mask.alpha_texture == 1);  // the embedded image
+  REQUIRE(m.alpha_textures.size() == 2);
+  const std::vector<unsigned char> quadrants = quadrants_rgba();
+  CHECK(m.alpha_textures[0].width == 4);
+  CHECK(m.alpha_textures[0].height == 4);
+  REQUIRE(m.alpha_textures[0].values.size() == 16);
+  for (std::size_t i = 0; i < 16; ++i) CHECK(m.alpha_textures[0].values[i] == quadrants[4 * i + 3]);
+  CHECK(m.alpha_textures[1].values == std::vector<std::uint8_t>{0, 85, 170, 255});
+  CHECK(m.textures[std::size_t(m.alpha_sources[0])].source.find("quadrants.png") != std::string::npos);
+  CHECK(m.textures[std::size_t(m.alpha_sources[1])].source.find("embedded") != std::string::npos);
+  // The alpha factor alone below the cutoff: alpha-tested without a texture (never present).
+  const model_import::material& cutout = material_named(m, "Cutout");
+  CHECK(cutout.opacity == surface_opacity::alpha_tested);
+  CHECK(cutout.alpha == 0.5f);
+  CHECK(cutout.alpha_cutoff == 0.6f);
+  CHECK(cutout.alpha_texture == -1);
+  // MASK with an RGB texture (no alpha channel) and the factor above the cutoff: present everywhere.
+  CHECK(material_named(m, "Solid mask").opacity == surface_opacity::opaque);
+  CHECK(material_named(m, "Solid mask").alpha_texture == -1);
+  // BLEND: 1 - alpha (grey), alpha = factor x the texture's mean alpha.
+  const model_import::material& veil = material_named(m, "Veil");
+  CHECK(veil.opacity == surface_opacity::translucent);
+  CHECK(glm::length(veil.transmittance - glm::vec3(0.6f)) < 1e-6f);
+  CHECK(glm::length(material_named(m, "Striped veil").transmittance - glm::vec3(0.75f)) < 1e-6f);
+  // Transmission: factor x base colour; with BLEND: (1 - a) + a x that.
+  const model_import::material& glass = material_named(m, "Glass");
+  CHECK(glass.opacity == surface_opacity::translucent);
+  CHECK(glass.transmission == 0.8f);
+  CHECK(glm::length(glass.transmittance - glm::vec3(0.4f, 0.8f, 0.8f)) < 1e-6f);
+  CHECK(glm::length(material_named(m, "Frosted").transmittance - glm::vec3(0.75f, 0.625f, 0.5f)) < 1e-6f);
+  // OPAQUE ignores the factor's alpha; the default material assimp adds is opaque.
+  CHECK(material_named(m, "Plain").opacity == surface_opacity::opaque);
+  std::size_t see_through = 0;
+  for (const model_import::material& mat : m.materials) see_through += mat.opacity != surface_opacity::opaque;
+  CHECK(see_through == 9);
+  // flat() carries it to the scene's material.
+  const material flat = leaves.flat(m.textures);
+  CHECK(flat.opacity == surface_opacity::alpha_tested);
+  CHECK(flat.alpha == 0.9f);
+  CHECK(flat.alpha_cutoff == 0.3f);
+  CHECK(flat.alpha_texture == 0);
+  CHECK(glass.flat(m.textures).transmittance == glass.transmittance);
+  // The texcoords: the texture's own set as the file stores it (glTF's v), not the lightmap UVs.
+  const std::vector<glm::vec2> tc0 = model_import::mesh_texcoords(m, mesh_with_material(m, "Leaves"));
+  CHECK(tc0 == std::vector<glm::vec2>{{0, 1}, {1, 1}, {1, 0}, {0, 0}});
+  const std::vector<glm::vec2> tc1 = model_import::mesh_texcoords(m, mesh_with_material(m, "Leaves1"));
+  CHECK(tc1 == std::vector<glm::vec2>{{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  CHECK(model_import::mesh_texcoords(m, mesh_with_material(m, "Cutout")).empty());  // no texture read
+  CHECK(model_import::mesh_texcoords(m, mesh_with_material(m, "Glass")).empty());
+  // One line names them.
+  const std::string line = model_import::opacity_summary(m);
+  INFO(line);
+  CHECK(line.find("9 of " + std::to_string(m.materials.size()) + " materials let light through") == 0);
+  CHECK(line.find("'Leaves' alpha-tested (MASK, cutoff 0.3, alpha 0.9, alpha texture '") != std::string::npos);
+  CHECK(line.find("quadrants.png' 4 x 4)") != std::string::npos);
+  CHECK(line.find("'Glass' translucent (transmission 0.8: transmittance 0.4, 0.8, 0.8)") != std::string::npos);
+  CHECK(line.find("'Veil' translucent (BLEND: transmittance 0.6)") != std::string::npos);
+  CHECK(line.find('\n') == std::string::npos);
+  // Without see-through materials: no line.
+  CHECK(model_import::opacity_summary(model_import::import_model(write_quad("import_opaque_quad", {0, 0, 0, 1, 1, 1, 1, 0}))).empty());
+}
+
+TEST_CASE("Model import: the alpha texture reaches the scene the right way round (row 0 at v = 0, u along the columns)",
+          "[model_import]") {
+  // The quadrants texture: present in its top-left quadrant only (rows 0-1, columns 0-1). On the
+  // quad, TEXCOORD_0 = (x, 1 + z): the top-left quadrant is x < 0.5, z < -0.5.
+  const opacity_files files("import_alpha_orientation");
+  const std::string path = write_quads("import_alpha_orientation", opacity_materials, {"quadrants.png", "opaque.png", files.stripes_uri},
+                                       {0, 9}, side_by_side(2));
+  const model_import::model m = model_import::import_model(path);
+  const model_scene_arrays a(m);
+  const std::shared_ptr<const scene> sc = scene::create(a.mesh.desc());
+  for (std::size_t k = 0; k < m.meshes.size(); ++k) {
+    const model_import::mesh& me = m.meshes[k];
+    // The texture's own UV set: TEXCOORD_0 = (x, 1 + z) for 'Leaves', TEXCOORD_1 = (x, -z) for 'Leaves1'.
+    const bool set1 = m.materials[me.material].name == "Leaves1";
+    for (std::size_t t = 0; t < 2; ++t) {
+      const std::size_t tri = a.first_triangle[k] + t;
+      const std::uint32_t* v = &me.indices[3 * t];
+      // Points at the quadrants' centres inside this triangle (barycentrics from the positions).
+      const glm::vec3 p0 = me.positions[v[0]], e1 = me.positions[v[1]] - p0, e2 = me.positions[v[2]] - p0;
+      for (const glm::vec2 q : {glm::vec2(0.25f, -0.75f), glm::vec2(0.75f, -0.75f), glm::vec2(0.25f, -0.25f), glm::vec2(0.75f, -0.25f)}) {
+        const glm::vec2 d(q.x + 2.0f * float(k) - p0.x, q.y - p0.z);  // the point in the triangle's plane (y = 0)
+        const float det = e1.x * e2.z - e1.z * e2.x;
+        const float b1 = (d.x * e2.z - d.y * e2.x) / det, b2 = (e1.x * d.y - e1.z * d.x) / det;
+        if (b1 < 0.0f || b2 < 0.0f || b1 + b2 > 1.0f) continue;  // in the other triangle
+        const glm::vec2 uv = set1 ? glm::vec2(q.x, -q.y) : glm::vec2(q.x, 1.0f + q.y);
+        const bool want = uv.x < 0.5f && uv.y < 0.5f;
+        INFO(m.materials[me.material].name << " triangle " << t << " at (x, z) = (" << q.x << ", " << q.y << ")");
+        CHECK(sc->alpha_present(tri, b1, b2) == want);
+      }
+    }
+  }
+}
+
+TEST_CASE("Model import: a texture an alpha-tested material cannot read, or cannot find UVs for, is an error naming it",
+          "[model_import]") {
+  const opacity_files files("import_opacity_errors");
+  const std::string mask = R"({"name": "Leaves", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})";
+  const model_import::import_options io;
+  import_fails(write_quads("import_opacity_errors", mask, {"missing.png"}, {0}, side_by_side(1)), io,
+               "material 0 ('Leaves'): texture '");
+  import_fails(write_quads("import_opacity_errors", mask, {"missing.png"}, {0}, side_by_side(1)), io, "missing.png' cannot be read");
+  import_fails(write_quads("import_opacity_errors", mask, {"broken.png"}, {0}, side_by_side(1)), io, "broken.png' cannot be read");
+  const std::string set2 = R"({"name": "Leaves", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}})";
+  import_fails(write_quads("import_opacity_errors", set2, {"quadrants.png"}, {0}, side_by_side(1)), io,
+               "mesh 0 ('Quad0') at node 'quad0': its material 0 ('Leaves') reads its alpha texture at UV channel 2 (TEXCOORD_2), "
+               "which the mesh does not have");
+  // ignore_opacity: every material opaque and counted; textures are still read (and still fail).
+  model_import::import_options ignore;
+  ignore.ignore_opacity = true;
+  const model_import::model m = model_import::import_model(
+      write_quads("import_opacity_errors", opacity_materials, {"quadrants.png", "opaque.png", files.stripes_uri},
+                  {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}, side_by_side(11)),
+      ignore);
+  for (const model_import::material& mat : m.materials) CHECK(mat.opacity == surface_opacity::opaque);
+  CHECK(m.alpha_textures.empty());
+  CHECK(m.ignored_see_through == 9);  // the always-present MASK is opaque anyway
+  CHECK(model_import::opacity_summary(m) == "9 see-through materials baked opaque (opacity ignored)");
+  import_fails(write_quads("import_opacity_errors", mask, {"broken.png"}, {0}, side_by_side(1)), ignore, "broken.png' cannot be read");
+}
+
+TEST_CASE("Model export: the alpha mode, cutoff, base alpha and transmission of an imported model are written back", "[model_import]") {
+  const opacity_files files("export_opacity");
+  const model_import::model m = model_import::import_model(
+      write_quads("export_opacity", opacity_materials, {"quadrants.png", "opaque.png", files.stripes_uri},
+                  {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}, side_by_side(11)));
+  const std::string glb = files.dir + "/back.glb";
+  model_export::write_glb(m, glb);
+  const model_import::model back = model_import::import_model(glb);
+  for (const char* name : {"Leaves", "LeavesToo", "Cutout", "Solid mask", "Veil", "Glass", "Frosted", "Plain", "Leaves1"}) {
+    INFO(name);
+    const model_import::material &a = material_named(m, name), &b = material_named(back, name);
+    CHECK(b.alpha_mode == a.alpha_mode);
+    CHECK(b.base_alpha == a.base_alpha);
+    CHECK(b.gltf_alpha_cutoff == a.gltf_alpha_cutoff);
+    CHECK(b.transmission == a.transmission);
+    CHECK(b.opacity == a.opacity);
+    CHECK(b.alpha == a.alpha);
+    CHECK(b.alpha_cutoff == a.alpha_cutoff);
+    CHECK(glm::length(b.transmittance - a.transmittance) < 1e-6f);
+    CHECK((b.alpha_texture >= 0) == (a.alpha_texture >= 0));  // the file texture (quadrants.png) is written
+  }
+}
+
+TEST_CASE("Model import: a half-open alpha-textured card from glTF shades the floor under its closed quadrant only", "[model_import][opacity]") {
+  // The floor (material 'Plain', lightmap UVs over the page) and the 'Leaves' card 0.5 above it:
+  // present in the quadrant x < 0.5, z < -0.5 only (alpha 0.9 x texture >= 0.3). A hard sun of
+  // irradiance 2 straight down, sky 0, one bounce: the floor texels under that quadrant 0, the
+  // rest 2 (texels whose footprint reaches the quadrant's edge left out).
+  const opacity_files files("import_opacity_shadow");
+  const std::string path = write_quads("import_opacity_shadow", opacity_materials, {"quadrants.png", "opaque.png", files.stripes_uri},
+                                       {8, 0}, {glm::vec3(0.0f), glm::vec3(0.0f, 0.5f, 0.0f)});
+  const model_import::model m = model_import::import_model(path);
+  REQUIRE(m.meshes.size() == 2);
+  const model_scene_arrays a(m);
+  scene_bake_input in;
+  in.geometry.scene = a.mesh.desc();
+  lightmap_page page;
+  page.width = page.height = 8;
+  in.pages = {page};
+  for (std::size_t k = 0; k < 2; ++k) {
+    bake_mesh bm;
+    bm.first_triangle = a.first_triangle[k];
+    bm.triangle_count = 2;
+    bm.page = m.materials[m.meshes[k].material].name == "Plain" ? 0 : -1;  // the card: an occluder
+    in.meshes.push_back(bm);
+  }
+  bake_options o;
+  o.sampler.resolution = 16;
+  o.thread_count = 2;
+  light sun;
+  sun.type = light_type::directional;
+  sun.direction = {0, -1, 0};
+  sun.color = glm::vec3(2.0f);
+  o.lights = {sun};
+  const scene_bake_result r = bake_scene(in, o);
+  // Page texel (x, y): lightmap UV = (x, -z) of the floor, so x < 4 and y >= 4 lie under the quadrant.
+  int wrong = 0;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      if (x == 3 || x == 4 || y == 3 || y == 4) continue;  // next to the quadrant's edges
+      const float want = x < 4 && y >= 4 ? 0.0f : 2.0f, e = r.pages[0].irradiance.at(x, y)[0];
+      if (!(std::fabs(e - want) < 1e-5f)) {
+        ++wrong;
+        UNSCOPED_INFO("texel (" << x << ", " << y << ") = " << e << ", expected " << want);
+      }
+    }
+  CHECK(wrong == 0);
+}
