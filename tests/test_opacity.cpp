@@ -186,6 +186,27 @@ TEST_CASE("opacity: a hemicube sees the ceiling through the checker card's open 
   }
 }
 
+TEST_CASE("opacity: the back of a one-sided see-through card is black but not a back face", "[opacity]") {
+  // The card at z = 1 faces down (add_card), towards the point; flipped, the point sees its back.
+  for (surface_opacity o : {surface_opacity::opaque, surface_opacity::alpha_tested}) {
+    scene_mesh mesh;
+    material card;
+    card.emission = glm::vec3(0.5f);
+    card.opacity = o;
+    add_card(mesh, 1.0f, 1.0f, card);
+    std::swap(mesh.indices[1], mesh.indices[2]);
+    std::swap(mesh.indices[4], mesh.indices[5]);
+    const auto s = scene::create(mesh.desc());
+    hemicube_rasterizer r(s);
+    hemicube_buffer buf;
+    r.render({0.0f, 0.0f, 0.0f}, up, 32, buf);
+    const std::size_t centre = hemicube_texel_index(32, {hemicube_face::top, 16, 16});
+    CHECK(buf.radiance_at(centre) == glm::vec3(0.0f));
+    CHECK(buf.distance[centre] == Approx(1.0f / hemicube_texel_direction(32, centre).z).epsilon(1e-5));
+    CHECK(buf.flags[centre] == (o == surface_opacity::opaque ? texel_back_face : texel_hit_front));
+  }
+}
+
 TEST_CASE("opacity: see-through renders are bitwise the same on every path and with occlusion culling", "[opacity]") {
   scene_mesh mesh = checker_scene();
   // Enough opaque triangles behind the card for the culling to matter: a floor grid below the point.

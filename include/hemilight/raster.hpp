@@ -20,7 +20,8 @@
 //     the opaque ones by a per-texel ray test (watertight: a texel centre on an edge two of them
 //     share belongs to one): an alpha-tested one covers a texel where it is nearer and present at
 //     the centre (scene::alpha_present; also with edge_coverage, no partial coverage), and loses a
-//     depth tie to an opaque one; translucent ones never set depth, distance or flags: per texel
+//     depth tie to an opaque one; seen from behind, a one-sided one is black without
+//     texel_back_face (cards are no closed surfaces: they do not make a texel look inside geometry); translucent ones never set depth, distance or flags: per texel
 //     the layers in front of what it sees are composited far to near, L = transmittance L + the
 //     layer's own radiance (emission, or the texture at its lightmap UV; 0 seen from behind a
 //     one-sided one). They occlude nothing in the occlusion culling (they are tested against it),

@@ -327,6 +327,7 @@ class alignas(64) rasterizer_impl {
   void keep_cutouts(const hemicube_buffer& out);
   void restore_cutouts(hemicube_buffer& out) const;
   void composite_translucent(hemicube_buffer& out, const radiance_texture* texture);
+  std::uint32_t see_through_back_key_ = 0;  // the shade of a see-through triangle's back (bind)
   std::vector<translucent_fragment> translucent_;
   std::vector<translucent_draw> translucent_draws_;
   std::vector<std::uint32_t> cutouts_;  // texels an alpha-tested fragment won when drawn

@@ -313,6 +313,10 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
   for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
+  // The back of a one-sided see-through triangle: black, but not a back face to the tests for
+  // texels inside geometry (a card or a pane is no closed surface). Only when the scene has them.
+  see_through_back_key_ = static_cast<std::uint32_t>(shades_.size());
+  if (!scene_->see_through_triangles().empty()) shades_.push_back({0.0f, 0.0f, 0.0f, texel_hit_front});
   // Texel ids are draw << key_bits_ | key when both fit in 31 bits (draws: at most one per
   // drawable triangle, plus draw 0); the resolve then reads the key from the id instead of
   // looking it up per draw (a gather per group of eight texels). Ids stay below 2^31: the

@@ -223,7 +223,14 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
           continue;
         }
         if (!scene_->alpha_present(tri.index, glm::dot(grad_b1, q), glm::dot(grad_b2, q))) continue;
-        if (draw == 0) draw = commit_draw(rec.plane, tri, &rec, basis);
+        if (draw == 0) {
+          draw = commit_draw(rec.plane, tri, &rec, basis);
+          if (back) {  // black, without the back-face flag (bind's see_through_back_key_)
+            const auto number = static_cast<std::uint32_t>(draw_keys_.size() - 1);
+            draw_keys_.back() = see_through_back_key_;
+            draw = key_bits_ ? number << key_bits_ | see_through_back_key_ : number;
+          }
+        }
         depth_[i] = z;
         ids_[i] = draw;
         cutouts_.push_back(static_cast<std::uint32_t>(i));
