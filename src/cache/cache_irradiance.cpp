@@ -59,12 +59,13 @@ struct coverage_detail {
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
 // `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered),
-// `cone` the same of the HL2 cones, `detail` (optional) what coverage_detail describes.
+// `cone` the same of the HL2 cones, `ao` the same of their ambient occlusion, `detail` (optional)
+// what coverage_detail describes.
 float interpolate(const std::vector<cache_record>& records, const record_lists& lists, const record_bvh& large, std::size_t point, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
                   coverage_detail* detail = nullptr,
-                  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked = nullptr) {
+                  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked = nullptr, float* ao = nullptr) {
   // 1. The covering records and their weights, then in record order: the sums below do not
   // depend on how the lists and the tree report records (the same order as interpolate_records).
   struct covering {
@@ -90,7 +91,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
   std::array<glm::vec3, 4> sh_sum{};
   hl2_cone cone_sum;
   if (cone) cone_sum.reference = make_frame(n).t;
-  float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  float wsum = 0.0f, ao_sum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   const int order = prediction_order(o);
   for (const covering& c : cover) {
@@ -106,6 +107,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
       const hl2_cone rc = rotate_hl2_cone(r.cone, r.normal, cone_sum.reference);
       for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * rc.coefficients[k];
     }
+    if (ao) ao_sum += w * r.ao;
     const float l = luminance(e);
     lo = std::min(lo, l);
     hi = std::max(hi, l);
@@ -127,6 +129,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
       for (glm::vec3& c : cone_sum.coefficients) c /= wsum;
     *cone = cone_sum;
   }
+  if (ao) *ao = wsum > 0.0f ? ao_sum / wsum : 0.0f;
   if (detail) detail->visited = visited;
   if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
   if (own) *own = at_record;
@@ -627,6 +630,7 @@ class placement {
       r.sh_l1 = s.sh_l1;
       r.cone = s.cone;
     }
+    if (r_.ao) r.ao = s.ao;
     float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o_.max_radius;
     r.limit = std::isfinite(s.harmonic_mean_distance) ? radius_limit::split_sphere : radius_limit::max_radius;
     if (o_.expert.limit_radius_by_gradient) {
@@ -918,19 +922,22 @@ class placement {
       result.sh_l1.assign(count_, std::array<glm::vec3, 4>{});
       result.cone.assign(count_, hl2_cone{});
     }
+    if (r_.ao) result.ao.assign(count_, 0.0f);
     parallel_for(count_, threads_, 4096, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
+        float ao = 0.0f;
         if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, r_.directional ? &sh : nullptr,
-                                      r_.directional ? &cone : nullptr, nullptr, blocked()) > 0.0f) {
+                                      r_.directional ? &cone : nullptr, nullptr, blocked(), r_.ao ? &ao : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
           if (r_.directional) {
             result.sh_l1[i] = sh;
             result.cone[i] = cone;
           }
+          if (r_.ao) result.ao[i] = ao;
         }
       }
     });
@@ -991,11 +998,12 @@ class placement {
     std::array<glm::vec3, 4> sh{};
     hl2_cone cone;
     cone.reference = make_frame(n_[i]).t;
-    float wsum = 0.0f;
+    float wsum = 0.0f, ao = 0.0f;
     for (const auto& bw : best)
       if (bw.first > 0.0f) {
         const cache_record& rec = records_[bw.second];
         sum += bw.first * rec.irradiance;
+        ao += bw.first * rec.ao;
         if (r_.directional) {
           for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
           const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
@@ -1004,6 +1012,7 @@ class placement {
         wsum += bw.first;
       }
     result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+    if (r_.ao) result.ao[i] = wsum > 0.0f ? ao / wsum : 0.0f;
     if (r_.directional && wsum > 0.0f) {
       for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
       for (glm::vec3& c : cone.coefficients) c /= wsum;
