@@ -36,6 +36,10 @@ constexpr std::size_t list_entries_per_point = 8;
 // render_seeds marks a seed that cache_run::inside_test called inside with this backface
 // fraction (no hemicube; a sampler never returns more than 1).
 constexpr float tested_inside = 2.0f;
+// With cache_run::ao and cache_expert_options::refine_where_ao_disagrees, the coverage tests hold
+// the AO the records predict to a x max(AO, ao_floor), as they hold E to a x max(E, 5% of the mean
+// record E): AO is a fraction in [0, 1], so its floor is absolute.
+constexpr float ao_floor = 0.05f;
 
 // A seed of pick_seeds: where it is and its normal.
 struct seed {
@@ -53,6 +57,7 @@ struct coverage_detail {
   std::uint32_t last = 0;        // index of the last covering record (the only one when records == 1)
   float last_prediction = 0.0f;  // its luminance prediction at the point
   std::size_t visited = 0;       // records whose box the query visited (covering or not)
+  float ao_lo = 0.0f, ao_hi = 0.0f;  // the covering records' smallest and largest AO (with `ao`)
 };
 
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
@@ -108,6 +113,10 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
       for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * rc.coefficients[k];
     }
     if (ao) ao_sum += w * r.ao;
+    if (ao && detail) {
+      detail->ao_lo = detail->records == 0 ? r.ao : std::min(detail->ao_lo, r.ao);
+      detail->ao_hi = detail->records == 0 ? r.ao : std::max(detail->ao_hi, r.ao);
+    }
     const float l = luminance(e);
     lo = std::min(lo, l);
     hi = std::max(hi, l);
@@ -287,6 +296,7 @@ class placement {
     finest_ = a * o_.min_radius;
     nearby_reach_ = o_.expert.lone_record_neighbour_reach * finest_;
     contact_backface_ = 0.1f * o_.invalid_backface_fraction;
+    ao_refine_ = r_.ao && o_.expert.refine_where_ao_disagrees;
   }
 
   void set_up() {
@@ -446,13 +456,20 @@ class placement {
       const float reach = o_.error_threshold * key.radius;
       return glm::dot(dx, dx) <= 1.0002f * reach * reach;
     });
+    float ao = 0.0f;
     const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail,
-                                blocked());
+                                blocked(), r_.ao ? &ao : nullptr);
     visited = detail.visited;
     bool ok = w > 0.0f;
     open_reason why = open_reason::uncovered;
     if (ok && o_.expert.refine_where_records_disagree && !own) {
       ok = spread <= a * std::max(luminance(value), floor_e_);
+      why = open_reason::records_disagree;
+    }
+    // The same for AO (cache_run::ao): it varies where E may not (within the AO distance of a
+    // contact or a corner, under a uniform light), and it has no gradient to extrapolate with.
+    if (ok && ao_refine_ && !own) {
+      ok = detail.ao_hi - detail.ao_lo <= a * std::max(ao, ao_floor);
       why = open_reason::records_disagree;
     }
     // Second opinion: a point that only one record covers is not covered while that record's
@@ -473,14 +490,15 @@ class placement {
     // themselves, must predict the same there within a (a hard shadow edge between two rows of
     // points is invisible to the covering record's gradient, not to a record beyond it).
     if (ok && o_.expert.lone_record_neighbour_reach > 0.0f && !own && detail.records == 1) {
-      ok = nearby_records_agree(i, detail);
+      ok = nearby_records_agree(i, detail, ao);
       why = open_reason::nearby_disagrees;
     }
     covered_[i] = ok ? 1 : 0;
     open_reason_[i] = static_cast<std::uint8_t>(why);
   }
 
-  bool nearby_records_agree(std::size_t i, const coverage_detail& detail) const {
+  // (With ao_refine_, the nearby records' AO must agree with the covering record's `ao` as well.)
+  bool nearby_records_agree(std::size_t i, const coverage_detail& detail, float ao) const {
     const glm::vec3 x = p_[i], nx = n_[i];
     const float la = std::max(detail.last_prediction, 0.0f);
     const float tolerance = o_.error_threshold * std::max(la, floor_e_);
@@ -491,6 +509,7 @@ class placement {
       if (k == detail.last || glm::dot(d, d) > r2) return false;
       if (glm::dot(rb.normal, nx) <= 0.9f || is_behind(rb, x, nx)) return false;
       const float lb = luminance(glm::max(o_.use_gradients ? rb.predict(x, nx) : rb.irradiance, glm::vec3(0.0f)));
+      if (ao_refine_ && std::fabs(records_[k].ao - ao) > o_.error_threshold * std::max(ao, ao_floor)) return true;
       return std::fabs(lb - la) > tolerance;
     });
   }
@@ -1030,6 +1049,7 @@ class placement {
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
   float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (make_record)
+  bool ao_refine_ = false;         // the coverage tests hold AO too (cache_expert_options::refine_where_ao_disagrees)
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;
   std::vector<cache_record> records_;
