@@ -338,7 +338,7 @@ cache_error compare_to_reference(const bake_result& cached, const bake_result& r
 }  // namespace
 
 TEST_CASE("AO: the cache against a hemicube per texel on the Cornell box", "[ao]") {
-  // The same bake (48 x 48, N = 64, D = 0.1 m, about a fifth of the room, 4 texels) with the
+  // The same bake (48 x 48, N = 64, D = 0.1 m, about a fifth of the room, 2.3 texels) with the
   // cache (a = 0.2, the default) and with a hemicube at every texel. The cache interpolates AO
   // with the records' weights and no gradients; AO changes fastest within D of contacts and
   // corners, where E need not. By default (refine_where_ao_disagrees) the coverage tests hold
@@ -406,13 +406,12 @@ TEST_CASE("AO: off, the bake is as before; on, the irradiance changes only throu
   CHECK(same(plain.sh_l1[1], passenger.sh_l1[1]));
   CHECK(plain.valid == passenger.valid);
   CHECK(plain.stats.hemicubes == passenger.stats.hemicubes);
-  // With the rule (the default) the first pass renders more hemicubes; later passes as before.
+  // With the rule (the default) the first pass renders more hemicubes (the later ones carry no AO).
   o.cache.expert.refine_where_ao_disagrees = true;
   const bake_result with_ao = bake_lightmap(in, o);
   REQUIRE(with_ao.ao.width == 32);
   REQUIRE(with_ao.stats.passes.size() == 2);
   CHECK(with_ao.stats.passes[0].hemicubes > plain.stats.passes[0].hemicubes);
-  CHECK(with_ao.stats.passes[1].records == plain.stats.passes[1].records);
   // A hemicube per texel: AO on or off, the irradiance is the same bit for bit.
   {
     bake_options p = o;

@@ -117,7 +117,7 @@ struct cache_expert_options {
   /// while a record near a point that one record covers holds an AO differing by more than that.
   /// AO has no gradient and varies where E may not (within the AO distance of contacts and
   /// corners), so records placed for E alone carry it with large errors there (the Cornell box at
-  /// 48^2, AO within 4 texels: 5.5% RMS and 24% at the 99th percentile without the rule, 0.9% and
+  /// 48^2, AO within 2.3 texels: 5.5% RMS and 24% at the 99th percentile without the rule, 0.9% and
   /// 5.8% with it, for 42% more hemicubes in that pass; docs/bake.md, "Ambient occlusion").
   /// Ignored without cache_run::ao.
   bool refine_where_ao_disagrees = true;
