@@ -596,8 +596,11 @@ typedef struct hemilight_bake_options {
    * width x height). ao_distance negative or not finite, or > 0 with ao NULL or ao_capacity too
    * small, is INVALID_ARGUMENT naming the field; with ao_distance 0, ao and ao_capacity are ignored.
    * Scene bakes write each page's AO through hemilight_bake_scene_desc.ao instead (options->ao is
-   * not used there). Cost: one compare and add per hemicube texel in the first bounce, the stitching
-   * and dilation of one more image; the irradiance is bitwise the same with or without it. */
+   * not used there). Cost: one compare and add per hemicube texel in the first bounce; with
+   * use_cache 1, the records the cache adds where AO varies faster than the irradiance (14% to 145%
+   * more hemicubes in the first bounce on the reference scenes, which also lowers the irradiance's
+   * error and so changes its bits); the stitching and dilation of one more image. With ao_distance
+   * 0 the bake is bitwise what it was. */
   float ao_distance;
   int reserved4;           /* padding, not read (aligns ao) */
   float* ao;

@@ -99,10 +99,15 @@ struct bake_options {
   /// Ambient occlusion (bake_result::ao) within this distance, in scene units: per texel the
   /// cosine-weighted fraction of the hemisphere that sees no geometry (front or back faces) within
   /// it (docs/bake.md, "Ambient occlusion"). Finite and >= 0, else error(invalid_argument) naming
-  /// "ao_distance"; 0 = no AO (the default). Taken from the first pass's hemicubes (no pass of its
-  /// own) and, with use_cache, interpolated by the cache with the irradiance's record weights (no
-  /// gradients). Cost: one compare and add per hemicube texel in the first pass, 4 bytes per
-  /// record, and the image's stitching and dilation. The irradiance does not change with it.
+  /// "ao_distance"; 0 = no AO (the default: the bake is then bitwise what it was without AO). Taken
+  /// from the first pass's hemicubes (no pass of its own) and, with use_cache, interpolated by the
+  /// cache with the irradiance's record weights (no gradients); the cache's AO rule
+  /// (cache.expert.refine_where_ao_disagrees, on) adds first-pass records where AO varies faster
+  /// than E, which changes the irradiance's bits too (it lowers its error); without the rule or
+  /// without the cache the irradiance is bitwise that of the bake without AO. Cost: one compare
+  /// and add per hemicube texel in the first pass, the added records' hemicubes (+14% to +145% of
+  /// the first pass's on the reference scenes, docs/bake.md), 4 bytes per record and sample, the
+  /// image (12 bytes per texel) and its stitching and dilation.
   float ao_distance = 0.0f;
   int thread_count = 0;  ///< >= 0; 0 = all cores. Results do not depend on it.
   /// Called from the calling thread with the fraction of the bake done, in [0, 1], never
