@@ -236,7 +236,7 @@ TEST_CASE("AO: a floor beside a wall, baked, against numerical quadrature of the
   }
 }
 
-TEST_CASE("AO: the cache's AO is the records' weighted average; the records hold their hemicubes' AO", "[ao]") {
+TEST_CASE("AO: the cache's AO is the records' weighted average, and the records hold their hemicubes' AO", "[ao]") {
   // The Cornell box's floor and back wall, 40 x 40 points each (as the cache's bit-for-bit test).
   const scene_mesh mesh = cornell_box();
   const float H = 0.5488f, D = 0.5592f, W = 0.556f;
@@ -378,7 +378,7 @@ TEST_CASE("AO: the cache against a hemicube per texel on the Cornell box", "[ao]
   CHECK(with_rule.e_rms <= 1.1 * without.e_rms);
 }
 
-TEST_CASE("AO: off, the bake is as before; on, the irradiance changes only through added records; AO comes from the first pass", "[ao]") {
+TEST_CASE("AO: off the bake is as before, on the irradiance changes only through added records, and AO comes from the first pass", "[ao]") {
   const scene_mesh m = cornell_with_uvs(32);
   const bake_input in = input_of(m);
   bake_options o;
