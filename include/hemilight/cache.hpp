@@ -356,8 +356,9 @@ std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_recor
                                                    const glm::vec3& normal, const cache_options& options);
 
 /// Interpolates the records' ambient occlusion (cache_record::ao) at one point with the weights of
-/// interpolate_records (plain weighted average, no gradients); 0 when no record covers the point.
-/// Brute force over all records: for tests and tools.
+/// interpolate_records (plain weighted average, no gradients); 0 when no record covers the point;
+/// in [0, 1] for records' AO in [0, 1]. Brute force over all records: for tests and tools. Cost:
+/// O(records).
 float interpolate_records_ao(const std::vector<cache_record>& records, const glm::vec3& position, const glm::vec3& normal,
                              const cache_options& options);
 
