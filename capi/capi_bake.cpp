@@ -184,6 +184,9 @@ hemilight_status check_common_options(const char* fn, const hemilight_bake_optio
     return invalid(fn, "options->min_coverage " + std::to_string(o.min_coverage) + " is not in [0, 1]");
   if (o.dilation < -1) return invalid(fn, "options->dilation " + std::to_string(o.dilation) + " must be >= -1 (-1: fill every texel)");
   if (o.thread_count < 0) return invalid(fn, "options->thread_count " + std::to_string(o.thread_count) + " must be >= 0 (0: all cores)");
+  if (!(o.ao_distance >= 0.0f) || !std::isfinite(o.ao_distance))
+    return invalid(fn, "options->ao_distance is " + std::to_string(o.ao_distance) +
+                           "; it must be finite and >= 0 (scene units; 0 = no ambient occlusion)");
   const std::pair<const char*, int> switches[] = {
       {"indirect_only", o.indirect_only}, {"use_cache", o.use_cache}, {"edge_coverage", o.edge_coverage}, {"strict", o.strict},
       {"stitch_seams", o.stitch_seams}};
@@ -407,6 +410,28 @@ hemilight_status check_page(const char* fn, const hemilight_bake_page& page, con
   return HEMILIGHT_OK;
 }
 
+// One page's ambient-occlusion buffer (`buffer`, `capacity` floats, named `name` and
+// `capacity_name` in messages) for a page of width x height texels: required (non-NULL) for
+// hemilight_bake_lightmap's options->ao, optional per page for scene bakes.
+hemilight_status check_ao_buffer(const char* fn, const float* buffer, size_t capacity, size_t texels, bool required,
+                                 const std::string& name, const std::string& capacity_name, float distance) {
+  if (!buffer) {
+    if (!required) return HEMILIGHT_OK;
+    return invalid(fn, "options->ao_distance is " + std::to_string(distance) + " but " + name +
+                           " is NULL (width x height floats; ao_distance 0 = no ambient occlusion)");
+  }
+  if (capacity < texels)
+    return invalid(fn, capacity_name + " " + std::to_string(capacity) + " is below width x height = " + std::to_string(texels) +
+                           " floats");
+  return HEMILIGHT_OK;
+}
+
+// Copies a bake's ambient occlusion (RGB, equal channels) as one float per texel.
+void write_ao(const hemilight::bake_result& r, float* out) {
+  const size_t texels = r.ao.pixels.size() / 3;
+  for (size_t k = 0; k < texels; ++k) out[k] = r.ao.pixels[3 * k];
+}
+
 // Copies a successful bake's images into the page's buffers (checked by check_page).
 void write_page(const hemilight::bake_result& r, const hemilight_bake_page& page, bool mask) {
   const size_t texels = size_t(page.width) * size_t(page.height);
@@ -437,6 +462,11 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     bool mask = false;
     if (const hemilight_status st = check_common_options(fn, o, environment, mask)) return st;
     if (const hemilight_status st = check_page(fn, page, {"options->", "", "options->"}, mask)) return st;
+    const bool ao = o.ao_distance > 0.0f;
+    if (ao)
+      if (const hemilight_status st = check_ao_buffer(fn, o.ao, o.ao_capacity, size_t(o.width) * size_t(o.height), true,
+                                                      "options->ao", "options->ao_capacity", o.ao_distance))
+        return st;
     std::vector<hemilight::light> lights;
     if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
     // Step 2: the meshes, checked in the caller's terms and concatenated.
@@ -453,6 +483,7 @@ hemilight_status bake(const char* fn, const hemilight_bake_mesh* meshes, size_t 
     // Step 4: the outputs, only when everything is finite.
     if (!result_finite(r)) return invalid(fn, overflow_message);
     write_page(r, page, mask);
+    if (ao) write_ao(r, o.ao);
     if (stats) hemilight::capi::write_sized(stats_of(r.stats, meshes, mesh_count), stats);
     return HEMILIGHT_OK;
   });
@@ -599,6 +630,20 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
       want_sh = want_sh || sd.pages[p].sh_l1_rgb;
       want_hl2 = want_hl2 || sd.pages[p].hl2_rgb;
     }
+    const bool ao = o.ao_distance > 0.0f;
+    if (ao) {
+      if (!sd.ao)
+        return invalid(fn, "options->ao_distance is " + std::to_string(o.ao_distance) +
+                               " but scene->ao is NULL (page_count pointers, each NULL or a page's width x height floats)");
+      if (!sd.ao_capacity) return invalid(fn, "scene->ao_capacity is NULL (page_count capacities, in floats)");
+      for (size_t p = 0; p < sd.page_count; ++p) {
+        const std::string name = "scene->ao[" + std::to_string(p) + "]";
+        if (const hemilight_status st =
+                check_ao_buffer(fn, sd.ao[p], sd.ao_capacity[p], size_t(sd.pages[p].width) * size_t(sd.pages[p].height), false, name,
+                                "scene->ao_capacity[" + std::to_string(p) + "]", o.ao_distance))
+          return st;
+      }
+    }
     std::vector<hemilight::light> lights;
     if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
     // Step 2: the placements, the opacities, then the meshes (checked against their pages) concatenated.
@@ -615,7 +660,10 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
     // Step 4: the outputs, only when every page is finite.
     for (const hemilight::bake_result& page : r.pages)
       if (!result_finite(page)) return invalid(fn, overflow_message);
-    for (size_t p = 0; p < sd.page_count; ++p) write_page(r.pages[p], sd.pages[p], mask);
+    for (size_t p = 0; p < sd.page_count; ++p) {
+      write_page(r.pages[p], sd.pages[p], mask);
+      if (ao && sd.ao[p]) write_ao(r.pages[p], sd.ao[p]);
+    }
     if (stats) hemilight::capi::write_sized(stats_of(r.stats, sd.meshes, sd.mesh_count), stats);
     return HEMILIGHT_OK;
   });

@@ -42,8 +42,10 @@ const span bake_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_options, lights), HEMILIGHT_SPAN(hemilight_bake_options, light_count),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_lights), HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_rgba),
     HEMILIGHT_SPAN(hemilight_bake_options, shadow_mask_capacity), HEMILIGHT_SPAN(hemilight_bake_options, edge_coverage),
-    HEMILIGHT_SPAN(hemilight_bake_options, strict), HEMILIGHT_SPAN(hemilight_bake_options, stitch_seams)};
-// (reserved1 and reserved2 are padding: never read)
+    HEMILIGHT_SPAN(hemilight_bake_options, strict), HEMILIGHT_SPAN(hemilight_bake_options, stitch_seams),
+    HEMILIGHT_SPAN(hemilight_bake_options, ao_distance), HEMILIGHT_SPAN(hemilight_bake_options, ao),
+    HEMILIGHT_SPAN(hemilight_bake_options, ao_capacity)};
+// (reserved1 to reserved4 are padding: never read)
 const span cache_stats_fields[] = {HEMILIGHT_SPAN(hemilight_cache_stats, struct_size), HEMILIGHT_SPAN(hemilight_cache_stats, hemicubes),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, records), HEMILIGHT_SPAN(hemilight_cache_stats, seconds),
                                    HEMILIGHT_SPAN(hemilight_cache_stats, invalid_samples)};
@@ -68,18 +70,21 @@ const span cubemap_irradiance_options_fields[] = {
 // options of 96 bytes (after the padding field reserved0, since offset 92 was the old layout's
 // tail padding) and to the bake options of 144; strict to the bake options of 152 (after the
 // padding field reserved1); stitch_seams to the bake options of 160 (after the padding field
-// reserved2); the bake statistics' input counts to the statistics of 64, the seam counts to those
-// of 104.
+// reserved2); ao_distance, ao and ao_capacity to the bake options of 168 (after the padding field
+// reserved3; reserved4 aligns the pointer); the bake statistics' input counts to the statistics
+// of 64, the seam counts to those of 104.
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_options) == 104, "hemilight_cache_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_cache_options, edge_coverage) >= 96,
               "hemilight_cache_options: edge_coverage must start past the earlier layout's sizeof");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 168, "hemilight_bake_options changed: see above");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_options) == 192, "hemilight_bake_options changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, edge_coverage) >= 144,
               "hemilight_bake_options: edge_coverage must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, strict) >= 152,
               "hemilight_bake_options: strict must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, stitch_seams) >= 160,
               "hemilight_bake_options: stitch_seams must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_options, ao_distance) >= 168,
+              "hemilight_bake_options: ao_distance must start past the earlier layout's sizeof");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_cache_stats) == 40, "hemilight_cache_stats changed: see above");
 static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_stats) == 120, "hemilight_bake_stats changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_stats, degenerate_triangles) >= 64,
@@ -168,6 +173,9 @@ hemilight_bake_options default_bake_options() {
   o.edge_coverage = bake_options{}.sampler.raster.edge_coverage ? 1 : 0;
   o.strict = bake_options{}.strict ? 1 : 0;
   o.stitch_seams = bake_options{}.stitch_seams ? 1 : 0;
+  o.ao_distance = bake_options{}.ao_distance;
+  o.ao = nullptr;
+  o.ao_capacity = 0;
   return o;
 }
 
@@ -275,6 +283,7 @@ bake_options to_cpp(const hemilight_bake_options& c, std::shared_ptr<const cubem
   o.sampler.raster.edge_coverage = c.edge_coverage == 1;
   o.strict = c.strict == 1;
   o.stitch_seams = c.stitch_seams == 1;
+  o.ao_distance = c.ao_distance;  // range-checked, naming the C field, by the bake entries
   if (c.progress) {
     const hemilight_progress_fn progress = c.progress;
     void* user = c.progress_user;
@@ -350,13 +359,17 @@ const span bake_scene_desc_fields[] = {
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, mesh_count), HEMILIGHT_SPAN(hemilight_bake_scene_desc, placements),
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, pages), HEMILIGHT_SPAN(hemilight_bake_scene_desc, page_count),
     HEMILIGHT_SPAN(hemilight_bake_scene_desc, occluder_radiance), HEMILIGHT_SPAN(hemilight_bake_scene_desc, mesh_opacity),
-    HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_textures), HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_texture_count)};
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_textures), HEMILIGHT_SPAN(hemilight_bake_scene_desc, alpha_texture_count),
+    HEMILIGHT_SPAN(hemilight_bake_scene_desc, ao), HEMILIGHT_SPAN(hemilight_bake_scene_desc, ao_capacity)};  // (reserved0 is padding: never read)
 #undef HEMILIGHT_SPAN
-// The opacity fields were appended to the description of 56 bytes (the pointer's alignment puts
-// mesh_opacity at 56, past occluder_radiance's tail padding, on LP64).
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_scene_desc) == 80, "hemilight_bake_scene_desc changed: see above");
+// Appended to the description of 56 bytes: the opacity fields (mesh_opacity at 56, after the
+// padding field reserved0 at the older layout's tail padding, on LP64), then ao and ao_capacity
+// (a description of 80 bytes has no AO fields).
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_scene_desc) == 96, "hemilight_bake_scene_desc changed: see above");
 static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_scene_desc, mesh_opacity) >= 56,
               "hemilight_bake_scene_desc: mesh_opacity must start past the earlier layout's sizeof");
+static_assert(sizeof(void*) != 8 || offsetof(hemilight_bake_scene_desc, ao) >= 80,
+              "hemilight_bake_scene_desc: ao must start past the opacity layout's sizeof");
 
 }  // namespace
 

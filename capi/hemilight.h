@@ -676,6 +676,27 @@ typedef struct hemilight_bake_options {
    * seam (a hard shadow along it), are left as baked. Counted in
    * hemilight_bake_stats.seam_texels. */
   int stitch_seams;
+  int reserved3;           /* padding, not read: keeps ao_distance past the earlier layout's sizeof */
+  /* Since 0.15. Ambient occlusion within ao_distance (scene units, finite, >= 0; default 0 = none):
+   * per texel the cosine-weighted fraction of the hemisphere that sees no geometry (front or back
+   * faces) within that distance, in [0, 1] (1 = open, 0 = fully occluded), from the first bounce's
+   * hemicubes (no pass of its own; interpolated by the irradiance cache with the irradiance's
+   * weights when use_cache is 1), filled inside geometry, stitched along seams and dilated like the
+   * irradiance (docs/bake.md, "Ambient occlusion"). hemilight_bake_lightmap(_directional) writes it
+   * to `ao`: width x height floats, one per texel, rows as the irradiance, only when the bake
+   * succeeds and ao_distance > 0; ao_capacity is the floats available there (at least
+   * width x height). ao_distance negative or not finite, or > 0 with ao NULL or ao_capacity too
+   * small, is INVALID_ARGUMENT naming the field; with ao_distance 0, ao and ao_capacity are ignored.
+   * Scene bakes write each page's AO through hemilight_bake_scene_desc.ao instead (options->ao is
+   * not used there). Cost: one compare and add per hemicube texel in the first bounce; with
+   * use_cache 1, the records the cache adds where AO varies faster than the irradiance (14% to 145%
+   * more hemicubes in the first bounce on the reference scenes, which also lowers the irradiance's
+   * error and so changes its bits); the stitching and dilation of one more image. With ao_distance
+   * 0 the bake is bitwise what it was. */
+  float ao_distance;
+  int reserved4;           /* padding, not read (aligns ao) */
+  float* ao;
+  size_t ao_capacity;
 } hemilight_bake_options;
 
 /* As hemilight_cache_options_init_sized, for bake options. */
@@ -726,7 +747,8 @@ static inline void hemilight_bake_stats_init(hemilight_bake_stats* stats) {
  * outside [0, 1] clamped, triangles with 3D area but no UV area occlude without texels (unless
  * options->strict); the statistics count each.
  * Errors (nothing written): INVALID_ARGUMENT for NULL meshes (with mesh_count > 0), mesh_count 0,
- * NULL options/irradiance_rgb, capacities too small, options or struct_size (options, stats) out
+ * NULL options/irradiance_rgb, capacities too small, options->ao NULL with ao_distance > 0,
+ * options or struct_size (options, stats) out
  * of range (the message names the field), NULL arrays with nonzero counts, NaN/Inf positions,
  * normals or UVs, positions beyond 1e18 in magnitude, UVs more than 0.001 outside [0, 1], indices
  * out of range, with options->strict a triangle with 3D area but zero UV area ("meshes[1]:
@@ -912,6 +934,7 @@ typedef struct hemilight_bake_scene_desc {
   const hemilight_bake_page* pages;            /* page_count pages; their output buffers are written */
   size_t page_count;
   int occluder_radiance;                       /* HEMILIGHT_OCCLUDER_* (default HEMILIGHT_OCCLUDER_EMISSION) */
+  int reserved0;                               /* padding, not read (the earlier layout's tail padding) */
   /* Since 0.15: see-through triangles ("opacity" above; default NULL, NULL, 0: every triangle
    * opaque, also for a program built against an older header). Read during the call only. */
   const hemilight_mesh_opacity* mesh_opacity;  /* NULL, or mesh_count entries: mesh_opacity[i] for meshes[i] (occluder-only
@@ -919,6 +942,15 @@ typedef struct hemilight_bake_scene_desc {
   const hemilight_alpha_texture* alpha_textures; /* alpha_texture_count textures, the ones hemilight_opacity::alpha_texture
                                                     indexes (NULL when the count is 0) */
   size_t alpha_texture_count;
+  /* Since 0.15. Where each page's ambient occlusion goes when options->ao_distance > 0 (ignored
+   * otherwise): ao[p] is NULL (page p's AO not written) or width x height floats of page p, one
+   * per texel, rows as its irradiance (hemilight_bake_options.ao_distance says what they hold);
+   * ao_capacity[p] is the floats available at ao[p] (at least width x height). Both arrays hold
+   * page_count entries and are read during the call only (default NULL). With
+   * options->ao_distance > 0, ao or ao_capacity NULL, or a capacity too small, is INVALID_ARGUMENT
+   * naming scene->ao[p] or scene->ao_capacity[p]. */
+  float* const* ao;
+  const size_t* ao_capacity;
 } hemilight_bake_scene_desc;
 
 /* As hemilight_cache_options_init_sized, for scene descriptions (all NULL and 0, emission-only
@@ -930,14 +962,16 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
 
 /* Bakes every page of a scene in one bake (hemilight_bake_lightmap's pipeline over all pages).
  * options: as for hemilight_bake_lightmap, except that width and height are ignored (the pages
- * give the sizes) and the shadow mask goes to each page's shadow_mask_rgba. The directional maps
- * are computed when any page asks for them and written to the pages that do. stats (may be NULL):
+ * give the sizes), the shadow mask goes to each page's shadow_mask_rgba and the ambient occlusion
+ * to scene->ao. The directional maps are computed when any page asks for them and written to the
+ * pages that do. stats (may be NULL):
  * the whole bake. One page holding every mesh with scale (1, 1) and offset (0, 0) gives bitwise
  * what hemilight_bake_lightmap gives.
  * Errors (nothing written; the message names the function and the mesh, page or placement by
  * index, and the index within it): INVALID_ARGUMENT for NULL scene/options, a bad struct_size,
  * mesh_count or page_count 0, NULL meshes/placements/pages, an unknown occluder_radiance, a page
- * size out of range, a NULL irradiance_rgb or a capacity too small, an albedo or emission value
+ * size out of range, a NULL irradiance_rgb or a capacity too small, with options->ao_distance > 0
+ * a NULL scene->ao or scene->ao_capacity or an AO capacity too small, an albedo or emission value
  * out of range ("scene->pages[1].albedo_rgb[37] = 1.5"), a placement's page out of range or
  * non-finite scale/offset, a page UV more than 0.001 outside [0, 1] ("meshes[2].lightmap_uvs[9]
  * (vertex 4, v) = 0.9 maps to 1.3 in page 1"), with options->strict a triangle with no area in

@@ -9,7 +9,8 @@
 // Writes, per scene NAME, into the output directory: NAME_irradiance.exr (RGB float irradiance
 // E), NAME_mask.exr (R = coverage, G = valid, B = sampled), NAME_irradiance.png (tone-mapped
 // preview), and with --directional NAME_sh_l1_{0..3}.exr (world-space L1 SH) and/or
-// NAME_hl2_{0..2}.exr (Half-Life 2 basis in the lightmap tangent frame; bake.hpp). Shows a
+// NAME_hl2_{0..2}.exr (Half-Life 2 basis in the lightmap tangent frame; bake.hpp), with --ao D
+// NAME_ao.exr (ambient occlusion within D scene units, the same value in R, G and B). Shows a
 // progress bar with the time left and prints the bake's statistics.
 // --environment FILE.exr: an ENVMAP_CUBE EXR as the sky (built-in scenes and models).
 // --probes GRID|FILE: also NAME_probes.json, SH9 light probes (probes.hpp) rendered after the bake
@@ -106,6 +107,9 @@ const char* usage =
     "                     radius in radians (default 0.00465, the sun's; 0 = hard)\n"
     "  --point X,Y,Z,I[,R]   a point light (repeatable): position, intensity (W/sr), radius (default 0)\n"
     "  --shadow-mask      also write NAME_shadow_mask.exr: the visibility of the first four lights\n"
+    "  --ao D             also write NAME_ao.exr: ambient occlusion within D scene units (> 0), the\n"
+    "                     cosine-weighted unoccluded fraction of each texel's hemisphere, 1 = open,\n"
+    "                     0 = fully occluded, from the first bounce's hemicubes (docs/bake.md)\n"
     "  --probes P         also write NAME_probes.json: SH9 light probes (probes.hpp) that see the\n"
     "                     baked surfaces, at the centres of an AxBxC grid over the scene's bounds\n"
     "                     (P like 8x4x8) or at the points of a text file (x y z per line, # comments)\n"
@@ -253,6 +257,8 @@ settings parse(int argc, char** argv) {
       s.options.lights.push_back(l);
     } else if (a == "--shadow-mask") {
       s.shadow_mask = true;
+    } else if (a == "--ao") {
+      s.options.ao_distance = parse_float("--ao", value(), 0.0f, 1e18f, true);
     } else if (a == "--probes") {
       s.probes = value();
     } else if (a == "--preview") {
@@ -528,6 +534,20 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
                 100.0 * double(st.passes[p].hemicubes) / double(st.sampled_texels), st.passes[p].records, st.passes[p].seconds);
   if (!o.lights.empty())
     std::printf("  %zu light%s: direct light %.2f s\n", o.lights.size(), o.lights.size() > 1 ? "s" : "", st.direct_seconds);
+  if (o.ao_distance > 0.0f) {
+    double sum = 0.0;
+    float lowest = 1.0f;
+    std::size_t n = 0;
+    for (const bake_result& page : sr.pages)
+      for (std::size_t k = 0; k < page.sampled.size(); ++k)
+        if (page.sampled[k]) {
+          sum += double(page.ao.pixels[3 * k]);
+          lowest = std::min(lowest, page.ao.pixels[3 * k]);
+          ++n;
+        }
+    std::printf("  ambient occlusion within %g: mean %.3f, lowest %.3f over the sampled texels\n", double(o.ao_distance),
+                n ? sum / double(n) : 0.0, double(lowest));
+  }
   print_seams(in, sr, st);
   std::printf("  total %.2f s (coverage %.3f s); wrote %s_{%sirradiance.png}%s\n", st.seconds, st.coverage_seconds, base.c_str(),
               suffixes.c_str(), sr.pages.size() > 1 ? (" and the same for pages 1.." + std::to_string(sr.pages.size() - 1) + " (" + base + "_pageP_*)").c_str() : "");

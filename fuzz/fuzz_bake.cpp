@@ -1,6 +1,6 @@
 // libFuzzer harness: hemilight_bake_lightmap and _directional with one or two meshes (positions,
-// normals, UVs, indices, materials) and the options from the bytes, lights and a shadow mask
-// included. Checks the contract: finite outputs on OK, untouched ones on failure.
+// normals, UVs, indices, materials) and the options from the bytes, lights, a shadow mask and
+// ambient occlusion included. Checks the contract: finite outputs on OK, untouched ones on failure.
 #include "fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -74,6 +74,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   hemilight_bake_stats st;
   hemilight_bake_stats_init(&st);
   const bool directional = in.small(0, 1) == 1;
+  // Ambient occlusion, drawn last (the inputs before it keep their meaning): a distance (any float
+  // at times) and a buffer of texels floats, at times one short.
+  std::vector<float> ao;
+  if (in.small(0, 2) == 1) {
+    o.ao_distance = in.small(0, 3) == 0 ? in.any_float(2.0f) : float(in.small(1, 8)) / 8.0f;
+    ao.resize(texels + 1);
+    o.ao = ao.data();
+    o.ao_capacity = in.small(0, 7) == 0 && texels > 0 ? texels - 1 : texels;
+    fuzz::fill(ao.data(), ao.size() * sizeof(float));
+  }
   const hemilight_status r =
       directional ? hemilight_bake_lightmap_directional(meshes.data(), meshes_n, &o, out.data(), 3 * texels, valid.data(), texels,
                                                         sh.data(), 12 * texels, hl2.data(), 9 * texels, &st)
@@ -88,6 +98,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!mask.empty()) {
     if (o.shadow_mask_lights[0] >= 0) fuzz::check_finite(r, mask.data(), mask.size() - 1);
     fuzz::check_untouched(r, mask.data(), mask.size() * sizeof(float));
+  }
+  if (!ao.empty()) {
+    if (o.ao_distance > 0.0f) fuzz::check_finite(r, ao.data(), texels);
+    fuzz::check_untouched(r, ao.data(), ao.size() * sizeof(float));
+    if (r == HEMILIGHT_OK && o.ao_distance > 0.0f)
+      for (std::size_t k = 0; k < texels; ++k)
+        if (!(ao[k] >= 0.0f && ao[k] <= 1.0f)) fuzz::violated("an AO value outside [0, 1] on HEMILIGHT_OK");
+    fuzz::check_untouched(HEMILIGHT_ERROR_INVALID_ARGUMENT, &ao[texels], sizeof(float));  // past the capacity: never written
   }
   return 0;
 }

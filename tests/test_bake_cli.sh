@@ -62,6 +62,19 @@ expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 1 --sky 0,
 grep -q "2 lights: direct light" ok.log || { echo "FAIL: expected 2 lights:"; cat ok.log; fails=$((fails + 1)); }
 [ -s lit/quad_shadow_mask.exr ] || { echo "FAIL: lit/quad_shadow_mask.exr not written"; fails=$((fails + 1)); }
 
+# Ambient occlusion: --ao D writes NAME_ao.exr next to the irradiance; the quad under the open sky
+# sees nothing within D: exactly 1 at every texel. Without --ao no AO file.
+expect_ok quad.obj --lightmap-uv 0 --size 8 --resolution 16 --bounces 2 --ao 0.5 --out ao
+[ -s ao/quad_ao.exr ] || { echo "FAIL: ao/quad_ao.exr not written"; fails=$((fails + 1)); }
+grep -q "ambient occlusion within 0.5: mean 1.000, lowest 1.000 over the sampled texels" ok.log ||
+  { echo "FAIL: expected AO 1 everywhere:"; cat ok.log; fails=$((fails + 1)); }
+grep -q "quad_{irradiance.exr,mask.exr,ao.exr,irradiance.png}" ok.log || { echo "FAIL: ao.exr not in the written files:"; cat ok.log; fails=$((fails + 1)); }
+[ -e res/quad_ao.exr ] && { echo "FAIL: res/quad_ao.exr written without --ao"; fails=$((fails + 1)); }
+expect_fail "--ao 0" "(0" -- quad.obj --lightmap-uv 0 --ao 0
+expect_fail "--ao -1" -- quad.obj --lightmap-uv 0 --ao -1
+expect_fail "--ao nan" -- quad.obj --lightmap-uv 0 --ao nan
+expect_fail "--ao needs a value" -- quad.obj --lightmap-uv 0 --ao
+
 # Probes: a grid and a file of points; the JSON's fields, and a probe 0.5 above the floor's centre
 # under the uniform sky (radiance 1): c_0 lies between Y00 (4 pi - Omega) (a black floor) and
 # Y00 4 pi (a white one), Omega = 4 asin(1/2) = 2 pi / 3 the floor's solid angle from there.

@@ -1,5 +1,5 @@
 /* C99 test of the C ABI's lightmap baker: hemilight_bake_options_init, hemilight_bake_lightmap,
- * with and without lights.
+ * with and without lights, and ambient occlusion (also through hemilight_bake_scene).
  * Reference: a uniform sky of radiance L over unoccluded up-facing quads gives E = pi L at every
  * texel (closed form). Bad input: every failure leaves the caller's buffers untouched.
  * Prints failing checks and a closing "N passed, N failed" line. */
@@ -240,6 +240,132 @@ static void test_stitch_seams(void) {
   o.stitch_seams = 2;
   CHECK_FAILS(hemilight_bake_lightmap(m, 3, &o, raw, 3 * 32 * 32, v, 32 * 32, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
               "options->stitch_seams is 2; it must be 0 or 1");
+}
+
+/* Ambient occlusion (hemilight_bake_options.ao_distance, .ao; hemilight_bake_scene_desc.ao): a
+ * floor (x, z in [-4, 4], y = 0, facing up; u in [0, 0.5]) under a ceiling (the same square at
+ * y = 1, facing down; u in [0.5, 1]), a 32 x 32 map, a hemicube per texel at N = 64, D = 2.
+ * Closed form: under an infinite parallel plane at height h the directions with cos(theta) < h / D
+ * are open, whose cosine-weighted share of the hemisphere is (h / D)^2 (docs/bake.md). The sample
+ * sits 0.05 texel sizes above the floor (the bake's offset: the texel world size is
+ * sqrt(64 m^2 / 512 texels)), so h = 1 - 0.05 sqrt(0.125). Texels whose centre lies within
+ * 4 - sqrt(D^2 - h^2) = 2.25 of the middle in x and z see the square wherever the infinite plane
+ * is within D: exactly the closed form. Tolerance 2e-3: the N = 64 hemicubes' discretisation
+ * (texels on the boundary circle counted whole by their centres; measured at most 4.6e-4).
+ * Then: a one-page scene bake writes bitwise the same AO; bad input names the C field and
+ * writes nothing. */
+static void test_ao(void) {
+  static const float floor_pos[] = {-4, 0, -4, -4, 0, 4, 4, 0, 4, 4, 0, -4};
+  static const float ceiling_pos[] = {-4, 1, -4, 4, 1, -4, 4, 1, 4, -4, 1, 4};
+  static const float floor_uv[] = {0, 0, 0, 1, 0.5f, 1, 0.5f, 0};
+  static const float ceiling_uv[] = {0.5f, 0, 1, 0, 1, 1, 0.5f, 1};
+  static const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
+  static float e[3 * 32 * 32], ao[32 * 32], scene_ao[32 * 32], page_e[3 * 32 * 32];
+  hemilight_bake_mesh m[2];
+  hemilight_bake_options o;
+  hemilight_bake_placement placements[2];
+  hemilight_bake_page page;
+  hemilight_bake_scene_desc sd;
+  float* page_ao[1];
+  size_t page_ao_capacity[1];
+  const double h = 1.0 - 0.05 * sqrt(64.0 / 512.0), expected = (h / 2.0) * (h / 2.0);
+  double worst = 0.0;
+  int i, j, compared = 0, in_range = 1, untouched_ao = 1;
+  memset(m, 0, sizeof m);
+  m[0].positions = floor_pos;  /* (v1 - v0) x (v2 - v0) = (0, 8, 0) x (8, 8, 8) points up (+y) */
+  m[0].lightmap_uvs = floor_uv;
+  m[1].positions = ceiling_pos; /* faces down (-y) */
+  m[1].lightmap_uvs = ceiling_uv;
+  for (i = 0; i < 2; ++i) {
+    m[i].vertex_count = 4;
+    m[i].indices = quad;
+    m[i].triangle_count = 2;
+    m[i].material.albedo[0] = m[i].material.albedo[1] = m[i].material.albedo[2] = 0.5f;
+  }
+  hemilight_bake_options_init(&o);
+  CHECK(o.ao_distance == 0.0f && o.ao == NULL && o.ao_capacity == 0); /* off by default */
+  o.width = o.height = 32;
+  o.resolution = 64;
+  o.use_cache = 0;
+  o.sky_radiance[0] = o.sky_radiance[1] = o.sky_radiance[2] = 1.0f;
+  /* Off: the buffer is not written even when given. */
+  for (i = 0; i < 32 * 32; ++i) ao[i] = -7.0f;
+  o.ao = ao;
+  o.ao_capacity = 32 * 32;
+  CHECK(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL) == HEMILIGHT_OK);
+  for (i = 0; i < 32 * 32; ++i)
+    if (ao[i] != -7.0f) untouched_ao = 0;
+  CHECK(untouched_ao);
+  o.ao_distance = 2.0f;
+  CHECK(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL) == HEMILIGHT_OK);
+  for (i = 0; i < 32 * 32; ++i)
+    if (!(ao[i] >= 0.0f && ao[i] <= 1.0f)) in_range = 0;
+  CHECK(in_range);
+  for (j = 0; j < 32; ++j)    /* rows: v = z / 8 + 0.5, texel centre z = (j + 0.5) / 4 - 4 */
+    for (i = 0; i < 16; ++i) { /* the floor's columns: texel centre x = (i + 0.5) / 2 - 4 */
+      const double x = (i + 0.5) / 2.0 - 4.0, z = (j + 0.5) / 4.0 - 4.0;
+      if (fabs(x) > 2.25 || fabs(z) > 2.25) continue;
+      if (fabs(ao[j * 32 + i] - expected) > worst) worst = fabs(ao[j * 32 + i] - expected);
+      ++compared;
+    }
+  CHECK(compared == 10 * 18);
+  CHECK(worst < 2e-3);
+  if (!(worst < 2e-3)) printf("  AO under the ceiling: largest |AO - (h/D)^2| = %g (expected %g)\n", worst, expected);
+
+  /* The same meshes as a one-page scene bake (identity placements): bitwise the same AO. */
+  memset(placements, 0, sizeof placements);
+  for (i = 0; i < 2; ++i) placements[i].uv_scale[0] = placements[i].uv_scale[1] = 1.0f;
+  memset(&page, 0, sizeof page);
+  page.width = page.height = 32;
+  page.irradiance_rgb = page_e;
+  page.irradiance_capacity = 3 * 32 * 32;
+  hemilight_bake_scene_desc_init(&sd);
+  CHECK(sd.ao == NULL && sd.ao_capacity == NULL);
+  sd.meshes = m;
+  sd.mesh_count = 2;
+  sd.placements = placements;
+  sd.pages = &page;
+  sd.page_count = 1;
+  page_ao[0] = scene_ao;
+  page_ao_capacity[0] = 32 * 32;
+  sd.ao = page_ao;
+  sd.ao_capacity = page_ao_capacity;
+  CHECK(hemilight_bake_scene(&sd, &o, NULL) == HEMILIGHT_OK);
+  CHECK(memcmp(scene_ao, ao, sizeof ao) == 0);
+  CHECK(memcmp(page_e, e, sizeof e) == 0);
+
+  /* Bad input: the C field named, nothing written. */
+  for (i = 0; i < 32 * 32; ++i) ao[i] = -7.0f;
+  o.ao_distance = -1.0f;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "hemilight_bake_lightmap: options->ao_distance is -1");
+  o.ao_distance = (float)NAN;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->ao_distance is nan");
+  o.ao_distance = (float)INFINITY;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "hemilight_bake_scene: options->ao_distance is inf");
+  o.ao_distance = 2.0f;
+  o.ao_capacity = 32 * 32 - 1;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->ao_capacity 1023 is below width x height = 1024");
+  o.ao = NULL;
+  CHECK_FAILS(hemilight_bake_lightmap(m, 2, &o, e, 3 * 32 * 32, NULL, 0, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT,
+              "options->ao is NULL");
+  untouched_ao = 1;
+  for (i = 0; i < 32 * 32; ++i)
+    if (ao[i] != -7.0f) untouched_ao = 0;
+  CHECK(untouched_ao);
+  page_ao_capacity[0] = 100;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene->ao_capacity[0] 100 is below");
+  sd.ao_capacity = NULL;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene->ao_capacity is NULL");
+  sd.ao = NULL;
+  CHECK_FAILS(hemilight_bake_scene(&sd, &o, NULL), HEMILIGHT_ERROR_INVALID_ARGUMENT, "scene->ao is NULL");
+  /* A page may leave its AO out (ao[p] NULL): the bake succeeds. */
+  page_ao[0] = NULL;
+  sd.ao = page_ao;
+  sd.ao_capacity = page_ao_capacity;
+  CHECK(hemilight_bake_scene(&sd, &o, NULL) == HEMILIGHT_OK);
 }
 
 int main(void) {
@@ -491,6 +617,7 @@ int main(void) {
   test_edge_coverage();
   test_exported_floor();
   test_stitch_seams();
+  test_ao();
   printf("%d passed, %d failed\n", passed, failed);
   return failed == 0 ? 0 : 1;
 }

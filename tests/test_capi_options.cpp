@@ -108,6 +108,9 @@ TEST_CASE("C ABI options: the C defaults are the C++ defaults", "[capi]") {
   CHECK(b.sampler.raster.edge_coverage == bd.sampler.raster.edge_coverage);
   CHECK(b.strict == bd.strict);
   CHECK(b.stitch_seams == bd.stitch_seams);
+  CHECK(b.ao_distance == bd.ao_distance);
+  CHECK(capi::default_bake_options().ao == nullptr);
+  CHECK(capi::default_bake_options().ao_capacity == 0);
 }
 
 TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
@@ -129,6 +132,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   c.edge_coverage = 1;
   c.strict = 1;
   c.stitch_seams = 0;
+  c.ao_distance = 0.75f;
   light l;
   l.position = {1, 2, 3};
   const auto env = std::make_shared<const cubemap>();
@@ -156,6 +160,7 @@ TEST_CASE("C ABI options: every bake option reaches the C++ side", "[capi]") {
   CHECK(!capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false).strict);
   CHECK(!o.stitch_seams);
   CHECK(capi::to_cpp(capi::default_bake_options(), nullptr, {}, false, false).stitch_seams);
+  CHECK(o.ao_distance == 0.75f);
   REQUIRE(o.progress);
   progress_calls = 0;
   CHECK(o.progress(0.25f));
@@ -224,6 +229,46 @@ TEST_CASE("C ABI options: an older, shorter struct_size takes the defaults for t
   CHECK(stitch_full.stitch_seams == 1);
   CHECK(stitch_full.reserved2 == 0);         // padding: never read
   CHECK(stitch_full.strict == 0x01010101);  // read: within the older size
+  // The layout before ao_distance (up to stitch_seams and its tail padding, now reserved3, not
+  // read): ao_distance takes its default, 0, and ao and ao_capacity theirs, whatever lies beyond;
+  // the whole struct reads them.
+  hemilight_bake_options before_ao;
+  std::memset(&before_ao, 0x01, sizeof before_ao);
+  before_ao.struct_size = offsetof(hemilight_bake_options, reserved3);  // the older sizeof (168 on LP64)
+  hemilight_bake_options ao_full = capi::default_bake_options();
+  REQUIRE(capi::read_sized(&before_ao, ao_full).empty());
+  CHECK(ao_full.ao_distance == 0.0f);
+  CHECK(ao_full.ao == nullptr);
+  CHECK(ao_full.ao_capacity == 0);
+  CHECK(ao_full.reserved3 == 0);                 // padding: never read
+  CHECK(ao_full.stitch_seams == 0x01010101);    // read: within the older size
+  before_ao.struct_size = sizeof before_ao;
+  REQUIRE(capi::read_sized(&before_ao, ao_full).empty());
+  CHECK(ao_full.ao_capacity != 0);  // read: within the whole struct
+  CHECK(ao_full.reserved3 == 0);
+  CHECK(ao_full.reserved4 == 0);
+  // The scene description before ao (up to occluder_radiance and its tail padding, now reserved0):
+  // ao and ao_capacity stay NULL.
+  hemilight_bake_scene_desc desc_before_ao;
+  std::memset(&desc_before_ao, 0x01, sizeof desc_before_ao);
+  desc_before_ao.struct_size = offsetof(hemilight_bake_scene_desc, reserved0);  // occluder_radiance's end (52 of 56 on LP64)
+  hemilight_bake_scene_desc desc_full = capi::default_bake_scene_desc();
+  REQUIRE(capi::read_sized(&desc_before_ao, desc_full).empty());
+  CHECK(desc_full.ao == nullptr);
+  CHECK(desc_full.ao_capacity == nullptr);
+  CHECK(desc_full.reserved0 == 0);
+  CHECK(desc_full.occluder_radiance == 0x01010101);
+  // The description with the opacity fields but not ao (80 bytes on LP64): ao stays NULL.
+  desc_before_ao.struct_size = offsetof(hemilight_bake_scene_desc, ao);
+  desc_full = capi::default_bake_scene_desc();
+  REQUIRE(capi::read_sized(&desc_before_ao, desc_full).empty());
+  CHECK(desc_full.mesh_opacity != nullptr);
+  CHECK(desc_full.ao == nullptr);
+  CHECK(desc_full.ao_capacity == nullptr);
+  desc_before_ao.struct_size = sizeof desc_before_ao;
+  REQUIRE(capi::read_sized(&desc_before_ao, desc_full).empty());
+  CHECK(desc_full.ao != nullptr);
+  CHECK(desc_full.reserved0 == 0);
   // Statistics: only the fields within struct_size are written.
   hemilight_cache_stats from{};
   from.struct_size = sizeof from;

@@ -1,6 +1,6 @@
 // hemilight/bake.hpp — the lightmap baker: from triangles with lightmap UVs to an irradiance
-// lightmap (optionally directional maps and a shadow mask), through the irradiance cache, with
-// bounces and analytic lights. The pipeline, its steps and its figures: docs/bake.md.
+// lightmap (optionally directional maps, a shadow mask and ambient occlusion), through the
+// irradiance cache, with bounces and analytic lights. The pipeline, its steps and its figures: docs/bake.md.
 //
 // UV <-> texel convention (the same as radiance_texture::sample, raster.hpp): texel (x, y) has
 // its centre at uv = ((x + 0.5) / W, (y + 0.5) / H); u grows with the column x, v with the row y.
@@ -96,6 +96,19 @@ struct bake_options {
   /// Shadow mask (bake_result::shadow_mask): channel c holds the visibility of light
   /// shadow_mask_lights[c] (an index into lights), -1 leaves it 0. All -1: no mask.
   std::array<int, 4> shadow_mask_lights{{-1, -1, -1, -1}};
+  /// Ambient occlusion (bake_result::ao) within this distance, in scene units: per texel the
+  /// cosine-weighted fraction of the hemisphere that sees no geometry (front or back faces) within
+  /// it (docs/bake.md, "Ambient occlusion"). Finite and >= 0, else error(invalid_argument) naming
+  /// "ao_distance"; 0 = no AO (the default: the bake is then bitwise what it was without AO). Taken
+  /// from the first pass's hemicubes (no pass of its own) and, with use_cache, interpolated by the
+  /// cache with the irradiance's record weights (no gradients); the cache's AO rule
+  /// (cache.expert.refine_where_ao_disagrees, on) adds first-pass records where AO varies faster
+  /// than E, which changes the irradiance's bits too (it lowers its error); without the rule or
+  /// without the cache the irradiance is bitwise that of the bake without AO. Cost: one compare
+  /// and add per hemicube texel in the first pass, the added records' hemicubes (+14% to +145% of
+  /// the first pass's on the reference scenes, docs/bake.md), 4 bytes per record and sample, the
+  /// image (12 bytes per texel) and its stitching and dilation.
+  float ao_distance = 0.0f;
   int thread_count = 0;  ///< >= 0; 0 = all cores. Results do not depend on it.
   /// Called from the calling thread with the fraction of the bake done, in [0, 1], never
   /// decreasing; return false to cancel (error(status::cancelled), nothing returned). May be empty.
@@ -160,6 +173,12 @@ struct bake_result {
   /// shadow_mask_lights[c] (lights.hpp's light_sample::visibility: 1 for a light that casts no
   /// shadow, 0 where it is below the horizon or behind a rect), 0 for unused channels. Dilated.
   image shadow_mask;
+  /// With ao_distance > 0 (else empty): W x H RGB, the ambient occlusion in all three channels
+  /// (image_io writes 3 or 4 channels), in [0, 1]: 1 = open, 0 = fully occluded within
+  /// ao_distance. From the first pass (also with indirect_only or several bounces); texels inside
+  /// geometry are filled from their own chart, seams stitched and the map dilated like the
+  /// irradiance.
+  image ao;
   bake_stats stats;
 };
 
@@ -175,7 +194,7 @@ struct bake_input {
 /// Errors (hemilight::error naming the problem; nothing returned):
 ///   invalid_argument: options out of range (size 0 or > max_lightmap_size, bounces not in
 ///     [1, max_bounces], bad resolution, min_coverage not in [0, 1], offset_texels < 0 or NaN,
-///     dilation < -1, cache options out of range); no lightmap UVs; a UV more than
+///     dilation < -1, ao_distance < 0 or not finite, cache options out of range); no lightmap UVs; a UV more than
 ///     lightmap_uv_tolerance outside [0, 1] ("lightmap_uvs[7].u = 1.2 is outside [0, 1]"); with
 ///     strict, a triangle with 3D area but no UV area; a non-finite normal; an albedo outside
 ///     [0, 1]; everything scene::create rejects; no texel sampled (nothing to bake);
@@ -246,7 +265,7 @@ struct scene_bake_input {
 };
 
 /// What bake_scene returns: one bake_result per page (its irradiance, coverage, valid, sampled,
-/// directional maps and shadow mask at the page's size; its stats hold the page's texel counts:
+/// directional maps, shadow mask and ambient occlusion at the page's size; its stats hold the page's texel counts:
 /// texels, covered, sampled, invalid, overlapping, dilated; the rest 0) and the whole bake's
 /// statistics.
 struct scene_bake_result {
@@ -355,8 +374,8 @@ frame lightmap_tangent_frame(const glm::vec3 (&p)[3], const glm::vec2 (&uv)[3], 
 
 /// Writes the bake's EXR files (write_exr, image_io.hpp) with names prefix + suffix:
 /// "_irradiance.exr", "_mask.exr" (bake_mask_image), and when present "_sh_l1_0.exr" ..
-/// "_sh_l1_3.exr" (coefficients Y00, Y1-1, Y10, Y11), "_hl2_0.exr" .. "_hl2_2.exr" and
-/// "_shadow_mask.exr" (RGBA). Returns
+/// "_sh_l1_3.exr" (coefficients Y00, Y1-1, Y10, Y11), "_hl2_0.exr" .. "_hl2_2.exr",
+/// "_shadow_mask.exr" (RGBA) and "_ao.exr" (the AO in R, G and B). Returns
 /// the paths written, in that order. Errors: as write_exr (error(io) naming the file; files
 /// written before the failure stay).
 std::vector<std::string> write_bake_exrs(const bake_result& result, const std::string& prefix,

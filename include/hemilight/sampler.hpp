@@ -3,7 +3,8 @@
 //
 // A sampler renders a hemicube at (position, normal) (raster.hpp), reduces it (integrate.hpp) and,
 // on request, projects it onto the directional bases the baker writes: world-space L1 SH and the
-// irradiance on the cone of Half-Life 2 directions (hl2_cone). The cache calls it through
+// irradiance on the cone of Half-Life 2 directions (hl2_cone); and, on request, the ambient
+// occlusion within a distance from the same buffer's distances. The cache calls it through
 // `irradiance_sampler`, a plain function, and knows nothing else of this stage.
 // Directional conventions and measured accuracy: docs/bake.md ("Directional lightmaps").
 #pragma once
@@ -71,10 +72,17 @@ std::array<glm::vec3, 3> hl2_from_sh_l1(const std::array<glm::vec3, 4>& sh, cons
 
 // ---- samplers -------------------------------------------------------------------------------------
 
-/// What a sampler returns: the integrator's sample plus, when requested, the HL2 cone (zero
-/// otherwise). Converts implicitly from an irradiance_sample.
+/// What a sampler returns: the integrator's sample plus, when requested, the HL2 cone and the
+/// ambient occlusion (zero otherwise). Converts implicitly from an irradiance_sample.
 struct sampler_result : irradiance_sample {
   hl2_cone cone;
+  /// With sampler_pass::ao_distance > 0 (else 0): the cosine-weighted fraction of the hemisphere
+  /// that sees nothing within that distance, sum_i w_i [distance_i > D] / sum_i w_i over the
+  /// hemicube's texels (w_i: the integrator's projected solid angles, integration_table::vz;
+  /// distance_i: hemicube_buffer::distance, Euclidean, +inf for misses; back faces occlude like
+  /// front faces). In [0, 1]: exactly 1 when nothing lies within D, exactly 0 when every texel
+  /// sees geometry within D. docs/bake.md, "Ambient occlusion".
+  float ao = 0.0f;
   sampler_result() = default;
   sampler_result(const irradiance_sample& s) : irradiance_sample(s) {}  // NOLINT: implicit on purpose
 };
@@ -106,6 +114,10 @@ struct sampler_pass {
   /// Fill sampler_result::cone (reference = the hemicube's rolled tangent). Cost: 21 multiply-adds
   /// per texel and a table of 28 bytes per texel per resolution (table cache, memory.hpp).
   bool hl2_cone = false;
+  /// Fill sampler_result::ao: the ambient occlusion within this distance (scene units, finite,
+  /// >= 0; 0 = not computed, the default). Cost: one compare and add per texel, from the buffer
+  /// the irradiance comes from (no second render).
+  float ao_distance = 0.0f;
 };
 
 /// Checks the options and throws error(invalid_argument) naming the field, the message starting
@@ -115,9 +127,10 @@ void validate_sampler_options(const sampler_options& options, const std::string&
 
 /// A sampler that renders `scene` with one rasterizer, integrator and buffer per worker (`workers`
 /// of them; each worker makes its context on its first call). Throws error(invalid_argument) for a
-/// null scene, workers < 1, invalid options, an invalid texture, or pass.sh_l1 without
-/// integrate.rotation_gradient. The sampler throws error(invalid_argument) for a worker out of
-/// range. Cost per call: one render and one integration (raster.hpp, integrate.hpp).
+/// null scene, workers < 1, invalid options, an invalid texture, pass.sh_l1 without
+/// integrate.rotation_gradient, or pass.ao_distance negative or not finite (the message names
+/// "ao_distance"). The sampler throws error(invalid_argument) for a worker out of range. Cost per
+/// call: one render and one integration (raster.hpp, integrate.hpp), plus what the pass asks for.
 irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> scene, const sampler_options& options, int workers,
                                          const sampler_pass& pass = {});
 

@@ -169,11 +169,13 @@ std::function<bool(int, const glm::vec3&, const glm::vec3&)> rays_inside_test(co
   };
 }
 
-// One pass through the cache (bake_options::use_cache).
+// One pass through the cache (bake_options::use_cache); with `ao`, the records carry the
+// sampler's ambient occlusion and every sample gets its interpolation.
 pass_values cached_pass(const sample_points& pts, const irradiance_sampler& sampler, const cache_options& co, cache_run run,
-                        bool directional, const std::function<bool(float)>& progress, bake_stats& stats) {
+                        bool directional, bool ao, const std::function<bool(float)>& progress, bake_stats& stats) {
   const std::size_t count = pts.texel_of.size();
   run.directional = directional;
+  run.ao = ao;
   run.fill_invalid = false;  // fill_invalid_samples dilates valid texels into them instead
   if (progress) run.progress = progress;
   cache_result cr = cache_irradiance(pts.positions.data(), pts.normals.data(), count, sampler, co, run);
@@ -187,6 +189,7 @@ pass_values cached_pass(const sample_points& pts, const irradiance_sampler& samp
       for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = cr.sh_l1[i][c];
     v.cone = std::move(cr.cone);
   }
+  v.ao = std::move(cr.ao);
   stats.hemicubes += cr.stats.hemicubes;
   stats.records += cr.stats.records;
   stats.passes.push_back(cr.stats);
@@ -196,7 +199,7 @@ pass_values cached_pass(const sample_points& pts, const irradiance_sampler& samp
 // One pass with a hemicube at every sample (use_cache = false: the reference), in blocks so that
 // progress and cancellation stay live.
 pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& sampler, const bake_options& o,
-                           bool directional, const std::function<bool(float)>& progress, bake_stats& stats) {
+                           bool directional, bool ao, const std::function<bool(float)>& progress, bake_stats& stats) {
   const auto tp = std::chrono::steady_clock::now();
   const std::size_t count = pts.texel_of.size();
   pass_values v;
@@ -206,6 +209,7 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
     for (auto& plane : v.sh) plane.assign(count, glm::vec3(0.0f));
     v.cone.assign(count, hl2_cone{});
   }
+  if (ao) v.ao.assign(count, 0.0f);
   const std::size_t block = 2048;
   for (std::size_t b = 0; b < count; b += block) {
     if (progress && !progress(float(b) / float(count)))
@@ -220,6 +224,7 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
           for (std::size_t c = 0; c < 4; ++c) v.sh[c][i] = smp.sh_l1[c];
           v.cone[i] = rotate_hl2_cone(smp.cone, pts.normals[i], make_frame(pts.normals[i]).t);
         }
+        if (ao) v.ao[i] = smp.ao;
       }
     });
   }
@@ -276,20 +281,39 @@ direct_values lights_at_samples(const sample_points& pts, const scene& sc, const
 // What pass `pass`'s hemicubes compute besides irradiance (the radiance texture aside):
 // directional projections only where their result is used: the last pass, and the first when the
 // indirect part is wanted (last minus first). The cheap SH of sampler.hpp, not the integrator's
-// directional pass.
-sampler_pass pass_outputs(const bake_options& o, bool pass_directional) {
+// directional pass. Ambient occlusion in the first pass only (the geometry is the same in every
+// pass, so later passes' hemicubes would see the same distances).
+sampler_pass pass_outputs(const bake_options& o, bool pass_directional, bool first_pass) {
   sampler_pass pass;
   pass.sh_l1 = pass_directional && o.output_sh_l1;
   pass.hl2_cone = pass_directional && o.output_hl2;
+  pass.ao_distance = first_pass ? o.ao_distance : 0.0f;
   return pass;
 }
 
-// What the bounce passes leave: the last pass's values, the first's (with indirect_only), and
-// per sample whether every pass found it valid (outside geometry).
+// What the bounce passes leave: the last pass's values, the first's (with indirect_only), the
+// first pass's ambient occlusion (with ao_distance; filled where the sample is inside geometry),
+// and per sample whether every pass found it valid (outside geometry).
 struct bounce_values {
   pass_values last, first;
+  std::vector<float> ao;
   std::vector<std::uint8_t> valid;
 };
+
+// The ambient occlusion at samples inside geometry (valid = 0 after all passes: the set the last
+// pass's irradiance was filled at, since later passes take the earlier ones' invalid samples as
+// known inside) from the valid texels around them in their own chart (invalid_filler).
+void fill_invalid_ao(const sample_points& pts, const std::vector<std::uint8_t>& valid, const bake_layout& layout,
+                     std::vector<float>& ao) {
+  std::vector<std::uint8_t> invalid(valid.size());
+  for (std::size_t i = 0; i < valid.size(); ++i) invalid[i] = valid[i] ? 0 : 1;
+  const invalid_filler fill(pts, invalid, layout);
+  if (!fill.needed()) return;
+  std::vector<glm::vec3> plane(ao.size());
+  for (std::size_t i = 0; i < ao.size(); ++i) plane[i] = glm::vec3(ao[i]);
+  fill(plane);
+  for (std::size_t i = 0; i < ao.size(); ++i) ao[i] = plane[i].x;
+}
 
 // Step 3 and 4: o.bounces passes, each through the cache (or a hemicube per sample) over the
 // radiance texture of the previous pass's values (pass 1: the scene's emission, or the layout's
@@ -316,7 +340,8 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   for (int pass = 0; pass < o.bounces; ++pass) {
     report.check(float(pass) / float(o.bounces));
     const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
-    sampler_pass pass_request = pass_outputs(o, pass_directional);
+    sampler_pass pass_request = pass_outputs(o, pass_directional, pass == 0);
+    const bool pass_ao = pass_request.ao_distance > 0.0f;
     if (pass > 0 || layout.textured_first_pass) {
       texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
       texture_view = radiance_texture(texture);
@@ -332,13 +357,15 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
       for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(out.valid[i] ? 0 : 1);
       run.known_inside = inside.data();
     }
-    current = o.use_cache ? cached_pass(pts, sampler, o.cache, run, pass_directional, pass_progress, stats)
-                          : per_texel_pass(pts, sampler, o, pass_directional, pass_progress, stats);
+    current = o.use_cache ? cached_pass(pts, sampler, o.cache, run, pass_directional, pass_ao, pass_progress, stats)
+                          : per_texel_pass(pts, sampler, o, pass_directional, pass_ao, pass_progress, stats);
+    if (pass_ao) out.ao = std::move(current.ao);
     if (direct) add_direct(*direct, current);
     fill_invalid_samples(pts, current, layout);
     for (std::size_t i = 0; i < count; ++i) out.valid[i] = std::uint8_t(out.valid[i] & (current.invalid[i] ? 0 : 1));
     if (pass == 0 && o.indirect_only) out.first = current;
   }
+  if (!out.ao.empty()) fill_invalid_ao(pts, out.valid, layout, out.ao);
   return out;
 }
 
@@ -362,7 +389,7 @@ bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& s
   const bounce_values v = bounce_passes(pts, sc, o, layout, lit, report, r.stats);
   report.check(1.0f);
   if (lit) fill_direct_outputs(pts, v.valid, layout, direct);
-  write_outputs(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.valid, o, layout, r, filled);
+  write_outputs(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.ao, v.valid, o, layout, r, filled);
   r.stats.seconds = seconds_since(t0);
   return r;
 }

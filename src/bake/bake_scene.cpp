@@ -489,6 +489,7 @@ bake_result crop_page(const bake_result& all, const std::vector<std::uint8_t>& f
   for (std::size_t j = 0; j < 4; ++j) r.sh_l1[j] = crop(all.sh_l1[j]);
   for (std::size_t j = 0; j < 3; ++j) r.hl2[j] = crop(all.hl2[j]);
   r.shadow_mask = crop(all.shadow_mask);
+  r.ao = crop(all.ao);
   const std::vector<std::uint8_t> page_filled = crop_bytes(filled);
   r.stats.texels = pw * ph;
   r.stats.overlapping_texels = overlapping;

@@ -100,6 +100,9 @@ void check_options(const bake_options& o, const char* who, bool size) {
     throw_invalid_argument(std::string(who) + ": dilation " + std::to_string(o.dilation) + " must be >= -1");
   if (o.thread_count < 0)
     throw_invalid_argument(std::string(who) + ": thread_count " + std::to_string(o.thread_count) + " must be >= 0");
+  if (!(o.ao_distance >= 0.0f) || !std::isfinite(o.ao_distance))
+    throw_invalid_argument(std::string(who) + ": ao_distance " + num(o.ao_distance) +
+                           " must be finite and >= 0 (scene units; 0 = no ambient occlusion)");
   validate_cache_options(o.cache, std::string(who) + ": cache");  // whatever use_cache says
   try {
     validate_lights(o.lights.data(), o.lights.size());

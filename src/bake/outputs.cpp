@@ -85,8 +85,8 @@ void hl2_outputs(const sample_points& pts, const pass_values& last, const pass_v
 // Steps 5 and 6: the lightmap images from the last pass (less the first with indirect_only),
 // each stitched along the seams (bake_options::stitch_seams), then dilated around every chart.
 void write_outputs(const sample_points& pts, const pass_values& last, const pass_values* first,
-                   const direct_values* direct, const std::vector<std::uint8_t>& valid, const bake_options& o,
-                   const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled) {
+                   const direct_values* direct, const std::vector<float>& ao, const std::vector<std::uint8_t>& valid,
+                   const bake_options& o, const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled) {
   const std::size_t texels = std::size_t(layout.width) * std::size_t(layout.height);
   const std::size_t count = pts.texel_of.size();
   r.irradiance = sample_image(pts, layout, [&](std::size_t i) { return first ? glm::max(last.e[i] - first->e[i], glm::vec3(0.0f)) : last.e[i]; });
@@ -119,6 +119,9 @@ void write_outputs(const sample_points& pts, const pass_values& last, const pass
       r.shadow_mask.pixels[4 * k + 3] = alpha.pixels[3 * k];
     }
   }
+  // Ambient occlusion: one more scalar output of the stitcher (its three channels equal), kept in
+  // [0, 1].
+  if (!ao.empty()) r.ao = out.finish(sample_image(pts, layout, [&](std::size_t i) { return glm::vec3(ao[i]); }), 0.0f, 1.0f);
   out.finish(r.irradiance, filled, 0.0f, unbounded);
   if (out.stitcher) r.stats.seam_texels = out.stitcher->texels().size();
   r.stats.stitch_seconds += out.seconds;
@@ -141,6 +144,7 @@ std::vector<std::string> write_bake_exrs(const bake_result& r, const std::string
   for (std::size_t k = 0; k < r.hl2.size(); ++k)
     if (r.hl2[k].width > 0) put("_hl2_" + std::to_string(k) + ".exr", r.hl2[k]);
   if (r.shadow_mask.width > 0) put("_shadow_mask.exr", r.shadow_mask);
+  if (r.ao.width > 0) put("_ao.exr", r.ao);
   return written;
 }
 

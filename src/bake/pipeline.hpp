@@ -70,6 +70,7 @@ struct pass_values {
   std::vector<glm::vec3> e;
   sh_planes sh;                 // with directional outputs in this pass
   std::vector<hl2_cone> cone;   // with output_hl2 in this pass (reference make_frame(normal).t)
+  std::vector<float> ao;        // with ao_distance, in the first pass only
   std::vector<std::uint8_t> invalid;  // 1: the sample is inside geometry (filled, not computed)
 };
 
@@ -127,11 +128,12 @@ void fill_direct_outputs(const sample_points& pts, const std::vector<std::uint8_
                          direct_values& d);
 
 // Steps 5 and 6: the lightmap images from the last pass (less `first` with indirect_only), with
-// the lights' HL2 and shadow mask, dilated around every chart. `filled` receives the texels
-// written or dilated.
+// the lights' HL2 and shadow mask and the first pass's ambient occlusion `ao` (per sample, filled
+// at samples inside geometry; empty: none), dilated around every chart. `filled` receives the
+// texels written or dilated.
 void write_outputs(const sample_points& pts, const pass_values& last, const pass_values* first, const direct_values* direct,
-                   const std::vector<std::uint8_t>& valid, const bake_options& o, const bake_layout& layout, bake_result& r,
-                   std::vector<std::uint8_t>& filled);
+                   const std::vector<float>& ao, const std::vector<std::uint8_t>& valid, const bake_options& o,
+                   const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled);
 
 // Steps 2-6 of bake.hpp on the samples of a layout (one lightmap, or a scene bake's atlas):
 // the passes, the lights, the outputs. `filled` receives the texels written or dilated; t0 is

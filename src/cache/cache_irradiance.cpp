@@ -36,6 +36,10 @@ constexpr std::size_t list_entries_per_point = 8;
 // render_seeds marks a seed that cache_run::inside_test called inside with this backface
 // fraction (no hemicube; a sampler never returns more than 1).
 constexpr float tested_inside = 2.0f;
+// With cache_run::ao and cache_expert_options::refine_where_ao_disagrees, the coverage tests hold
+// the AO the records predict to a x max(AO, ao_floor), as they hold E to a x max(E, 5% of the mean
+// record E): AO is a fraction in [0, 1], so its floor is absolute.
+constexpr float ao_floor = 0.05f;
 
 // A seed of pick_seeds: where it is and its normal.
 struct seed {
@@ -53,18 +57,20 @@ struct coverage_detail {
   std::uint32_t last = 0;        // index of the last covering record (the only one when records == 1)
   float last_prediction = 0.0f;  // its luminance prediction at the point
   std::size_t visited = 0;       // records whose box the query visited (covering or not)
+  float ao_lo = 0.0f, ao_hi = 0.0f;  // the covering records' smallest and largest AO (with `ao`)
 };
 
 // Interpolation at one point through the BVH; returns the weight sum (0: not covered).
 // `spread` (optional) receives the range (max - min) of the luminance the covering records
 // predict for the point, and `own` whether one of them sits at the point itself.
 // `sh` (optional) receives the same weighted average of the records' L1 SH (zero if uncovered),
-// `cone` the same of the HL2 cones, `detail` (optional) what coverage_detail describes.
+// `cone` the same of the HL2 cones, `ao` the same of their ambient occlusion, `detail` (optional)
+// what coverage_detail describes.
 float interpolate(const std::vector<cache_record>& records, const record_lists& lists, const record_bvh& large, std::size_t point, const glm::vec3& x,
                   const glm::vec3& n, const cache_options& o, glm::vec3& out, float* spread = nullptr,
                   bool* own = nullptr, std::array<glm::vec3, 4>* sh = nullptr, hl2_cone* cone = nullptr,
                   coverage_detail* detail = nullptr,
-                  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked = nullptr) {
+                  const std::function<bool(const glm::vec3&, const glm::vec3&)>* blocked = nullptr, float* ao = nullptr) {
   // 1. The covering records and their weights, then in record order: the sums below do not
   // depend on how the lists and the tree report records (the same order as interpolate_records).
   struct covering {
@@ -90,7 +96,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
   std::array<glm::vec3, 4> sh_sum{};
   hl2_cone cone_sum;
   if (cone) cone_sum.reference = make_frame(n).t;
-  float wsum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  float wsum = 0.0f, ao_sum = 0.0f, lo = std::numeric_limits<float>::infinity(), hi = -lo;
   bool at_record = false;
   const int order = prediction_order(o);
   for (const covering& c : cover) {
@@ -105,6 +111,11 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
     if (cone) {
       const hl2_cone rc = rotate_hl2_cone(r.cone, r.normal, cone_sum.reference);
       for (std::size_t k = 0; k < std::size_t(hl2_cone_terms); ++k) cone_sum.coefficients[k] += w * rc.coefficients[k];
+    }
+    if (ao) ao_sum += w * r.ao;
+    if (ao && detail) {
+      detail->ao_lo = detail->records == 0 ? r.ao : std::min(detail->ao_lo, r.ao);
+      detail->ao_hi = detail->records == 0 ? r.ao : std::max(detail->ao_hi, r.ao);
     }
     const float l = luminance(e);
     lo = std::min(lo, l);
@@ -127,6 +138,7 @@ float interpolate(const std::vector<cache_record>& records, const record_lists& 
       for (glm::vec3& c : cone_sum.coefficients) c /= wsum;
     *cone = cone_sum;
   }
+  if (ao) *ao = wsum > 0.0f ? ao_sum / wsum : 0.0f;
   if (detail) detail->visited = visited;
   if (spread) *spread = wsum > 0.0f ? hi - lo : 0.0f;
   if (own) *own = at_record;
@@ -284,6 +296,7 @@ class placement {
     finest_ = a * o_.min_radius;
     nearby_reach_ = o_.expert.lone_record_neighbour_reach * finest_;
     contact_backface_ = 0.1f * o_.invalid_backface_fraction;
+    ao_refine_ = r_.ao && o_.expert.refine_where_ao_disagrees;
   }
 
   void set_up() {
@@ -443,13 +456,20 @@ class placement {
       const float reach = o_.error_threshold * key.radius;
       return glm::dot(dx, dx) <= 1.0002f * reach * reach;
     });
+    float ao = 0.0f;
     const float w = interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], coverage_options_, value, &spread, &own, nullptr, nullptr, &detail,
-                                blocked());
+                                blocked(), r_.ao ? &ao : nullptr);
     visited = detail.visited;
     bool ok = w > 0.0f;
     open_reason why = open_reason::uncovered;
     if (ok && o_.expert.refine_where_records_disagree && !own) {
       ok = spread <= a * std::max(luminance(value), floor_e_);
+      why = open_reason::records_disagree;
+    }
+    // The same for AO (cache_run::ao): it varies where E may not (within the AO distance of a
+    // contact or a corner, under a uniform light), and it has no gradient to extrapolate with.
+    if (ok && ao_refine_ && !own) {
+      ok = detail.ao_hi - detail.ao_lo <= a * std::max(ao, ao_floor);
       why = open_reason::records_disagree;
     }
     // Second opinion: a point that only one record covers is not covered while that record's
@@ -470,14 +490,15 @@ class placement {
     // themselves, must predict the same there within a (a hard shadow edge between two rows of
     // points is invisible to the covering record's gradient, not to a record beyond it).
     if (ok && o_.expert.lone_record_neighbour_reach > 0.0f && !own && detail.records == 1) {
-      ok = nearby_records_agree(i, detail);
+      ok = nearby_records_agree(i, detail, ao);
       why = open_reason::nearby_disagrees;
     }
     covered_[i] = ok ? 1 : 0;
     open_reason_[i] = static_cast<std::uint8_t>(why);
   }
 
-  bool nearby_records_agree(std::size_t i, const coverage_detail& detail) const {
+  // (With ao_refine_, the nearby records' AO must agree with the covering record's `ao` as well.)
+  bool nearby_records_agree(std::size_t i, const coverage_detail& detail, float ao) const {
     const glm::vec3 x = p_[i], nx = n_[i];
     const float la = std::max(detail.last_prediction, 0.0f);
     const float tolerance = o_.error_threshold * std::max(la, floor_e_);
@@ -488,6 +509,7 @@ class placement {
       if (k == detail.last || glm::dot(d, d) > r2) return false;
       if (glm::dot(rb.normal, nx) <= 0.9f || is_behind(rb, x, nx)) return false;
       const float lb = luminance(glm::max(o_.use_gradients ? rb.predict(x, nx) : rb.irradiance, glm::vec3(0.0f)));
+      if (ao_refine_ && std::fabs(records_[k].ao - ao) > o_.error_threshold * std::max(ao, ao_floor)) return true;
       return std::fabs(lb - la) > tolerance;
     });
   }
@@ -627,6 +649,7 @@ class placement {
       r.sh_l1 = s.sh_l1;
       r.cone = s.cone;
     }
+    if (r_.ao) r.ao = s.ao;
     float radius = std::isfinite(s.harmonic_mean_distance) ? s.harmonic_mean_distance : o_.max_radius;
     r.limit = std::isfinite(s.harmonic_mean_distance) ? radius_limit::split_sphere : radius_limit::max_radius;
     if (o_.expert.limit_radius_by_gradient) {
@@ -918,19 +941,22 @@ class placement {
       result.sh_l1.assign(count_, std::array<glm::vec3, 4>{});
       result.cone.assign(count_, hl2_cone{});
     }
+    if (r_.ao) result.ao.assign(count_, 0.0f);
     parallel_for(count_, threads_, 4096, [&](int, std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         glm::vec3 v;
         std::array<glm::vec3, 4> sh{};
         hl2_cone cone;
+        float ao = 0.0f;
         if (!inside(i) && interpolate(records_, lists_, large_tree_, i, p_[i], n_[i], o_, v, nullptr, nullptr, r_.directional ? &sh : nullptr,
-                                      r_.directional ? &cone : nullptr, nullptr, blocked()) > 0.0f) {
+                                      r_.directional ? &cone : nullptr, nullptr, blocked(), r_.ao ? &ao : nullptr) > 0.0f) {
           result.irradiance[i] = v;
           result.valid[i] = 1;
           if (r_.directional) {
             result.sh_l1[i] = sh;
             result.cone[i] = cone;
           }
+          if (r_.ao) result.ao[i] = ao;
         }
       }
     });
@@ -991,11 +1017,12 @@ class placement {
     std::array<glm::vec3, 4> sh{};
     hl2_cone cone;
     cone.reference = make_frame(n_[i]).t;
-    float wsum = 0.0f;
+    float wsum = 0.0f, ao = 0.0f;
     for (const auto& bw : best)
       if (bw.first > 0.0f) {
         const cache_record& rec = records_[bw.second];
         sum += bw.first * rec.irradiance;
+        ao += bw.first * rec.ao;
         if (r_.directional) {
           for (std::size_t c = 0; c < 4; ++c) sh[c] += bw.first * rec.sh_l1[c];
           const hl2_cone rc = rotate_hl2_cone(rec.cone, rec.normal, cone.reference);
@@ -1004,6 +1031,7 @@ class placement {
         wsum += bw.first;
       }
     result.irradiance[i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
+    if (r_.ao) result.ao[i] = wsum > 0.0f ? ao / wsum : 0.0f;
     if (r_.directional && wsum > 0.0f) {
       for (std::size_t c = 0; c < 4; ++c) result.sh_l1[i][c] = sh[c] / wsum;
       for (glm::vec3& c : cone.coefficients) c /= wsum;
@@ -1021,6 +1049,7 @@ class placement {
   int threads_ = 1;
   float diagonal_ = 0.0f, spacing_ = 0.0f, finest_ = 0.0f, nearby_reach_ = 0.0f, reported_ = 0.0f;
   float contact_backface_ = 0.0f;  // records seeing more back faces than this stand at a contact (make_record)
+  bool ao_refine_ = false;         // the coverage tests hold AO too (cache_expert_options::refine_where_ao_disagrees)
   float floor_e_ = 0.0f;   // the tests' dark floor (coverage_pass), fixed once set
   bool floor_set_ = false;
   std::vector<cache_record> records_;

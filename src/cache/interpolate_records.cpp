@@ -1,6 +1,7 @@
 // The cache's brute-force interpolation over a list of records, for tests and tools (cache.hpp:
-// record_weight, record_is_behind, interpolate_records, interpolate_records_sh_l1). The
-// placement's own interpolation through its search structures is in placement.cpp.
+// record_weight, record_is_behind, interpolate_records, interpolate_records_sh_l1,
+// interpolate_records_ao). The placement's own interpolation through its search structures is in
+// placement.cpp.
 #include "weights.hpp"
 
 #include "hemilight/cache.hpp"
@@ -45,6 +46,18 @@ std::array<glm::vec3, 4> interpolate_records_sh_l1(const std::vector<cache_recor
   if (wsum > 0.0f)
     for (glm::vec3& c : sum) c /= wsum;
   return sum;
+}
+
+float interpolate_records_ao(const std::vector<cache_record>& records, const glm::vec3& x, const glm::vec3& n,
+                             const cache_options& o) {
+  float sum = 0.0f, wsum = 0.0f;
+  for (const cache_record& r : records) {
+    const float w = record_weight(r, x, n, o);
+    if (w <= 0.0f || record_is_behind(r, x, n)) continue;
+    sum += w * r.ao;
+    wsum += w;
+  }
+  return wsum > 0.0f ? sum / wsum : 0.0f;
 }
 
 }  // namespace hemilight

@@ -1,7 +1,9 @@
 // make_hemicube_sampler and validate_sampler_options (sampler.hpp): a hemicube per call, rendered
-// and integrated with one context per worker, plus the optional directional projections.
+// and integrated with one context per worker, plus the optional directional projections and
+// ambient occlusion.
 #include "../core/hash.hpp"
 
+#include "ao.hpp"
 #include "hl2_cone.hpp"
 #include "sh_l1.hpp"
 
@@ -22,6 +24,9 @@ void check_sampler_arguments(const std::shared_ptr<const scene>& s, const sample
   if (workers < 1) throw_invalid_argument("make_hemicube_sampler: workers is " + std::to_string(workers) + "; it must be >= 1");
   if (pass.sh_l1 && !o.integrate.rotation_gradient)
     throw_invalid_argument("make_hemicube_sampler: sh_l1 needs integrate.rotation_gradient (band 1 comes from it)");
+  if (!(pass.ao_distance >= 0.0f) || !std::isfinite(pass.ao_distance))
+    throw_invalid_argument("make_hemicube_sampler: ao_distance is " + std::to_string(pass.ao_distance) +
+                           "; it must be finite and >= 0 (0 = no ambient occlusion)");
   validate_sampler_options(o, "make_hemicube_sampler");
 }
 
@@ -62,10 +67,12 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const s
   std::shared_ptr<const hemicube_table> table = pass.sh_l1 ? hemicube_table::get(o.resolution) : nullptr;
   std::shared_ptr<const sampler_detail::cone_weights> cone_table =
       pass.hl2_cone ? sampler_detail::make_cone_weights(o.resolution) : nullptr;
+  std::shared_ptr<const sampler_detail::ao_weights> ao_table =
+      pass.ao_distance > 0.0f ? sampler_detail::make_ao_weights(o.resolution) : nullptr;
   // One context per worker, made by the worker on its first call: a worker that never runs (a
   // cache of a few points on many threads) costs nothing.
   auto contexts = std::make_shared<std::vector<std::unique_ptr<sampler_context>>>(static_cast<std::size_t>(workers));
-  return [contexts, s, o, pass, table, cone_table](int worker, const glm::vec3& x, const glm::vec3& n) -> sampler_result {
+  return [contexts, s, o, pass, table, cone_table, ao_table](int worker, const glm::vec3& x, const glm::vec3& n) -> sampler_result {
     if (worker < 0 || std::size_t(worker) >= contexts->size())
       throw_invalid_argument("hemicube sampler: worker " + std::to_string(worker) + " is out of range");
     std::unique_ptr<sampler_context>& slot = (*contexts)[std::size_t(worker)];
@@ -78,6 +85,7 @@ irradiance_sampler make_hemicube_sampler(std::shared_ptr<const scene> s, const s
     sampler_result out = c.integrator.integrate(c.buffer);
     if (cone_table) out.cone = sampler_detail::project_hl2_cone(c.buffer, *cone_table, f.t);
     if (pass.sh_l1) out.sh_l1 = sampler_detail::project_sh_l1(c.buffer, *table, out.irradiance, out.rotation_gradient, f.n);
+    if (ao_table) out.ao = sampler_detail::unoccluded_fraction(c.buffer, *ao_table, pass.ao_distance);
     return out;
   };
 }
