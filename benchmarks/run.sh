@@ -31,8 +31,8 @@
 #                                     ~11 min the first time, ~6.5 with the references kept in build-bench/seams_truth; in the default
 #                                     run); SEAMS_FLAGS="--scenes open_street --sizes 256" etc.
 #   bash benchmarks/run.sh opacity            see-through surfaces' cost: foliage cards opaque, alpha-tested and
-#                                     translucent, per hemicube and per shadow ray, paired rounds (docs/materials.md;
-#                                     ~3 min; in the default run); OPACITY_FLAGS="--cards 250 --rounds 3" etc.
+#                                     translucent, per hemicube and per shadow ray, and ambient occlusion's cost in bakes,
+#                                     paired rounds (docs/materials.md, docs/bake.md; ~5 min; in the default run); OPACITY_FLAGS="--cards 250 --rounds 3" etc.
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -210,7 +210,7 @@ for n in "${names[@]}"; do
   if [ "$n" = opacity ]; then
     echo "== sweep_opacity"
     # shellcheck disable=SC2086  # the flags are words on purpose
-    "$build/benchmarks/sweep_opacity" docs/bench/opacity.csv ${OPACITY_FLAGS-}
+    "$build/benchmarks/sweep_opacity" docs/bench/opacity.csv docs/bench/ao_cost.csv ${OPACITY_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_opacity.py docs/bench
     continue
   fi

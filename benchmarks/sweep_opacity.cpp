@@ -6,15 +6,22 @@
 //     round (the machine's drift cancels); medians over the rounds;
 //   - shadow-ray time per ray towards a sun (occluded() for opaque and alpha-tested cards,
 //     transmittance() for translucent ones), in the same rounds;
-//   - what the hemicubes see: the share of texels showing a card.
-// Usage: sweep_opacity OUT.csv [--rounds R] [--cards 250,1000,4000] [--min-time S]
+//   - what the hemicubes see: the share of texels showing a card;
+// and ambient occlusion's cost in a bake (AO_OUT.csv): the Cornell box and the hexagon room
+// (t = 2), 128², one bounce, two threads, baked without AO, with AO (the default: the cache also
+// places records where AO varies) and with AO riding on E's records
+// (refine_where_ao_disagrees off), in paired rounds; bake seconds, first-pass hemicubes.
+// Usage: sweep_opacity OUT.csv [AO_OUT.csv] [--rounds R] [--cards 250,1000,4000] [--min-time S]
+#include "hemilight/bake.hpp"
 #include "hemilight/raster.hpp"
+#include "hemilight/reference_scenes.hpp"
 #include "hemilight/rays.hpp"
 #include "hemilight/scene.hpp"
 
 #include "bench_util.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -130,15 +137,62 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+// AO's cost in bakes (see the top), in paired rounds.
+void ao_cost(const char* path, int rounds) {
+  std::FILE* f = std::fopen(path, "w");
+  if (!f) return;
+  std::fprintf(f, "scene,size,ao_distance,variant,seconds,ratio_vs_no_ao,hemicubes,rounds,load_average\n");
+  struct row {
+    const char* name;
+    scene_mesh mesh;
+    float d;
+  };
+  const row rows[] = {{"cornell_box", cornell_box(), 0.1f}, {"hexagon_room", hexagon_room(2), 0.5f}};
+  const char* const variants[3] = {"no_ao", "ao", "ao_without_rule"};
+  for (const row& r : rows) {
+    bake_input in;
+    in.scene = r.mesh.desc();
+    std::vector<double> seconds[3], ratio[3];
+    std::size_t hemicubes[3] = {};
+    for (int round = 0; round < rounds; ++round) {
+      double got[3] = {};
+      for (int k = 0; k < 3; ++k) {
+        const int v = (round + k) % 3;
+        bake_options o;
+        o.width = o.height = 128;
+        o.thread_count = 2;
+        o.ao_distance = v == 0 ? 0.0f : r.d;
+        o.cache.expert.refine_where_ao_disagrees = v != 2;
+        const auto t0 = std::chrono::steady_clock::now();
+        const bake_result b = bake_lightmap(in, o);
+        got[v] = bench::seconds_since(t0);
+        hemicubes[v] = b.stats.hemicubes;
+      }
+      for (int v = 0; v < 3; ++v) {
+        seconds[v].push_back(got[v]);
+        ratio[v].push_back(got[v] / got[0]);
+      }
+    }
+    for (int v = 0; v < 3; ++v) {
+      std::fprintf(f, "%s,128,%g,%s,%.4f,%.3f,%zu,%d,%.2f\n", r.name, double(r.d), variants[v], median(seconds[v]), median(ratio[v]),
+                   hemicubes[v], rounds, bench::loadavg());
+      std::printf("%-13s AO %-16s %.3f s (x%.3f of no AO)  %zu hemicubes\n", r.name, variants[v], median(seconds[v]), median(ratio[v]),
+                  hemicubes[v]);
+    }
+  }
+  std::fclose(f);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "usage: sweep_opacity OUT.csv [--rounds R] [--cards 250,1000,4000] [--min-time S]\n");
+    std::fprintf(stderr, "usage: sweep_opacity OUT.csv [AO_OUT.csv] [--rounds R] [--cards 250,1000,4000] [--min-time S]\n");
     return 2;
   }
   int rounds = 7;
   double min_time = 0.3;
   std::vector<int> card_counts = {250, 1000, 4000};
-  for (int i = 2; i + 1 < argc; i += 2) {
+  const char* ao_path = argc > 2 && argv[2][0] != '-' ? argv[2] : nullptr;
+  for (int i = ao_path ? 3 : 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--rounds") rounds = std::max(1, std::atoi(argv[i + 1]));
     else if (a == "--min-time") min_time = std::atof(argv[i + 1]);
@@ -202,5 +256,6 @@ int main(int argc, char** argv) {
     }
   }
   std::fclose(f);
+  if (ao_path) ao_cost(ao_path, rounds);
   return 0;
 }
