@@ -8,13 +8,14 @@
 //     transmittance() for translucent ones), in the same rounds;
 //   - what the hemicubes see: the share of texels showing a card;
 // and ambient occlusion's cost in a bake (AO_OUT.csv): the Cornell box and the hexagon room
-// (t = 2), 128², one bounce, two threads, baked without AO, with AO (the default: the cache also
+// (t = 2) on the unwrapper's UVs, 128², one bounce, two threads, baked without AO, with AO (the default: the cache also
 // places records where AO varies) and with AO riding on E's records
 // (refine_where_ao_disagrees off), in paired rounds; bake seconds, first-pass hemicubes.
 // Usage: sweep_opacity OUT.csv [AO_OUT.csv] [--rounds R] [--cards 250,1000,4000] [--min-time S]
 #include "hemilight/bake.hpp"
 #include "hemilight/raster.hpp"
 #include "hemilight/reference_scenes.hpp"
+#include "hemilight/unwrap.hpp"
 #include "hemilight/rays.hpp"
 #include "hemilight/scene.hpp"
 
@@ -150,8 +151,10 @@ void ao_cost(const char* path, int rounds) {
   const row rows[] = {{"cornell_box", cornell_box(), 0.1f}, {"hexagon_room", hexagon_room(2), 0.5f}};
   const char* const variants[3] = {"no_ao", "ao", "ao_without_rule"};
   for (const row& r : rows) {
+    scene_mesh mesh = r.mesh;
+    generate_lightmap_uvs(mesh, 128, 2);  // chart UVs, 2 texels of padding
     bake_input in;
-    in.scene = r.mesh.desc();
+    in.scene = mesh.desc();
     std::vector<double> seconds[3], ratio[3];
     std::size_t hemicubes[3] = {};
     for (int round = 0; round < rounds; ++round) {

@@ -329,6 +329,8 @@ class alignas(64) rasterizer_impl {
   void composite_translucent(hemicube_buffer& out, const radiance_texture* texture);
   std::uint32_t see_through_back_key_ = 0;  // the shade of a see-through triangle's back (bind)
   std::vector<translucent_fragment> translucent_;
+  std::vector<translucent_fragment> layers_;   // composite_translucent's scratch: the fragments by texel
+  std::vector<std::uint32_t> layer_start_, layer_fill_;  // and each texel's first, per texel + 1
   std::vector<translucent_draw> translucent_draws_;
   std::vector<std::uint32_t> cutouts_;  // texels an alpha-tested fragment won when drawn
   std::vector<kept_texel> kept_cutouts_;

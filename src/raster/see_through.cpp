@@ -268,12 +268,28 @@ void raster_detail::rasterizer_impl::composite_translucent(hemicube_buffer& out,
   if (translucent_.empty()) return;
   stats_.translucent_fragments = translucent_.size();
   // Per texel, far to near (1/w ascending); equal depths in drawing order, the later drawn nearer.
-  std::sort(translucent_.begin(), translucent_.end(), [](const translucent_fragment& a, const translucent_fragment& b) {
-    if (a.texel != b.texel) return a.texel < b.texel;
-    if (a.z != b.z) return a.z < b.z;
-    return a.draw < b.draw;
-  });
-  const std::size_t count = out.texel_count();
+  // Grouped by texel with a counting sort (O(fragments + texels)), then each texel's few layers
+  // sorted by insertion.
+  const std::size_t texels = out.texel_count();
+  layer_start_.assign(texels + 1, 0u);
+  for (const translucent_fragment& f : translucent_) ++layer_start_[f.texel + 1];
+  for (std::size_t i = 0; i < texels; ++i) layer_start_[i + 1] += layer_start_[i];
+  layers_.resize(translucent_.size());
+  {
+    std::vector<std::uint32_t>& next = layer_fill_;
+    next.assign(layer_start_.begin(), layer_start_.end() - 1);
+    for (const translucent_fragment& f : translucent_) layers_[next[f.texel]++] = f;  // drawing order kept
+  }
+  const auto farther_first = [](const translucent_fragment& a, const translucent_fragment& b) {
+    return a.z < b.z || (a.z == b.z && a.draw < b.draw);
+  };
+  for (std::size_t i = 0; i < texels; ++i) {
+    const std::uint32_t b = layer_start_[i], e = layer_start_[i + 1];
+    for (std::uint32_t k = b + 1; k < e; ++k)
+      for (std::uint32_t j = k; j > b && farther_first(layers_[j], layers_[j - 1]); --j) std::swap(layers_[j], layers_[j - 1]);
+  }
+  translucent_.swap(layers_);
+  const std::size_t count = texels;
   const bool textured = texture && scene_->has_lightmap_uvs();
   const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
   const std::vector<std::uint32_t>& indices = scene_->indices();
