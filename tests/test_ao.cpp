@@ -239,16 +239,8 @@ TEST_CASE("AO: a floor beside a wall, baked, against numerical quadrature of the
 TEST_CASE("AO: the cache's AO is the records' weighted average, and the records hold their hemicubes' AO", "[ao]") {
   // The Cornell box's floor and back wall, 40 x 40 points each (as the cache's bit-for-bit test).
   const scene_mesh mesh = cornell_box();
-  const float H = 0.5488f, D = 0.5592f, W = 0.556f;
-  const int k = 40;
   std::vector<glm::vec3> p, n;
-  for (int j = 0; j < k; ++j)
-    for (int i = 0; i < k; ++i) {
-      p.push_back({(float(i) + 0.5f) / float(k) * W, 1e-3f, (float(j) + 0.5f) / float(k) * D});
-      n.push_back({0.0f, 1.0f, 0.0f});
-      p.push_back({(float(i) + 0.5f) / float(k) * W, (float(j) + 0.5f) / float(k) * H, D - 1e-3f});
-      n.push_back({0.0f, 0.0f, -1.0f});
-    }
+  test::cornell_floor_and_wall_points(40, p, n);
   sampler_options so;
   so.resolution = 32;
   sampler_pass pass;

@@ -7,6 +7,7 @@
 #include "hemilight/reference_scenes.hpp"
 
 #include "integrate_scenes.hpp"
+#include "test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -411,16 +412,8 @@ TEST_CASE("cache: each point's value is the brute-force interpolation over all r
   // order. Points: the Cornell box's floor and back wall, 48 x 48 each (several spacings of
   // coarse rounds, where only part of the points are seed candidates, and contacts at the edge).
   const scene_mesh mesh = cornell_box();
-  const float H = 0.5488f, D = 0.5592f, W = 0.556f;
-  const int k = 48;
   std::vector<glm::vec3> p, n;
-  for (int j = 0; j < k; ++j)
-    for (int i = 0; i < k; ++i) {
-      p.push_back({(float(i) + 0.5f) / float(k) * W, 1e-3f, (float(j) + 0.5f) / float(k) * D});
-      n.push_back({0.0f, 1.0f, 0.0f});
-      p.push_back({(float(i) + 0.5f) / float(k) * W, (float(j) + 0.5f) / float(k) * H, D - 1e-3f});
-      n.push_back({0.0f, 0.0f, -1.0f});
-    }
+  test::cornell_floor_and_wall_points(48, p, n);
   sampler_options so;
   so.resolution = 32;
   const irradiance_sampler sampler = make_hemicube_sampler(scene::create(mesh.desc()), so, resolve_thread_count(0));

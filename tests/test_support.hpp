@@ -28,6 +28,20 @@ void require_error(F&& f, status code, const std::string& needle) {
   }
 }
 
+/// k x k points 1 mm off the Cornell box's (reference_scenes.hpp) floor and back wall, at the
+/// centres of a k x k grid on each, the two surfaces' points interleaved (floor, wall) per grid
+/// cell, appended to p with their normals appended to n.
+inline void cornell_floor_and_wall_points(int k, std::vector<glm::vec3>& p, std::vector<glm::vec3>& n) {
+  const float H = 0.5488f, D = 0.5592f, W = 0.556f;
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) {
+      p.push_back({(float(i) + 0.5f) / float(k) * W, 1e-3f, (float(j) + 0.5f) / float(k) * D});
+      n.push_back({0.0f, 1.0f, 0.0f});
+      p.push_back({(float(i) + 0.5f) / float(k) * W, (float(j) + 0.5f) / float(k) * H, D - 1e-3f});
+      n.push_back({0.0f, 0.0f, -1.0f});
+    }
+}
+
 /// A mesh with explicit lightmap UVs: triangles given as (3D, UV) vertex triples, each with its
 /// own three vertices.
 struct uv_mesh {
