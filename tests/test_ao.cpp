@@ -109,6 +109,20 @@ bake_input input_of(const scene_mesh& m) {
   return in;
 }
 
+// A scene bake of `in` on one size x size page holding every triangle (identity placement).
+scene_bake_input one_page(const bake_input& in, int size) {
+  scene_bake_input sin;
+  sin.geometry = in;
+  lightmap_page page;
+  page.width = page.height = size;
+  sin.pages.push_back(page);
+  bake_mesh all;
+  all.triangle_count = in.scene.triangle_count;
+  all.page = 0;
+  sin.meshes.push_back(all);
+  return sin;
+}
+
 }  // namespace
 
 TEST_CASE("AO: a point under a parallel ceiling at height h is (h/D)^2 for D >= h and 1 for D < h", "[ao]") {
@@ -439,15 +453,7 @@ TEST_CASE("AO: off the bake is as before, on the irradiance changes only through
   o.bounces = 3;
   CHECK(same(bake_lightmap(in, o).ao, one.ao));
   // bake_scene with one page holding everything (identity placement) is bake_lightmap, AO too.
-  scene_bake_input sin;
-  sin.geometry = in;
-  lightmap_page page;
-  page.width = page.height = 32;
-  sin.pages.push_back(page);
-  bake_mesh all;
-  all.triangle_count = m.triangle_count();
-  all.page = 0;
-  sin.meshes.push_back(all);
+  const scene_bake_input sin = one_page(in, 32);
   o.bounces = 1;
   const scene_bake_result sr = bake_scene(sin, o);
   REQUIRE(sr.pages.size() == 1);
@@ -514,15 +520,7 @@ TEST_CASE("AO: bad ao_distance is refused naming the field", "[ao]") {
     o.width = o.height = 8;
     o.ao_distance = bad;
     require_error([&] { bake_lightmap(in, o); }, status::invalid_argument, "bake_lightmap: ao_distance");
-    scene_bake_input sin;
-    sin.geometry = in;
-    lightmap_page page;
-    page.width = page.height = 8;
-    sin.pages.push_back(page);
-    bake_mesh all;
-    all.triangle_count = in.scene.triangle_count;
-    all.page = 0;
-    sin.meshes.push_back(all);
+    const scene_bake_input sin = one_page(in, 8);
     require_error([&] { bake_scene(sin, o); }, status::invalid_argument, "bake_scene: ao_distance");
     sampler_pass pass;
     pass.ao_distance = bad;

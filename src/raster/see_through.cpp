@@ -105,12 +105,11 @@ struct face_edges {
 };
 
 // The texels of face `face` (columns x0..x1, rows y0..y1) whose centre rays may meet the triangle
-// with local vertices l: its projection's box where all three lie in front of the near plane,
-// the whole face otherwise. False when the triangle cannot reach the face.
-bool see_through_box(int face, const glm::vec3 (&l)[3], int n, double step, double first, float near, int& x0, int& x1,
+// with clip-space vertices c (to_clip of its local vertices): its projection's box where all three
+// lie in front of the near plane, the whole face otherwise. False when it cannot reach the face.
+bool see_through_box(int face, const clip_vertex (&c)[3], int n, double step, double first, float near, int& x0, int& x1,
                      int& y0, int& y1) noexcept {
   const int rows = face == 0 ? n : n / 2;
-  const clip_vertex c[3] = {to_clip(face, l[0]), to_clip(face, l[1]), to_clip(face, l[2])};
   // Wholly behind the near plane, or wholly beyond one side of the face's frustum.
   const auto all = [&](auto outside) { return outside(c[0]) && outside(c[1]) && outside(c[2]); };
   if (all([&](const clip_vertex& v) { return v.w < near; })) return false;
@@ -183,15 +182,13 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
   std::uint32_t draw = 0;
   for (int f = 0; f < 5; ++f) {
     int x0, x1, y0, y1;
-    if (!see_through_box(f, local, n_, texel_step_, first_centre_, near_, x0, x1, y0, y1)) continue;
+    const clip_vertex c[3] = {to_clip(f, local[0]), to_clip(f, local[1]), to_clip(f, local[2])};
+    if (!see_through_box(f, c, n_, texel_step_, first_centre_, near_, x0, x1, y0, y1)) continue;
     // Hidden on this face behind what is drawn (the occlusion culling's tiles, when it ran): a
     // conservative test, so no texel changes.
-    if (tiles_ready_) {
-      const clip_vertex c[3] = {to_clip(f, local[0]), to_clip(f, local[1]), to_clip(f, local[2])};
-      if (triangle_hidden(f, c)) {
-        ++stats_.see_through_occluded;
-        continue;
-      }
+    if (tiles_ready_ && triangle_hidden(f, c)) {
+      ++stats_.see_through_occluded;
+      continue;
     }
     if (edge_) draw = 0;  // one draw per (triangle, face), as the opaque paths number them
     face_setup fs;
