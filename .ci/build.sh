@@ -11,7 +11,7 @@ case "$mode" in main|test) ;; *) echo "usage: bash .ci/build.sh main|test" >&2; 
 
 # Debian packages the build, tests, examples and benchmarks need (Debian packages only: no vendored copies).
 packages=(cmake g++ make pkg-config libglm-dev libeigen3-dev catch2 libopenexr-dev libbenchmark-dev python3-matplotlib
-          glslang-tools libassimp-dev libpng-dev libstb-dev libembree-dev libmeshoptimizer-dev clang libclang-rt-14-dev)
+          glslang-tools libassimp-dev nlohmann-json3-dev python3-distributed python3-dask libpng-dev libstb-dev libembree-dev libmeshoptimizer-dev clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -62,10 +62,12 @@
 #include "hemilight/probes.hpp"
 #include "hemilight/reference_scenes.hpp"
 #include "hemilight/seams.hpp"
+#include "hemilight/shards.hpp"
 
 #include "model_export.hpp"
 #include "model_import.hpp"
 #include "preview.hpp"
+#include "shard_files.hpp"
 
 
 #include <algorithm>
@@ -77,6 +79,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -130,6 +133,13 @@ const char* usage =
     "                     an error naming the material and the file, for its alpha too)\n"
     "  --no-stitch-seams  leave the seams as baked (default: texels along seams between near-coplanar\n"
     "                     faces set so that both sides agree under bilinear filtering; docs/bake.md)\n"
+    "  --shards S         bake through S shards (1..4096): the sharded bake's jobs and merges in this\n"
+    "                     process (tools/dask_bake.py runs them on a Dask cluster, the same bits)\n"
+    "  --shard I/S --pass K  one job of a sharded bake: shard I (0-based) of S of pass K (1-based);\n"
+    "                     reads OUT/NAME_pass{K-1}.{exr,json} for K > 1, writes\n"
+    "                     OUT/NAME_pass{K}_shard{I}of{S}.{exr,json} (docs/distributed.md)\n"
+    "  --merge K          with --shards S: merges pass K's shards (and pass 1's); writes\n"
+    "                     OUT/NAME_pass{K}.{exr,json} for the next pass, or the bake's files after the last\n"
     "  --quiet            no progress bar\n"
     "  --help             this text\n";
 
@@ -167,6 +177,12 @@ struct settings {
   bool has_camera = false;   // --preview EX,EY,EZ,TX,TY,TZ[,FOV]
   preview::camera camera;
   std::string probes;  // --probes: "AxBxC" or a file of points; empty: none
+  // Sharded bakes (shards.hpp): --shards S alone bakes through S shards in this process;
+  // --shard I/S --pass K runs one job; --merge K --shards S merges pass K.
+  int shards = 0;       // 0: not sharded
+  int shard = -1;       // --shard I/S: I (-1: no job)
+  int pass = 0;         // --pass K (with --shard)
+  int merge = 0;        // --merge K (0: no merge)
 };
 
 // "a,b,c,d[,e]": 4 or 5 finite numbers.
@@ -289,6 +305,23 @@ settings parse(int argc, char** argv) {
       s.options.stitch_seams = false;
     } else if (a == "--quiet") {
       s.quiet = true;
+    } else if (a == "--shards") {
+      const int n = parse_int("--shards", value(), 1, max_bake_shards);
+      if (s.shards != 0 && s.shards != n) fail("--shards " + std::to_string(n) + " disagrees with --shard's count " + std::to_string(s.shards), 2);
+      s.shards = n;
+    } else if (a == "--shard") {
+      const std::string v = value();
+      int index = -1, n = 0;
+      char tail;
+      if (std::sscanf(v.c_str(), "%d/%d%c", &index, &n, &tail) != 2 || n < 1 || n > max_bake_shards || index < 0 || index >= n)
+        fail("--shard " + v + " is invalid: it must be I/S with 0 <= I < S <= " + std::to_string(max_bake_shards), 2);
+      if (s.shards != 0 && s.shards != n) fail("--shard " + v + " disagrees with --shards " + std::to_string(s.shards), 2);
+      s.shard = index;
+      s.shards = n;
+    } else if (a == "--pass") {
+      s.pass = parse_int("--pass", value(), 1, 64);
+    } else if (a == "--merge") {
+      s.merge = parse_int("--merge", value(), 1, 64);
     } else if (a.size() > 1 && a[0] == '-') {
       fail("unknown option " + a + " (see --help)", 2);
     } else if (s.model.empty()) {
@@ -297,6 +330,12 @@ settings parse(int argc, char** argv) {
       fail("more than one model given: " + s.model + " and " + a, 2);
     }
   }
+  if (s.shard >= 0 && s.pass == 0) fail("--shard needs --pass K (the pass the job computes)", 2);
+  if (s.pass > 0 && s.shard < 0) fail("--pass needs --shard I/S", 2);
+  if (s.merge > 0 && (s.shard >= 0 || s.shards == 0)) fail("--merge K needs --shards S and no --shard", 2);
+  if (std::max(s.pass, s.merge) > s.options.bounces)
+    fail((s.merge > 0 ? "--merge " + std::to_string(s.merge) : "--pass " + std::to_string(s.pass)) + " is past the last pass (--bounces " +
+             std::to_string(s.options.bounces) + ")", 2);
   if (!s.probes.empty() && s.options.indirect_only)
     fail("--probes cannot be used with --indirect-only: the probes see the surfaces' whole baked light", 2);
   return s;
@@ -483,6 +522,63 @@ void print_skipped_input(const bake_stats& st, const std::vector<std::string>& m
   }
 }
 
+// The bake, plain or sharded (settings: shards, shard, pass, merge). A job (--shard I/S --pass K)
+// writes its shard's files; a merge of pass K < bounces writes the state for pass K + 1; both
+// print one line and return nothing. The merge of the last pass and --shards S alone return the
+// bake's result, written as a plain bake's.
+std::optional<scene_bake_result> run_bake(const std::string& name, const std::string& base, const scene_bake_input& in,
+                                          const bake_options& o, const settings& s) {
+  if (s.shards == 0) return bake_scene(in, o);
+  if (s.shard < 0 && s.merge == 0) return bake_scene_sharded(in, o, s.shards);
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    if (s.shard >= 0) {
+      std::optional<bake_pass_state> previous;
+      if (s.pass > 1) previous = shard_files::read_state(shard_files::state_stem(base, s.pass - 1));
+      const bake_shard_result r = bake_scene_shard(in, o, s.shard, s.shards, s.pass, previous ? &*previous : nullptr);
+      const std::string stem = shard_files::shard_stem(base, s.pass, s.shard, s.shards);
+      shard_files::write_shard(stem, name, r);
+      if (bar_open) std::fprintf(stderr, "\n");
+      bar_open = false;
+      std::printf("%s: pass %d shard %d of %d: %zu samples, %zu hemicubes, %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.pass, s.shard,
+                  s.shards, r.sample_count, r.hemicubes, r.seconds, stem.c_str());
+      return std::nullopt;
+    }
+    // A merge: pass K's shards, pass 1's (their lights and AO), the state after pass K - 1.
+    const auto read_pass = [&](int pass) {
+      std::vector<bake_shard_result> shards;
+      for (int i = 0; i < s.shards; ++i) shards.push_back(shard_files::read_shard(shard_files::shard_stem(base, pass, i, s.shards)));
+      return shards;
+    };
+    const std::vector<bake_shard_result> these = read_pass(s.merge);
+    const std::vector<bake_shard_result> first = s.merge == 1 ? these : read_pass(1);
+    std::optional<bake_pass_state> previous;
+    if (s.merge > 1) previous = shard_files::read_state(shard_files::state_stem(base, s.merge - 1));
+    const bake_pass_state* prev = previous ? &*previous : nullptr;
+    if (s.merge == o.bounces) return finish_sharded_bake(in, o, these.data(), these.size(), first.data(), prev);
+    const bake_pass_state state = merge_bake_pass(in, o, s.merge, these.data(), these.size(), first.data(), prev);
+    const std::string stem = shard_files::state_stem(base, s.merge);
+    shard_files::write_state(stem, name, state);
+    std::size_t hemicubes = 0;
+    for (const bake_shard_result& r : these) hemicubes += r.hemicubes;
+    std::printf("%s: pass %d merged from %d shards (%zu hemicubes), %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.merge, s.shards,
+                hemicubes, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stem.c_str());
+    return std::nullopt;
+  } catch (const hemilight::error& e) {
+    if (e.code() != status::invalid_argument) throw;
+    // A mismatch the library found between this bake and the files: name the files.
+    const std::string inputs =
+        s.shard >= 0 ? shard_files::state_stem(base, s.pass - 1) + ".{exr,json}"
+                     : shard_files::shard_stem(base, s.merge, 0, s.shards) + " .. " + std::to_string(s.shards - 1) + "of" +
+                           std::to_string(s.shards) + (s.merge > 1 ? ", the same of pass 1 and " + shard_files::state_stem(base, s.merge - 1) : "");
+    fail("the files do not belong to this bake (" + inputs + "): " + e.what());
+  } catch (const cli_error&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    fail(e.what());  // a shard file missing or broken (shard_files names it)
+  }
+}
+
 void bake_and_write(const std::string& name, const scene_bake_input& in, const settings& s, const std::vector<light>& scene_lights,
                     const std::vector<std::string>& mesh_names = {}) {
   bake_options o = s.options;
@@ -496,11 +592,13 @@ void bake_and_write(const std::string& name, const scene_bake_input& in, const s
   bar.label = name;
   bar.quiet = s.quiet;
   o.progress = [&bar](float f) { return bar(f); };
-  const scene_bake_result sr = bake_scene(in, o);
+  const std::string base = s.out + "/" + name;
+  const std::optional<scene_bake_result> baked = run_bake(name, base, in, o, s);
   if (bar_open) std::fprintf(stderr, "\n");
   bar_open = false;
+  if (!baked) return;  // a job, or the merge of a pass before the last: its files are written
+  const scene_bake_result& sr = *baked;
   // Page 0 keeps the names of a one-lightmap bake (NAME_irradiance.exr ...); page p > 0 is NAME_pageP_*.
-  const std::string base = s.out + "/" + name;
   const auto page_base = [&](std::size_t p) { return p == 0 ? base : base + "_page" + std::to_string(p); };
   std::string suffixes;
   for (std::size_t p = 0; p < sr.pages.size(); ++p) {

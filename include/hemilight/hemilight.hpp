@@ -15,7 +15,8 @@
 //   cache      cache.hpp: the irradiance cache: records, radii, deterministic placement
 //   probes     probes.hpp: light probes: SH9 of the radiance at points
 //   bake       bake.hpp: the lightmap baker: UV coverage, samples, bounces, dilation;
-//              seams.hpp: the seams of a lightmap and their measured step (the baker stitches them)
+//              seams.hpp: the seams of a lightmap and their measured step (the baker stitches them);
+//              shards.hpp: a scene bake split into jobs for other processes or machines
 // The reference scenes by name are fixtures, outside the library (fixtures/, reference_scenes.hpp).
 #pragma once
 
@@ -36,4 +37,5 @@
 #include "hemilight/sampler.hpp"
 #include "hemilight/scene.hpp"
 #include "hemilight/seams.hpp"
+#include "hemilight/shards.hpp"
 #include "hemilight/unwrap.hpp"

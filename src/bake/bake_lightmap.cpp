@@ -78,9 +78,6 @@ void invalid_filler::operator()(std::vector<glm::vec3>& values) const {
     if (invalid_[i]) std::memcpy(&values[i], tmp.pixels.data() + 3 * pts_.texel_of[i], sizeof(glm::vec3));
 }
 
-
-namespace {
-
 // Samples inside geometry get the values of the valid texels around them (invalid_filler). Used
 // by both modes.
 void fill_invalid_samples(const sample_points& pts, pass_values& v, const bake_layout& layout) {
@@ -135,6 +132,8 @@ image pass_radiance_texture(const scene& sc, const sample_points& pts, const std
     std::memcpy(texture.pixels.data() + 3 * g.first, texture.pixels.data() + 3 * g.second, 3 * sizeof(float));
   return texture;
 }
+
+namespace {
 
 // The cache's cheap inside test of its seeds (cache_run::inside_test): rays in 16 fixed directions
 // spread evenly over the projected solid angle of the point's hemisphere (a golden-angle spiral);
@@ -242,6 +241,47 @@ pass_values per_texel_pass(const sample_points& pts, const irradiance_sampler& s
   return v;
 }
 
+// What pass `pass`'s hemicubes compute besides irradiance (the radiance texture aside):
+// directional projections only where their result is used: the last pass, and the first when the
+// indirect part is wanted (last minus first). The cheap SH of sampler.hpp, not the integrator's
+// directional pass. Ambient occlusion in the first pass only (the geometry is the same in every
+// pass, so later passes' hemicubes would see the same distances).
+sampler_pass pass_outputs(const bake_options& o, bool pass_directional, bool first_pass) {
+  sampler_pass pass;
+  pass.sh_l1 = pass_directional && o.output_sh_l1;
+  pass.hl2_cone = pass_directional && o.output_hl2;
+  pass.ao_distance = first_pass ? o.ao_distance : 0.0f;
+  return pass;
+}
+
+}  // namespace
+
+pass_values hemicube_pass(const sample_points& pts, const std::shared_ptr<const scene>& sc, const bake_options& o, int pass,
+                          const radiance_texture* texture, const std::uint8_t* known_inside,
+                          const std::function<bool(float)>& progress, bake_stats& stats) {
+  const bool directional = (o.output_sh_l1 || o.output_hl2) && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
+  sampler_pass request = pass_outputs(o, directional, pass == 0);
+  request.texture = texture;
+  const bool ao = request.ao_distance > 0.0f;
+  if (pts.texel_of.empty()) {  // a shard without samples
+    pass_values v;
+    stats.passes.push_back(cache_stats{});
+    return v;
+  }
+  const irradiance_sampler sampler = make_hemicube_sampler(sc, o.sampler, resolve_thread_count(o.thread_count), request);
+  if (!o.use_cache) return per_texel_pass(pts, sampler, o, directional, ao, progress, stats);
+  cache_run run;
+  run.thread_count = o.thread_count;
+  run.point_spacing = pts.spacing.data();
+  run.inside_test = rays_inside_test(sc);
+  // No record reaches across a wall (cache_run::segment_blocked): one any-hit ray.
+  run.segment_blocked = [sc](const glm::vec3& from, const glm::vec3& to) { return occluded(*sc, from, to - from, 1.0f); };
+  run.known_inside = known_inside;
+  return cached_pass(pts, sampler, o.cache, run, directional, ao, progress, stats);
+}
+
+namespace {
+
 // The bake's progress through the callback (if any): the cache's fraction can step back between
 // rounds; the bake reports the running maximum.
 class bake_progress {
@@ -263,6 +303,8 @@ class bake_progress {
   float reported_ = 0.0f;
 };
 
+}  // namespace
+
 // Step 3b with its timing: the lights' values at every sample, or nothing without lights.
 direct_values lights_at_samples(const sample_points& pts, const scene& sc, const light_set& lights, const bake_options& o,
                                 bake_stats& stats) {
@@ -277,28 +319,6 @@ direct_values lights_at_samples(const sample_points& pts, const scene& sc, const
   stats.direct_seconds = seconds_since(td);
   return direct;
 }
-
-// What pass `pass`'s hemicubes compute besides irradiance (the radiance texture aside):
-// directional projections only where their result is used: the last pass, and the first when the
-// indirect part is wanted (last minus first). The cheap SH of sampler.hpp, not the integrator's
-// directional pass. Ambient occlusion in the first pass only (the geometry is the same in every
-// pass, so later passes' hemicubes would see the same distances).
-sampler_pass pass_outputs(const bake_options& o, bool pass_directional, bool first_pass) {
-  sampler_pass pass;
-  pass.sh_l1 = pass_directional && o.output_sh_l1;
-  pass.hl2_cone = pass_directional && o.output_hl2;
-  pass.ao_distance = first_pass ? o.ao_distance : 0.0f;
-  return pass;
-}
-
-// What the bounce passes leave: the last pass's values, the first's (with indirect_only), the
-// first pass's ambient occlusion (with ao_distance; filled where the sample is inside geometry),
-// and per sample whether every pass found it valid (outside geometry).
-struct bounce_values {
-  pass_values last, first;
-  std::vector<float> ao;
-  std::vector<std::uint8_t> valid;
-};
 
 // The ambient occlusion at samples inside geometry (valid = 0 after all passes: the set the last
 // pass's irradiance was filled at, since later passes take the earlier ones' invalid samples as
@@ -315,22 +335,23 @@ void fill_invalid_ao(const sample_points& pts, const std::vector<std::uint8_t>& 
   for (std::size_t i = 0; i < ao.size(); ++i) ao[i] = plane[i].x;
 }
 
+namespace {
+
+// What the bounce passes leave: the last pass's values, the first's (with indirect_only), the
+// first pass's ambient occlusion (with ao_distance; filled where the sample is inside geometry),
+// and per sample whether every pass found it valid (outside geometry).
+struct bounce_values {
+  pass_values last, first;
+  std::vector<float> ao;
+  std::vector<std::uint8_t> valid;
+};
+
 // Step 3 and 4: o.bounces passes, each through the cache (or a hemicube per sample) over the
 // radiance texture of the previous pass's values (pass 1: the scene's emission, or the layout's
 // emission images), plus the lights, with samples inside geometry filled from their chart.
 bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<const scene>& sc, const bake_options& o,
                             const bake_layout& layout, const direct_values* direct, bake_progress& report, bake_stats& stats) {
   const std::size_t count = pts.texel_of.size();
-  const int workers = resolve_thread_count(o.thread_count);
-  const bool directional = o.output_sh_l1 || o.output_hl2;
-  cache_run run;
-  run.thread_count = o.thread_count;
-  run.point_spacing = pts.spacing.data();
-  if (o.use_cache) {
-    run.inside_test = rays_inside_test(sc);
-    // No record reaches across a wall (cache_run::segment_blocked): one any-hit ray.
-    run.segment_blocked = [sc](const glm::vec3& from, const glm::vec3& to) { return occluded(*sc, from, to - from, 1.0f); };
-  }
   bounce_values out;
   out.valid.assign(count, 1);
   std::vector<std::uint8_t> inside(count, 0);  // per sample: found inside geometry by an earlier pass
@@ -339,37 +360,46 @@ bounce_values bounce_passes(const sample_points& pts, const std::shared_ptr<cons
   radiance_texture texture_view;
   for (int pass = 0; pass < o.bounces; ++pass) {
     report.check(float(pass) / float(o.bounces));
-    const bool pass_directional = directional && (pass == o.bounces - 1 || (pass == 0 && o.indirect_only));
-    sampler_pass pass_request = pass_outputs(o, pass_directional, pass == 0);
-    const bool pass_ao = pass_request.ao_distance > 0.0f;
+    const radiance_texture* view = nullptr;
     if (pass > 0 || layout.textured_first_pass) {
       texture = pass_radiance_texture(*sc, pts, pass > 0 ? &current.e : nullptr, o, layout);
       texture_view = radiance_texture(texture);
-      pass_request.texture = &texture_view;
+      view = &texture_view;
     }
-    const irradiance_sampler sampler = make_hemicube_sampler(sc, o.sampler, workers, pass_request);
     const float base = float(pass) / float(o.bounces), span = 1.0f / float(o.bounces);
     std::function<bool(float)> pass_progress;
     if (report) pass_progress = [&](float f) { return report(base + span * f); };
     // Points an earlier pass found inside geometry are inside in this one too (the geometry is
     // the same): the cache renders no hemicube for them.
+    const std::uint8_t* known_inside = nullptr;
     if (pass > 0) {
       for (std::size_t i = 0; i < count; ++i) inside[i] = std::uint8_t(out.valid[i] ? 0 : 1);
-      run.known_inside = inside.data();
+      known_inside = inside.data();
     }
-    current = o.use_cache ? cached_pass(pts, sampler, o.cache, run, pass_directional, pass_ao, pass_progress, stats)
-                          : per_texel_pass(pts, sampler, o, pass_directional, pass_ao, pass_progress, stats);
-    if (pass_ao) out.ao = std::move(current.ao);
-    if (direct) add_direct(*direct, current);
-    fill_invalid_samples(pts, current, layout);
-    for (std::size_t i = 0; i < count; ++i) out.valid[i] = std::uint8_t(out.valid[i] & (current.invalid[i] ? 0 : 1));
+    current = hemicube_pass(pts, sc, o, pass, view, known_inside, pass_progress, stats);
+    if (!current.ao.empty()) out.ao = std::move(current.ao);
+    merge_pass(pts, direct, layout, current, out.valid);
     if (pass == 0 && o.indirect_only) out.first = current;
   }
-  if (!out.ao.empty()) fill_invalid_ao(pts, out.valid, layout, out.ao);
   return out;
 }
 
 }  // namespace
+
+void merge_pass(const sample_points& pts, const direct_values* direct, const bake_layout& layout, pass_values& v,
+                std::vector<std::uint8_t>& valid) {
+  if (direct) add_direct(*direct, v);
+  fill_invalid_samples(pts, v, layout);
+  for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = std::uint8_t(valid[i] & (v.invalid[i] ? 0 : 1));
+}
+
+void finish_samples(const sample_points& pts, const pass_values& last, const pass_values* first, direct_values* direct,
+                    std::vector<float>& ao, const std::vector<std::uint8_t>& valid, const bake_options& o,
+                    const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled) {
+  if (!ao.empty()) fill_invalid_ao(pts, valid, layout, ao);
+  if (direct) fill_direct_outputs(pts, valid, layout, *direct);
+  write_outputs(pts, last, first, direct, ao, valid, o, layout, r, filled);
+}
 
 bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& sc, const bake_options& o,
                          const bake_layout& layout, std::chrono::steady_clock::time_point t0, std::vector<std::uint8_t>& filled) {
@@ -384,12 +414,11 @@ bake_result bake_samples(sparse_samples s, const std::shared_ptr<const scene>& s
   s = sparse_samples{};  // what the passes need is in pts now
   const light_set lights(o.lights.data(), o.lights.size());
   direct_values direct = lights_at_samples(pts, *sc, lights, o, r.stats);
-  const direct_values* lit = lights.empty() ? nullptr : &direct;
+  direct_values* lit = lights.empty() ? nullptr : &direct;
   bake_progress report(o.progress);
-  const bounce_values v = bounce_passes(pts, sc, o, layout, lit, report, r.stats);
+  bounce_values v = bounce_passes(pts, sc, o, layout, lit, report, r.stats);
   report.check(1.0f);
-  if (lit) fill_direct_outputs(pts, v.valid, layout, direct);
-  write_outputs(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.ao, v.valid, o, layout, r, filled);
+  finish_samples(pts, v.last, o.indirect_only ? &v.first : nullptr, lit, v.ao, v.valid, o, layout, r, filled);
   r.stats.seconds = seconds_since(t0);
   return r;
 }

@@ -40,14 +40,6 @@ void check_page_image(const char* who, std::size_t p, const char* name, const im
     }
 }
 
-// The atlas of a scene bake: pages stacked vertically in one texel grid, each with guard rows
-// and columns between it and the rest (copies of its edge in radiance textures, never filled by
-// dilation), then the occluders' 2 x 2 blocks.
-struct scene_atlas {
-  bake_layout layout;
-  std::vector<int> page_y;  // first row of each page
-};
-
 scene_atlas make_atlas(const std::vector<lightmap_page>& pages, std::size_t occluder_materials) {
   scene_atlas a;
   int width = 0;
@@ -101,21 +93,6 @@ scene_atlas make_atlas(const std::vector<lightmap_page>& pages, std::size_t occl
   }
   return a;
 }
-
-// The combined geometry of a scene bake: the input's triangles with lightmap UVs in the atlas
-// (vertices shared by meshes duplicated, occluders' corners pointing at their material's block)
-// and, per vertex, its page UV (for the per-page samples).
-struct scene_geometry {
-  std::size_t clamped_uvs = 0;  // page UVs up to lightmap_uv_tolerance outside [0, 1], clamped
-  std::string clamped_warning;  // naming the first of them
-  std::vector<glm::vec3> positions, normals;
-  std::vector<glm::vec2> page_uvs;
-  std::vector<glm::vec2> texcoords;  // the alpha textures' coordinates, per vertex (when the input has them)
-  std::vector<std::uint32_t> indices;
-  std::vector<int> triangle_page;  // per triangle: page, or -1 (occluder)
-  std::vector<material> occluder_materials;
-  std::vector<std::size_t> triangle_block;  // per triangle: its occluder block (occluders only)
-};
 
 std::string uv_text(const glm::vec2& v) { return "(" + num(v.x) + ", " + num(v.y) + ")"; }
 
@@ -441,6 +418,8 @@ void page_materials(const scene_bake_input& input, const scene_atlas& atlas, con
   }
 }
 
+}  // namespace
+
 // The seams of a scene bake (within meshes, between meshes and pages) into the atlas's layout, each
 // side in its page's rows; returns the time it took.
 double scene_seams(const scene_bake_input& input, const scene_geometry& g, const scene& walls, scene_atlas& atlas) {
@@ -461,6 +440,8 @@ double scene_seams(const scene_bake_input& input, const scene_geometry& g, const
   atlas.layout.seam_pages = m.pages;
   return seconds_since(t0);
 }
+
+namespace {
 
 // Page p's result: the atlas rows of the page (images, per-texel arrays) and its statistics.
 bake_result crop_page(const bake_result& all, const std::vector<std::uint8_t>& filled, const scene_atlas& atlas,
@@ -504,23 +485,20 @@ bake_result crop_page(const bake_result& all, const std::vector<std::uint8_t>& f
 
 }  // namespace
 
-}  // namespace bake_detail
-
-scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& o) {
-  using namespace bake_detail;
-  const char* who = "bake_scene";
-  const auto t0 = std::chrono::steady_clock::now();
+scene_setup make_scene_setup(const char* who, const scene_bake_input& input, const bake_options& o) {
   check_scene_input(who, input, o);
-  const scene_geometry g = make_scene_geometry(who, input);
-  scene_atlas atlas = make_scene_atlas(who, input, g);
-  const std::shared_ptr<const scene> sc = combined_scene(input.geometry.scene, g, atlas_uvs(input, g, atlas));
-  std::vector<std::size_t> page_overlapping;
-  sparse_samples s = atlas_samples(who, input, g, atlas, o.strict, page_overlapping);
-  page_materials(input, atlas, s, atlas.layout);
-  const double seam_seconds = o.stitch_seams ? scene_seams(input, g, *sc, atlas) : 0.0;
-  std::vector<std::uint8_t> filled;
-  bake_result all = bake_samples(std::move(s), sc, o, atlas.layout, t0, filled);
-  all.stats.stitch_seconds += seam_seconds;
+  scene_setup su;
+  su.geometry = make_scene_geometry(who, input);
+  su.atlas = make_scene_atlas(who, input, su.geometry);
+  su.sc = combined_scene(input.geometry.scene, su.geometry, atlas_uvs(input, su.geometry, su.atlas));
+  su.samples = atlas_samples(who, input, su.geometry, su.atlas, o.strict, su.page_overlapping);
+  page_materials(input, su.atlas, su.samples, su.atlas.layout);
+  return su;
+}
+
+scene_bake_result scene_pages(const char* who, const scene_bake_input& input, const scene_setup& su, bake_result&& all,
+                              const std::vector<std::uint8_t>& filled) {
+  const scene_geometry& g = su.geometry;
   all.stats.clamped_uvs = g.clamped_uvs;
   if (g.clamped_uvs > 0) all.stats.warnings.push_back(g.clamped_warning);
   if (all.stats.no_uv_area_triangles > 0)
@@ -529,11 +507,25 @@ scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& 
   scene_bake_result out;
   out.pages.resize(input.pages.size());
   for (std::size_t p = 0; p < input.pages.size(); ++p)
-    out.pages[p] = crop_page(all, filled, atlas, input.pages[p], p, page_overlapping[p]);
+    out.pages[p] = crop_page(all, filled, su.atlas, input.pages[p], p, su.page_overlapping[p]);
   out.stats = std::move(all.stats);
   out.stats.texels = 0;
   for (const bake_result& r : out.pages) out.stats.texels += r.stats.texels;
   return out;
+}
+
+}  // namespace bake_detail
+
+scene_bake_result bake_scene(const scene_bake_input& input, const bake_options& o) {
+  using namespace bake_detail;
+  const char* who = "bake_scene";
+  const auto t0 = std::chrono::steady_clock::now();
+  scene_setup su = make_scene_setup(who, input, o);
+  const double seam_seconds = o.stitch_seams ? scene_seams(input, su.geometry, *su.sc, su.atlas) : 0.0;
+  std::vector<std::uint8_t> filled;
+  bake_result all = bake_samples(std::move(su.samples), su.sc, o, su.atlas.layout, t0, filled);
+  all.stats.stitch_seconds += seam_seconds;
+  return scene_pages(who, input, su, std::move(all), filled);
 }
 
 }  // namespace hemilight

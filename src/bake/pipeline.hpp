@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -105,6 +106,50 @@ class invalid_filler {
   bool any_ = false;
 };
 
+// The atlas of a scene bake: pages stacked vertically in one texel grid, each with guard rows
+// and columns between it and the rest (copies of its edge in radiance textures, never filled by
+// dilation), then the occluders' 2 x 2 blocks.
+struct scene_atlas {
+  bake_layout layout;
+  std::vector<int> page_y;  // first row of each page
+};
+
+// The combined geometry of a scene bake: the input's triangles with lightmap UVs in the atlas
+// (vertices shared by meshes duplicated, occluders' corners pointing at their material's block)
+// and, per vertex, its page UV (for the per-page samples).
+struct scene_geometry {
+  std::size_t clamped_uvs = 0;  // page UVs up to lightmap_uv_tolerance outside [0, 1], clamped
+  std::string clamped_warning;  // naming the first of them
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> page_uvs;
+  std::vector<glm::vec2> texcoords;  // the alpha textures' coordinates, per vertex (when the input has them)
+  std::vector<std::uint32_t> indices;
+  std::vector<int> triangle_page;  // per triangle: page, or -1 (occluder)
+  std::vector<material> occluder_materials;
+  std::vector<std::size_t> triangle_block;  // per triangle: its occluder block (occluders only)
+};
+
+// A scene bake's set-up (bake_scene.cpp: check_scene_input -> make_scene_geometry ->
+// make_scene_atlas -> combined_scene -> atlas_samples -> page_materials): everything before the
+// passes, the same bits for every job of a sharded bake. Throws as bake_scene does.
+struct scene_setup {
+  scene_geometry geometry;
+  scene_atlas atlas;
+  std::shared_ptr<const scene> sc;
+  sparse_samples samples;
+  std::vector<std::size_t> page_overlapping;  // per page
+};
+scene_setup make_scene_setup(const char* who, const scene_bake_input& input, const bake_options& o);
+
+// The seams of a scene bake (within meshes, between meshes and pages) into the atlas's layout;
+// returns the time it took.
+double scene_seams(const scene_bake_input& input, const scene_geometry& g, const scene& walls, scene_atlas& atlas);
+
+// The pages of a scene bake cut from the atlas's result `all` (filled: its texels written or
+// dilated), with the whole bake's statistics and warnings.
+scene_bake_result scene_pages(const char* who, const scene_bake_input& input, const scene_setup& su, bake_result&& all,
+                              const std::vector<std::uint8_t>& filled);
+
 // Wall time since t0, in seconds.
 double seconds_since(std::chrono::steady_clock::time_point t0);
 
@@ -113,6 +158,11 @@ double seconds_since(std::chrono::steady_clock::time_point t0);
 // their statistics. Throws error(invalid_argument) when no texel is sampled.
 sample_points place_samples(const sparse_samples& s, const scene& sc, const bake_options& o, const bake_layout& layout,
                             bake_result& r);
+
+// Step 3b with its timing (stats.direct_seconds): the lights' values at every sample, or nothing
+// without lights.
+direct_values lights_at_samples(const sample_points& pts, const scene& sc, const light_set& lights, const bake_options& o,
+                                bake_stats& stats);
 
 // Step 3b: the lights' direct irradiance (and SH, HL2, shadow-mask visibility as the options ask)
 // at every sample; keep_going (may be empty) is polled between blocks (false: error(cancelled)).
@@ -134,6 +184,36 @@ void fill_direct_outputs(const sample_points& pts, const std::vector<std::uint8_
 void write_outputs(const sample_points& pts, const pass_values& last, const pass_values* first, const direct_values* direct,
                    const std::vector<float>& ao, const std::vector<std::uint8_t>& valid, const bake_options& o,
                    const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled);
+
+// Step 4's radiance texture for pass `e` != null: emission + albedo e / pi per sample, dilated,
+// with the occluder blocks and the guards; e = null: the emission alone (pass 1 with emission
+// images).
+image pass_radiance_texture(const scene& sc, const sample_points& pts, const std::vector<glm::vec3>* e, const bake_options& o,
+                            const bake_layout& layout);
+
+// Step 4, the hemicubes of pass `pass` (0-based) at the samples pts: through the cache or a
+// hemicube per sample, seeing `texture` (null: the scene's emission); known_inside (null, or
+// per sample 1: found inside geometry by an earlier pass) skips hemicubes. The values as the
+// sampler gives them: no lights, invalid samples not filled. Appends the pass's cache_stats.
+pass_values hemicube_pass(const sample_points& pts, const std::shared_ptr<const scene>& sc, const bake_options& o, int pass,
+                          const radiance_texture* texture, const std::uint8_t* known_inside,
+                          const std::function<bool(float)>& progress, bake_stats& stats);
+
+// A pass's values finished over all samples: the lights added (direct may be null), samples
+// inside geometry filled from their chart, valid[i] cleared where the pass found sample i inside.
+void merge_pass(const sample_points& pts, const direct_values* direct, const bake_layout& layout, pass_values& v,
+                std::vector<std::uint8_t>& valid);
+
+// The ambient occlusion at samples inside geometry (valid = 0 after all passes) from the valid
+// texels around them in their own chart.
+void fill_invalid_ao(const sample_points& pts, const std::vector<std::uint8_t>& valid, const bake_layout& layout,
+                     std::vector<float>& ao);
+
+// Steps 5 and 6 after the passes: AO and the lights' outputs filled at samples inside geometry,
+// then write_outputs.
+void finish_samples(const sample_points& pts, const pass_values& last, const pass_values* first, direct_values* direct,
+                    std::vector<float>& ao, const std::vector<std::uint8_t>& valid, const bake_options& o,
+                    const bake_layout& layout, bake_result& r, std::vector<std::uint8_t>& filled);
 
 // Steps 2-6 of bake.hpp on the samples of a layout (one lightmap, or a scene bake's atlas):
 // the passes, the lights, the outputs. `filled` receives the texels written or dilated; t0 is
