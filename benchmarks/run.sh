@@ -33,6 +33,11 @@
 #   bash benchmarks/run.sh opacity            see-through surfaces' cost: foliage cards opaque, alpha-tested and
 #                                     translucent, per hemicube and per shadow ray, and ambient occlusion's cost in bakes,
 #                                     paired rounds (docs/materials.md, docs/bake.md; ~5 min; in the default run); OPACITY_FLAGS="--cards 250 --rounds 3" etc.
+#   bash benchmarks/run.sh shards             the sharded bake on the stand-in levels: error, hemicubes and shard balance
+#                                     against the shard count, set-up, merge and transfer (sweep_shards), the Dask driver's
+#                                     speed-up against worker processes (benchmarks/dask_speedup.py), and the paper estimate
+#                                     for a 32-page level (docs/distributed.md; ~25 min; not run by default);
+#                                     SHARDS_FLAGS="--shards 1,4" DASK_SPEEDUP_FLAGS="--rounds 3" etc.
 # What each program measures, what it writes and how long it takes: benchmarks/README.md.
 # For each NAME: build-bench/benchmarks/bench_NAME runs as a Google Benchmark with repetitions
 # (CSV of the medians etc.), build-bench/benchmarks/sweep_NAME (if any) writes its own CSV, and
@@ -53,6 +58,7 @@ if [ ${#names[@]} -eq 0 ]; then
     n=$(basename "$f"); n=${n#bench_}; n=${n#sweep_}
     [ "$n" = bake_scaling ] && continue  # long (a 1M-triangle bake, 4096^2 lightmaps): only when named
     [ "$n" = cache_levels ] && continue  # long (bakes of the levels up to 1024²): only when named
+    [ "$n" = shards ] && continue  # long (per-texel references of three levels, the Dask rounds): only when named
     [[ " ${names[*]-} " == *" $n "* ]] || names+=("$n")
   done
 fi
@@ -205,6 +211,17 @@ for n in "${names[@]}"; do
     # shellcheck disable=SC2086  # the flags are words on purpose
     "$build/benchmarks/sweep_bake_scaling" docs/bench/bake_scaling.csv ${BAKE_SCALING_FLAGS-}
     PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_bake_scaling.py docs/bench
+    continue
+  fi
+  if [ "$n" = shards ]; then
+    echo "== sweep_shards"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    "$build/benchmarks/sweep_shards" docs/bench/shards.csv ${SHARDS_FLAGS-}
+    echo "== dask_speedup"
+    # shellcheck disable=SC2086
+    /usr/bin/python3 benchmarks/dask_speedup.py --bake "$build/examples/hemilight_bake" \
+      --make-level "$build/examples/hemilight_make_level" --out docs/bench/dask_speedup.csv ${DASK_SPEEDUP_FLAGS-}
+    PYTHONPATH=benchmarks /usr/bin/python3 benchmarks/plot_shards.py docs/bench
     continue
   fi
   if [ "$n" = opacity ]; then
