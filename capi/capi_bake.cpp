@@ -1,7 +1,9 @@
 // The C ABI of the lightmap baker: meshes concatenated into one scene, bake_lightmap, outputs
-// copied into the caller's buffers only after everything succeeded.
+// copied into the caller's buffers only after everything succeeded. The scene bake's checks and
+// outputs are steps (capi_scene_bake.hpp) that the sharded bakes (capi_shards.cpp) share.
 #include "capi_internal.hpp"
 #include "capi_options.hpp"
+#include "capi_scene_bake.hpp"
 
 #include "hemilight/bake.hpp"
 
@@ -613,60 +615,82 @@ hemilight_status bake_scene(const hemilight_bake_scene_desc* scene, const hemili
                             hemilight_bake_stats* stats) {
   const char* fn = "hemilight_bake_scene";
   return guarded(fn, [&] {
-    // Step 1: the description, the options, every page, the lights.
-    if (!scene) return invalid(fn, "scene is NULL (use hemilight_bake_scene_desc_init)");
-    hemilight_bake_scene_desc sd = hemilight::capi::default_bake_scene_desc();
-    if (const std::string problem = hemilight::capi::read_sized(scene, sd); !problem.empty()) return invalid(fn, problem);
-    hemilight_bake_options o;
-    if (const hemilight_status st = read_options(fn, options, stats, o)) return st;
-    if (const hemilight_status st = check_scene_desc(fn, sd)) return st;
-    std::shared_ptr<const hemilight::cubemap> environment;
-    bool mask = false;
-    if (const hemilight_status st = check_common_options(fn, o, environment, mask)) return st;
-    bool want_sh = false, want_hl2 = false;
-    for (size_t p = 0; p < sd.page_count; ++p) {
-      const std::string name = "scene->pages[" + std::to_string(p) + "]";
-      if (const hemilight_status st = check_page(fn, sd.pages[p], {name + ": ", name + ".", name + "."}, mask)) return st;
-      want_sh = want_sh || sd.pages[p].sh_l1_rgb;
-      want_hl2 = want_hl2 || sd.pages[p].hl2_rgb;
-    }
-    const bool ao = o.ao_distance > 0.0f;
-    if (ao) {
-      if (!sd.ao)
-        return invalid(fn, "options->ao_distance is " + std::to_string(o.ao_distance) +
-                               " but scene->ao is NULL (page_count pointers, each NULL or a page's width x height floats)");
-      if (!sd.ao_capacity) return invalid(fn, "scene->ao_capacity is NULL (page_count capacities, in floats)");
-      for (size_t p = 0; p < sd.page_count; ++p) {
-        const std::string name = "scene->ao[" + std::to_string(p) + "]";
-        if (const hemilight_status st =
-                check_ao_buffer(fn, sd.ao[p], sd.ao_capacity[p], size_t(sd.pages[p].width) * size_t(sd.pages[p].height), false, name,
-                                "scene->ao_capacity[" + std::to_string(p) + "]", o.ao_distance))
-          return st;
-      }
-    }
-    std::vector<hemilight::light> lights;
-    if (const hemilight_status st = hemilight::capi::to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
-    // Step 2: the placements, the opacities, then the meshes (checked against their pages) concatenated.
-    std::vector<uv_target> targets;
-    if (const hemilight_status st = placement_targets(fn, sd, targets)) return st;
-    bool reads_texture = false;
-    if (const hemilight_status st = check_opacity(fn, sd, reads_texture)) return st;
-    gathered_scene g;
-    if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, o.strict == 1, g, "scene->")) return st;
-    add_opacity(sd, reads_texture, g);
+    // Steps 1 and 2: the description, options, pages, lights and meshes (prepare_scene_bake).
+    hemilight::capi::scene_bake_call call;
+    if (const hemilight_status st = hemilight::capi::prepare_scene_bake(fn, scene, options, stats, call)) return st;
     // Step 3: the bake (whatever it still refuses reaches the caller under fn: guarded).
-    const hemilight::bake_options bo = hemilight::capi::to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
-    const hemilight::scene_bake_result r = hemilight::bake_scene(scene_input_of(sd, g, o), bo);
-    // Step 4: the outputs, only when every page is finite.
-    for (const hemilight::bake_result& page : r.pages)
-      if (!result_finite(page)) return invalid(fn, overflow_message);
-    for (size_t p = 0; p < sd.page_count; ++p) {
-      write_page(r.pages[p], sd.pages[p], mask);
-      if (ao && sd.ao[p]) write_ao(r.pages[p], sd.ao[p]);
-    }
-    if (stats) hemilight::capi::write_sized(stats_of(r.stats, sd.meshes, sd.mesh_count), stats);
-    return HEMILIGHT_OK;
+    const hemilight::scene_bake_result r = hemilight::bake_scene(call.input, call.options);
+    // Step 4: the outputs, only when every page is finite (write_scene_bake).
+    return hemilight::capi::write_scene_bake(fn, call, r, stats);
   });
 }
 
 }  // namespace
+
+namespace hemilight::capi {
+
+hemilight_status prepare_scene_bake(const char* fn, const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                    const hemilight_bake_stats* stats, scene_bake_call& call) {
+  // Step 1: the description, the options, every page, the lights.
+  if (!scene) return invalid(fn, "scene is NULL (use hemilight_bake_scene_desc_init)");
+  hemilight_bake_scene_desc sd = default_bake_scene_desc();
+  if (const std::string problem = read_sized(scene, sd); !problem.empty()) return invalid(fn, problem);
+  hemilight_bake_options o;
+  if (const hemilight_status st = read_options(fn, options, stats, o)) return st;
+  if (const hemilight_status st = check_scene_desc(fn, sd)) return st;
+  std::shared_ptr<const hemilight::cubemap> environment;
+  bool mask = false;
+  if (const hemilight_status st = check_common_options(fn, o, environment, mask)) return st;
+  bool want_sh = false, want_hl2 = false;
+  for (size_t p = 0; p < sd.page_count; ++p) {
+    const std::string name = "scene->pages[" + std::to_string(p) + "]";
+    if (const hemilight_status st = check_page(fn, sd.pages[p], {name + ": ", name + ".", name + "."}, mask)) return st;
+    want_sh = want_sh || sd.pages[p].sh_l1_rgb;
+    want_hl2 = want_hl2 || sd.pages[p].hl2_rgb;
+  }
+  const bool ao = o.ao_distance > 0.0f;
+  if (ao) {
+    if (!sd.ao)
+      return invalid(fn, "options->ao_distance is " + std::to_string(o.ao_distance) +
+                             " but scene->ao is NULL (page_count pointers, each NULL or a page's width x height floats)");
+    if (!sd.ao_capacity) return invalid(fn, "scene->ao_capacity is NULL (page_count capacities, in floats)");
+    for (size_t p = 0; p < sd.page_count; ++p) {
+      const std::string name = "scene->ao[" + std::to_string(p) + "]";
+      if (const hemilight_status st =
+              check_ao_buffer(fn, sd.ao[p], sd.ao_capacity[p], size_t(sd.pages[p].width) * size_t(sd.pages[p].height), false, name,
+                              "scene->ao_capacity[" + std::to_string(p) + "]", o.ao_distance))
+        return st;
+    }
+  }
+  std::vector<hemilight::light> lights;
+  if (const hemilight_status st = to_lights(fn, "options->lights", o.lights, o.light_count, lights)) return st;
+  // Step 2: the placements, the opacities, then the meshes (checked against their pages) concatenated.
+  std::vector<uv_target> targets;
+  if (const hemilight_status st = placement_targets(fn, sd, targets)) return st;
+  bool reads_texture = false;
+  if (const hemilight_status st = check_opacity(fn, sd, reads_texture)) return st;
+  const auto g = std::make_shared<gathered_scene>();
+  if (const hemilight_status st = gather_meshes(fn, sd.meshes, sd.mesh_count, targets, o.strict == 1, *g, "scene->")) return st;
+  add_opacity(sd, reads_texture, *g);
+  call.desc = sd;
+  call.mask = mask;
+  call.ao = ao;
+  call.input = scene_input_of(sd, *g, o);
+  call.storage = g;
+  call.options = to_cpp(o, std::move(environment), std::move(lights), want_sh, want_hl2);
+  return HEMILIGHT_OK;
+}
+
+hemilight_status write_scene_bake(const char* fn, const scene_bake_call& call, const scene_bake_result& r, hemilight_bake_stats* stats) {
+  const hemilight_bake_scene_desc& sd = call.desc;
+  for (const hemilight::bake_result& page : r.pages)
+    if (!result_finite(page)) return invalid(fn, overflow_message);
+  for (size_t p = 0; p < sd.page_count; ++p) {
+    write_page(r.pages[p], sd.pages[p], call.mask);
+    if (call.ao && sd.ao[p]) write_ao(r.pages[p], sd.ao[p]);
+  }
+  if (stats) write_sized(stats_of(r.stats, sd.meshes, sd.mesh_count), stats);
+  return HEMILIGHT_OK;
+}
+
+}  // namespace hemilight::capi

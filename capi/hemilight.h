@@ -32,8 +32,9 @@
  *
  * Structs that grow (what stays compatible)
  *   - hemilight_cache_options, hemilight_cache_stats, hemilight_bake_options,
- *     hemilight_bake_stats, hemilight_bake_scene_desc, hemilight_unwrap_options and
- *     hemilight_unwrap_stats begin with size_t struct_size. Their _init functions are inline (below)
+ *     hemilight_bake_stats, hemilight_bake_scene_desc, hemilight_unwrap_options,
+ *     hemilight_unwrap_stats, hemilight_bake_shard_info and hemilight_bake_pass_state_info begin
+ *     with size_t struct_size. Their _init functions are inline (below)
  *     and record the sizeof the program was compiled with; call one before use.
  *   - A later minor version only appends fields to them, each new field starting at or after the
  *     previous version's sizeof. The library reads the fields that lie within the caller's
@@ -988,6 +989,221 @@ static inline void hemilight_bake_scene_desc_init(hemilight_bake_scene_desc* sce
  * "opacity" above says, and 8 bytes per vertex for the texcoords when a texture is read. */
 HEMILIGHT_API hemilight_status hemilight_bake_scene(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
                                                     hemilight_bake_stats* stats);
+
+/* ---- sharded scene bakes: jobs anywhere, then merges --------------------------------------------
+ * Since 0.15. hemilight_bake_scene split into shards (include/hemilight/shards.hpp; docs/capi.md,
+ * "Sharded bakes"): jobs that run in any process or on any machine, and the merges that join
+ * them. A bake of B = options->bounces bounces with S shards is B passes; pass k (1-based) is S
+ * jobs and one merge:
+ *   job (shard i of S, pass k):  hemilight_bake_scene_shard(scene, options, i, S, k, state_k-1)   -> shard_k,i
+ *   merge (pass k < B):          hemilight_merge_bake_pass(scene, options, k, shards_k, S, shards_1, state_k-1) -> state_k
+ *   finish (pass B):             hemilight_finish_sharded_bake(scene, options, shards_B, S, shards_1, state_B-1, stats)
+ * (state_0 is NULL; shards_1 are pass 1's S results, which carry the lights and the ambient
+ * occlusion to the merges). The finish writes the pages' outputs as hemilight_bake_scene does;
+ * hemilight_bake_scene_sharded runs it all in one process. Every call is given the same scene and
+ * options and recomputes the bake's set-up (geometry, atlas, samples) from them; nothing else
+ * passes between calls but the shards and states, which hemilight_bake_shard_get and
+ * hemilight_bake_pass_state_get turn into plain numbers and arrays, and the _create functions
+ * back into handles, so that a program can ship them between machines. Each carries the bake's
+ * key, a 64-bit hash of the scene and of every option but thread_count and progress (not
+ * cryptographic: it catches mistakes); the merges refuse a shard or state of another bake, pass
+ * or shard count, and a shard missing or given twice.
+ * Determinism: a shard's values depend on the scene, the options, S, i and k only (not on
+ * thread_count nor on the process that runs the job), so the result is bitwise the same however
+ * the jobs are spread. With S = 1 it is bitwise hemilight_bake_scene's; with S > 1 and the
+ * irradiance cache each shard places its own records (shard i holds the samples that come i-th in
+ * a Morton order over the scene's bounds), so the result differs from hemilight_bake_scene's
+ * within the cache's error; without the cache (options->use_cache = 0) it is bitwise
+ * hemilight_bake_scene's for every S.
+ * The scene: every call checks scene and options exactly as hemilight_bake_scene does, the pages'
+ * output buffers and scene->ao included, so that one description serves every call. Jobs and
+ * merges never read nor write those buffers, but which pages have sh_l1_rgb or hl2_rgb decides
+ * whether the bake computes the directional maps (part of the key), and a shadow mask needs the
+ * pages' shadow_mask_rgba: give every call the same description (a job's process may point the
+ * buffers at scratch memory of the right capacity). Handles are immutable after creation and may
+ * be used from any thread. */
+
+/* Since 0.15. One job's result (C++ bake_shard_result): per sample of its shard, in the bake's
+ * sample order, channel_count floats. Opaque. */
+typedef struct hemilight_bake_shard hemilight_bake_shard;
+/* Since 0.15. The state between two passes (C++ bake_pass_state): the radiance the next pass
+ * renders, which samples are valid, and per-pass statistics. Opaque. */
+typedef struct hemilight_bake_pass_state hemilight_bake_pass_state;
+
+/* Since 0.15. Releases a shard or a state (NULL does nothing). Handles made from them stay valid:
+ * nothing refers to a shard or state after the call that read it returns. */
+HEMILIGHT_API void hemilight_bake_shard_release(hemilight_bake_shard* shard);
+HEMILIGHT_API void hemilight_bake_pass_state_release(hemilight_bake_pass_state* state);
+
+/* Since 0.15. Runs job `shard` (0-based) of `shard_count` of pass `pass` (1-based, in
+ * [1, options->bounces]) of the sharded bake of `scene` and returns its result in a new handle
+ * *out (release it with hemilight_bake_shard_release). previous: the state that
+ * hemilight_merge_bake_pass made after pass - 1; NULL for pass 1, required after. Nothing is
+ * written to the pages (see above); options->progress sees the job's fraction.
+ * Errors (nothing written to *out): INVALID_ARGUMENT for NULL scene, options or out, everything
+ * hemilight_bake_scene refuses in scene and options (its messages, named after this function),
+ * shard_count not in [1, 4096], shard not in [0, shard_count), pass not in [1, options->bounces],
+ * previous NULL for pass > 1 or given for pass 1, a previous state of another bake ("made by
+ * another bake": another scene or options), of another pass, shard count or atlas size;
+ * OUT_OF_MEMORY and CANCELLED as hemilight_bake_scene.
+ * Cost: the bake's set-up (coverage of every page: O(texels)), then about 1 / shard_count of the
+ * pass's hemicubes (and in pass 1 of the lights' shadow rays); the result holds 4 to 68
+ * floats per sample of the shard (hemilight_bake_shard_info.channel_count). */
+HEMILIGHT_API hemilight_status hemilight_bake_scene_shard(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                                          int32_t shard, int32_t shard_count, int32_t pass,
+                                                          const hemilight_bake_pass_state* previous, hemilight_bake_shard** out);
+
+/* Since 0.15. Merges pass `pass` (in [1, options->bounces - 1]) of the sharded bake of `scene`:
+ * the shards' values joined, the lights added, samples inside geometry filled, and the radiance
+ * texture of pass + 1 made; *out receives the new state (release it with
+ * hemilight_bake_pass_state_release). shards: the shard_count results of the pass, in any order
+ * (shard_count is the bake's S); first_pass: the shard_count results of pass 1 (their lights and
+ * AO), ignored (may be NULL or the same array) when pass = 1; previous: the state after pass - 1
+ * (NULL for pass 1). Nothing is written to the pages.
+ * Errors (nothing written to *out): INVALID_ARGUMENT for NULL scene, options, shards or out, a
+ * NULL element ("hemilight_merge_bake_pass: shards[2] is NULL"), first_pass NULL when pass > 1,
+ * shard_count not in [1, 4096], everything hemilight_bake_scene refuses, pass out of range, a
+ * shard of another bake ("shards[0] (shard 0 of pass 1) was baked from another scene or options"),
+ * of another pass or shard count, a shard given twice ("shards[1] is shard 0 again"), a shard whose
+ * sample or channel counts differ from this bake's, previous as hemilight_bake_scene_shard checks
+ * it; OUT_OF_MEMORY.
+ * Cost: the bake's set-up, a copy of the shards' values, O(atlas texels) and the dilation of the
+ * radiance texture; no hemicube. The state holds 4 floats per atlas texel. */
+HEMILIGHT_API hemilight_status hemilight_merge_bake_pass(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                                         int32_t pass, const hemilight_bake_shard* const* shards, size_t shard_count,
+                                                         const hemilight_bake_shard* const* first_pass,
+                                                         const hemilight_bake_pass_state* previous, hemilight_bake_pass_state** out);
+
+/* Since 0.15. Merges the last pass (pass = options->bounces) of the sharded bake of `scene` and
+ * writes every page's outputs (irradiance, valid, directional maps, shadow mask, scene->ao)
+ * exactly as hemilight_bake_scene writes them, only when everything succeeded. shards: the
+ * shard_count results of the last pass, in any order; first_pass: those of pass 1, ignored (may
+ * be NULL) when options->bounces = 1; previous: the state after pass bounces - 1 (NULL when
+ * bounces = 1). stats (may be NULL): the whole bake's counts (hemicubes and records summed over
+ * every job of every pass); seconds is this call's wall time.
+ * Errors (nothing written): as hemilight_merge_bake_pass ("hemilight_finish_sharded_bake: ..."),
+ * a result that overflows float, a bad stats->struct_size.
+ * Cost: as hemilight_merge_bake_pass, plus the outputs' seam stitching and dilation. */
+HEMILIGHT_API hemilight_status hemilight_finish_sharded_bake(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                                             const hemilight_bake_shard* const* shards, size_t shard_count,
+                                                             const hemilight_bake_shard* const* first_pass,
+                                                             const hemilight_bake_pass_state* previous, hemilight_bake_stats* stats);
+
+/* Since 0.15. The sharded bake of `scene` in one process: every job and merge above in order,
+ * with the set-up made once. Writes the outputs and stats as hemilight_bake_scene does; the same
+ * bits as running the jobs anywhere, and with shard_count 1 (or options->use_cache 0) bitwise
+ * hemilight_bake_scene's. options->progress sees the whole bake's fraction.
+ * Errors (nothing written): as hemilight_bake_scene, and INVALID_ARGUMENT for shard_count not in
+ * [1, 4096].
+ * Cost: hemilight_bake_scene's, plus the records the shards cannot share across their borders
+ * (with the cache), and the shards' values (4 to 68 floats per sample) kept between
+ * passes. */
+HEMILIGHT_API hemilight_status hemilight_bake_scene_sharded(const hemilight_bake_scene_desc* scene, const hemilight_bake_options* options,
+                                                            int32_t shard_count, hemilight_bake_stats* stats);
+
+/* Since 0.15. A shard's numbers ("Structs that grow"; fill with hemilight_bake_shard_info_init
+ * before hemilight_bake_shard_get or hemilight_bake_shard_create). */
+typedef struct hemilight_bake_shard_info {
+  size_t struct_size;     /* set by hemilight_bake_shard_info_init */
+  uint64_t key;           /* the bake's key */
+  int32_t pass;           /* 1-based */
+  int32_t shard;          /* in [0, shard_count) */
+  int32_t shard_count;    /* in [1, 4096] */
+  int32_t reserved0;      /* padding: set to 0 by _init and hemilight_bake_shard_get; its value is never used */
+  size_t sample_count;    /* samples of the shard */
+  size_t channel_count;   /* floats per sample (hemilight_bake_shard_channel_name names each) */
+  size_t hemicubes;       /* hemicubes the job rendered */
+  size_t records;         /* irradiance cache records the job placed */
+  size_t invalid_samples; /* samples the job found inside geometry */
+  double seconds;         /* the job's wall time, set-up included */
+  double direct_seconds;  /* of which the lights (pass 1) */
+} hemilight_bake_shard_info;
+
+/* As hemilight_cache_options_init_sized, for shard information (every field 0). */
+HEMILIGHT_API void hemilight_bake_shard_info_init_sized(hemilight_bake_shard_info* info, size_t struct_size);
+static inline void hemilight_bake_shard_info_init(hemilight_bake_shard_info* info) {
+  hemilight_bake_shard_info_init_sized(info, sizeof *info);
+}
+
+/* Since 0.15. Reads a shard: its numbers into *info (within info->struct_size) and, unless values
+ * is NULL (the numbers only), its sample_count x channel_count floats, sample-major (sample s,
+ * channel c at values[s channel_count + c]), into values. values_capacity: floats available at
+ * values. Errors (nothing written): INVALID_ARGUMENT for NULL shard or info, a bad
+ * info->struct_size, values_capacity below sample_count x channel_count with values given.
+ * Cost: O(sample_count x channel_count). */
+HEMILIGHT_API hemilight_status hemilight_bake_shard_get(const hemilight_bake_shard* shard, hemilight_bake_shard_info* info, float* values,
+                                                        size_t values_capacity);
+
+/* Since 0.15. The name of channel `channel` of a shard ("E.R", "E.G", "E.B", "invalid", then as
+ * the pass computes them "sh0.R" ..., "cone0.R" ..., "ao", "direct.E.R" ...; shards.hpp lists
+ * them), valid while the shard lives; NULL for a NULL shard or a channel >= channel_count (the
+ * last error is not changed). Cost: O(1). */
+HEMILIGHT_API const char* hemilight_bake_shard_channel_name(const hemilight_bake_shard* shard, size_t channel);
+
+/* Since 0.15. A shard from its numbers, channel names and values (as hemilight_bake_shard_get and
+ * hemilight_bake_shard_channel_name gave them, e.g. on another machine), copied into a new handle
+ * *out (release it with hemilight_bake_shard_release). info->reserved0 is not read.
+ * channel_names: info->channel_count strings; values: value_count = info->sample_count x
+ * info->channel_count floats, sample-major. Only the sizes and ranges are checked here; the merges
+ * check that the shard belongs to their bake (key, pass, shard count, sample count, channels).
+ * Errors (nothing written to *out): INVALID_ARGUMENT for NULL info or out, a bad
+ * info->struct_size, info->shard_count not in [1, 4096], info->shard not in [0, shard_count),
+ * info->pass not in [1, 64], channel_names NULL with a channel count or a NULL name
+ * ("channel_names[3] is NULL"), value_count not sample_count x channel_count, values NULL with
+ * value_count > 0, a value not finite ("values[37] (sample 9, channel E.G) = nan"), seconds or
+ * direct_seconds negative or not finite; OUT_OF_MEMORY. Cost: O(value_count). */
+HEMILIGHT_API hemilight_status hemilight_bake_shard_create(const hemilight_bake_shard_info* info, const char* const* channel_names,
+                                                           const float* values, size_t value_count, hemilight_bake_shard** out);
+
+/* Since 0.15. A state's numbers ("Structs that grow"; fill with hemilight_bake_pass_state_info_init
+ * before hemilight_bake_pass_state_get or hemilight_bake_pass_state_create). */
+typedef struct hemilight_bake_pass_state_info {
+  size_t struct_size;   /* set by hemilight_bake_pass_state_info_init */
+  uint64_t key;         /* the bake's key */
+  int32_t pass;         /* the pass it follows (1-based, < options->bounces) */
+  int32_t shard_count;  /* in [1, 4096] */
+  int32_t width;        /* the pages' atlas: the widest page x the sum of the heights and two */
+  int32_t height;       /* guard rows between pages */
+  size_t pass_count;    /* passes with statistics so far (= pass) */
+} hemilight_bake_pass_state_info;
+
+/* As hemilight_cache_options_init_sized, for state information (every field 0). */
+HEMILIGHT_API void hemilight_bake_pass_state_info_init_sized(hemilight_bake_pass_state_info* info, size_t struct_size);
+static inline void hemilight_bake_pass_state_info_init(hemilight_bake_pass_state_info* info) {
+  hemilight_bake_pass_state_info_init_sized(info, sizeof *info);
+}
+
+/* Since 0.15. Reads a state: its numbers into *info (within info->struct_size); unless
+ * radiance_rgba is NULL, its atlas into radiance_rgba (width x height RGBA floats, rows as the
+ * pages' images: RGB the radiance pass + 1 renders, A 1 where a sample lies that every pass so far
+ * found outside geometry, else 0; radiance_capacity: floats available there); and per pass so far
+ * (pass_count entries, pass_capacity available in each array given; each array may be NULL) the
+ * hemicubes, cache records and invalid samples summed over the pass's shards, and the sum of its
+ * jobs' wall times in seconds. Errors (nothing written): INVALID_ARGUMENT for NULL state or info, a
+ * bad info->struct_size, radiance_capacity below 4 x width x height with radiance_rgba given,
+ * pass_capacity below pass_count with a statistics array given. Cost: O(width x height). */
+HEMILIGHT_API hemilight_status hemilight_bake_pass_state_get(const hemilight_bake_pass_state* state, hemilight_bake_pass_state_info* info,
+                                                             float* radiance_rgba, size_t radiance_capacity, size_t* pass_hemicubes,
+                                                             size_t* pass_records, size_t* pass_invalid_samples, double* pass_seconds,
+                                                             size_t pass_capacity);
+
+/* Since 0.15. A state from its numbers and arrays (as hemilight_bake_pass_state_get gave them),
+ * copied into a new handle *out (release it with hemilight_bake_pass_state_release).
+ * radiance_rgba: count = 4 x info->width x info->height floats; the statistics arrays:
+ * info->pass_count entries each, or NULL (zeros: the finish's statistics then count nothing for
+ * those passes). Only sizes and ranges are checked here; the jobs and merges check that the state
+ * belongs to their bake (key, pass, shard count, atlas size, pass_count).
+ * Errors (nothing written to *out): INVALID_ARGUMENT for NULL info, radiance_rgba or out, a bad
+ * info->struct_size, info->pass not in [1, 63], info->shard_count not in [1, 4096], info->width or
+ * height below 1 or more than 2^28 texels in all, info->pass_count above 64, count not
+ * 4 x width x height, an RGB value negative or not finite, an A value not exactly 0 or 1
+ * ("radiance_rgba[23] (texel 5: x 5, y 0, A) = 0.500000; it must be 0 or 1"), a pass_seconds entry
+ * negative or not finite; OUT_OF_MEMORY. Cost: O(width x height). */
+HEMILIGHT_API hemilight_status hemilight_bake_pass_state_create(const hemilight_bake_pass_state_info* info, const float* radiance_rgba,
+                                                                size_t count, const size_t* pass_hemicubes, const size_t* pass_records,
+                                                                const size_t* pass_invalid_samples, const double* pass_seconds,
+                                                                hemilight_bake_pass_state** out);
+
 /* Irradiance methods of hemilight_cubemap_irradiance (measured error against a brute-force cosine
  * integral, and time, on a sky with a sun: docs/cubemap.md). */
 typedef enum hemilight_irradiance_method {

@@ -203,7 +203,10 @@ TEST_CASE("Sharded bake: mismatched inputs are refused, naming what differs", "[
   cut[1].values.pop_back();
   require_error([&] { merge_bake_pass(sc.input, o, 1, cut.data(), 2, cut.data(), nullptr); }, bad, "shards[1] (shard 1) holds");
   // The last pass through merge_bake_pass, an early one through finish_sharded_bake.
-  require_error([&] { merge_bake_pass(sc.input, o, 3, pass1.data(), 2, pass1.data(), &state); }, bad, "pass = 3 is not in [1, 2]");
+  require_error([&] { merge_bake_pass(sc.input, o, 3, pass1.data(), 2, pass1.data(), &state); }, bad,
+                "pass = 3 is not in [1, 2] (the bake has 3 bounces; the last pass is finish_sharded_bake's)");
+  require_error([&] { merge_bake_pass(sc.input, o, 1, pass1.data(), 5000, pass1.data(), nullptr); }, bad,
+                "merge_bake_pass: shard_count = 5000 is not in [1, 4096]");
   std::vector<bake_shard_result> pass2;
   for (int s = 0; s < 2; ++s) pass2.push_back(bake_scene_shard(sc.input, o, s, 2, 2, &state));
   const bake_pass_state state2 = merge_bake_pass(sc.input, o, 2, pass2.data(), 2, pass1.data(), &state);

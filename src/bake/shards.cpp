@@ -75,8 +75,9 @@ std::string key_text(std::uint64_t key) {
   return text;
 }
 
-void check_shard_count(const char* who, int shard_count) {
-  if (shard_count < 1 || shard_count > max_bake_shards)
+template <class Count>  // int (the jobs) or std::size_t (the merges)
+void check_shard_count(const char* who, Count shard_count) {
+  if (shard_count < Count(1) || shard_count > Count(max_bake_shards))
     throw_invalid_argument(std::string(who) + ": shard_count = " + std::to_string(shard_count) + " is not in [1, " +
                            std::to_string(max_bake_shards) + "]");
 }
@@ -216,10 +217,13 @@ void check_previous(const char* who, const shard_plan& p, int pass, const bake_p
                            " passes, not " + std::to_string(pass - 1));
 }
 
-void check_pass(const char* who, int pass, int lo, int hi) {
-  if (pass < lo || pass > hi)
-    throw_invalid_argument(std::string(who) + ": pass = " + std::to_string(pass) + " is not in [" + std::to_string(lo) + ", " +
-                           std::to_string(hi) + "] (the bake has " + std::to_string(hi) + " bounce" + (hi > 1 ? "s" : "") + ")");
+// pass in [1, hi], hi = bounces for jobs, bounces - 1 for merge_bake_pass (the last pass is
+// finish_sharded_bake's).
+void check_pass(const char* who, int pass, int hi, int bounces) {
+  if (pass < 1 || pass > hi)
+    throw_invalid_argument(std::string(who) + ": pass = " + std::to_string(pass) + " is not in [1, " + std::to_string(hi) +
+                           "] (the bake has " + std::to_string(bounces) + " bounce" + (bounces > 1 ? "s" : "") +
+                           (hi < bounces ? "; the last pass is finish_sharded_bake's)" : ")"));
 }
 
 // Job `shard` of pass `pass`: the pass's values (and in pass 1 the lights') at the shard's samples.
@@ -380,7 +384,7 @@ joined_pass join_pass(const char* who, const shard_plan& p, const bake_options& 
 
 bake_pass_state merge_state(const char* who, const shard_plan& p, const bake_options& o, int pass, const bake_shard_result* shards,
                             std::size_t count, const bake_shard_result* first_pass, const bake_pass_state* previous) {
-  check_pass(who, pass, 1, o.bounces - 1);
+  check_pass(who, pass, o.bounces - 1, o.bounces);
   joined_pass j = join_pass(who, p, o, pass, shards, count, first_pass, previous);
   bake_pass_state st;
   st.key = p.key;
@@ -440,7 +444,7 @@ bake_shard_result bake_scene_shard(const scene_bake_input& input, const bake_opt
   if (shard < 0 || shard >= shard_count)
     throw_invalid_argument(std::string(who) + ": shard = " + std::to_string(shard) + " is not in [0, " + std::to_string(shard_count) + ")");
   check_options(options, who, false);
-  check_pass(who, pass, 1, options.bounces);
+  check_pass(who, pass, options.bounces, options.bounces);
   const shard_plan p = make_shard_plan(who, input, options, shard_count);
   check_previous(who, p, pass, previous);
   float reported = 0.0f;
@@ -458,8 +462,8 @@ bake_pass_state merge_bake_pass(const scene_bake_input& input, const bake_option
   using namespace bake_detail;
   const char* who = "merge_bake_pass";
   check_options(options, who, false);
-  check_pass(who, pass, 1, options.bounces - 1);
-  if (shard_count < 1 || shard_count > std::size_t(max_bake_shards)) check_shard_count(who, -1);
+  check_pass(who, pass, options.bounces - 1, options.bounces);
+  check_shard_count(who, shard_count);
   const shard_plan p = make_shard_plan(who, input, options, int(shard_count));
   return merge_state(who, p, options, pass, shards, shard_count, first_pass, previous);
 }
@@ -469,7 +473,7 @@ scene_bake_result finish_sharded_bake(const scene_bake_input& input, const bake_
   using namespace bake_detail;
   const char* who = "finish_sharded_bake";
   const auto t0 = std::chrono::steady_clock::now();
-  if (shard_count < 1 || shard_count > std::size_t(max_bake_shards)) check_shard_count(who, -1);
+  check_shard_count(who, shard_count);
   shard_plan p = make_shard_plan(who, input, options, int(shard_count));
   return finish(who, input, p, options, shards, shard_count, first_pass, previous, t0);
 }
