@@ -566,12 +566,19 @@ std::optional<scene_bake_result> run_bake(const std::string& name, const std::st
     return std::nullopt;
   } catch (const hemilight::error& e) {
     if (e.code() != status::invalid_argument) throw;
-    // A mismatch the library found between this bake and the files: name the files.
-    const std::string inputs =
-        s.shard >= 0 ? shard_files::state_stem(base, s.pass - 1) + ".{exr,json}"
-                     : shard_files::shard_stem(base, s.merge, 0, s.shards) + " .. " + std::to_string(s.shards - 1) + "of" +
-                           std::to_string(s.shards) + (s.merge > 1 ? ", the same of pass 1 and " + shard_files::state_stem(base, s.merge - 1) : "");
-    fail("the files do not belong to this bake (" + inputs + "): " + e.what());
+    // A mismatch the library found between this bake and the files: name the file. The merges
+    // name shards[i] (pass K's i-th file, read in order), first_pass[i] (pass 1's) or the
+    // previous state; a job only reads the state.
+    const std::string what = e.what();
+    std::string file = shard_files::state_stem(base, std::max(s.pass, s.merge) - 1);
+    for (const auto& [array, pass] : {std::pair<std::string, int>{"first_pass[", 1}, {"shards[", s.merge}}) {
+      const std::size_t at = what.find(array);
+      if (s.merge > 0 && at != std::string::npos && what.find("previous state") == std::string::npos) {
+        file = shard_files::shard_stem(base, pass, std::atoi(what.c_str() + at + array.size()), s.shards);
+        break;
+      }
+    }
+    fail(file + ".{exr,json} does not belong to this bake: " + what);
   } catch (const cli_error&) {
     throw;
   } catch (const std::runtime_error& e) {
