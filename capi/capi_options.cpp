@@ -63,6 +63,25 @@ const span cubemap_irradiance_options_fields[] = {
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, method),
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, input_size),
     HEMILIGHT_SPAN(hemilight_cubemap_irradiance_options, thread_count)};
+// The sharded bake's info structs (capi_shards.cpp), fields in order (reserved0 is padding: set to 0 by _init and _get, its value
+// never used). A later version appends fields that start at or after this version's sizeof (88
+// and 40 bytes on LP64).
+const span shard_info_fields[] = {
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, struct_size),    HEMILIGHT_SPAN(hemilight_bake_shard_info, key),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, pass),           HEMILIGHT_SPAN(hemilight_bake_shard_info, shard),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, shard_count),    HEMILIGHT_SPAN(hemilight_bake_shard_info, reserved0),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, sample_count),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, channel_count),  HEMILIGHT_SPAN(hemilight_bake_shard_info, hemicubes),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, records),        HEMILIGHT_SPAN(hemilight_bake_shard_info, invalid_samples),
+    HEMILIGHT_SPAN(hemilight_bake_shard_info, seconds),        HEMILIGHT_SPAN(hemilight_bake_shard_info, direct_seconds)};
+const span state_info_fields[] = {
+    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, struct_size), HEMILIGHT_SPAN(hemilight_bake_pass_state_info, key),
+    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, pass),        HEMILIGHT_SPAN(hemilight_bake_pass_state_info, shard_count),
+    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, width),       HEMILIGHT_SPAN(hemilight_bake_pass_state_info, height),
+    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, pass_count)};
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_shard_info) == 88, "hemilight_bake_shard_info changed: append only");
+static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_pass_state_info) == 40, "hemilight_bake_pass_state_info changed: append only");
+
 #undef HEMILIGHT_SPAN
 
 // The sizes of this ABI's layouts (x86-64 and every LP64 ABI). A struct that grows keeps its old
@@ -219,6 +238,38 @@ void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out) {
   out->struct_size = size;
 }
 
+// The info structs: read over zeros (struct_size the caller's), checked and written like the stats.
+std::string read_sized(const hemilight_bake_shard_info* in, hemilight_bake_shard_info& out) {
+  out = hemilight_bake_shard_info{};
+  const std::string problem = size_problem("info", "hemilight_bake_shard_info_init", in->struct_size, sizeof out);
+  if (!problem.empty()) return problem;
+  copy_fields(shard_info_fields, in, &out, in->struct_size);
+  return {};
+}
+std::string read_sized(const hemilight_bake_pass_state_info* in, hemilight_bake_pass_state_info& out) {
+  out = hemilight_bake_pass_state_info{};
+  const std::string problem = size_problem("info", "hemilight_bake_pass_state_info_init", in->struct_size, sizeof out);
+  if (!problem.empty()) return problem;
+  copy_fields(state_info_fields, in, &out, in->struct_size);
+  return {};
+}
+std::string check_sized(const hemilight_bake_shard_info* info) {
+  return size_problem("info", "hemilight_bake_shard_info_init", info->struct_size, sizeof *info);
+}
+std::string check_sized(const hemilight_bake_pass_state_info* info) {
+  return size_problem("info", "hemilight_bake_pass_state_info_init", info->struct_size, sizeof *info);
+}
+void write_sized(const hemilight_bake_shard_info& from, hemilight_bake_shard_info* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(shard_info_fields, &from, out, size);
+  out->struct_size = size;
+}
+void write_sized(const hemilight_bake_pass_state_info& from, hemilight_bake_pass_state_info* out) {
+  const std::size_t size = out->struct_size;
+  copy_fields(state_info_fields, &from, out, size);
+  out->struct_size = size;
+}
+
 cache_options to_cpp(const hemilight_cache_options& c) {
   cache_options o;
   o.error_threshold = c.error_threshold;
@@ -339,6 +390,14 @@ void hemilight_cache_stats_init_sized(hemilight_cache_stats* stats, size_t struc
 
 void hemilight_bake_stats_init_sized(hemilight_bake_stats* stats, size_t struct_size) {
   hemilight::capi::init_sized(stats, struct_size, hemilight::capi::zeroed<hemilight_bake_stats>(), hemilight::capi::bake_stats_fields);
+}
+
+void hemilight_bake_shard_info_init_sized(hemilight_bake_shard_info* info, size_t struct_size) {
+  hemilight::capi::init_sized(info, struct_size, hemilight_bake_shard_info{}, hemilight::capi::shard_info_fields);
+}
+
+void hemilight_bake_pass_state_info_init_sized(hemilight_bake_pass_state_info* info, size_t struct_size) {
+  hemilight::capi::init_sized(info, struct_size, hemilight_bake_pass_state_info{}, hemilight::capi::state_info_fields);
 }
 
 void hemilight_cubemap_irradiance_options_init_sized(hemilight_cubemap_irradiance_options* options, size_t struct_size) {

@@ -35,6 +35,15 @@ std::string check_sized(const hemilight_bake_stats* stats);
 void write_sized(const hemilight_cache_stats& from, hemilight_cache_stats* out);
 void write_sized(const hemilight_bake_stats& from, hemilight_bake_stats* out);
 
+/// The sharded bake's info structs: read (the caller's fields within in->struct_size over zeros),
+/// checked and written as above; "" or what is wrong with info->struct_size.
+std::string read_sized(const hemilight_bake_shard_info* in, hemilight_bake_shard_info& out);
+std::string read_sized(const hemilight_bake_pass_state_info* in, hemilight_bake_pass_state_info& out);
+std::string check_sized(const hemilight_bake_shard_info* info);
+std::string check_sized(const hemilight_bake_pass_state_info* info);
+void write_sized(const hemilight_bake_shard_info& from, hemilight_bake_shard_info* out);
+void write_sized(const hemilight_bake_pass_state_info& from, hemilight_bake_pass_state_info* out);
+
 /// The C++ options of checked C options (switches already 0 or 1, the weight a known value). The
 /// C struct is flat; its fields land in one of three C++ homes: the cache's options (to_cpp), how
 /// the call runs (thread_count, progress: cache_run_of) and the sampler's options (resolution,

@@ -2,6 +2,7 @@
 // merges and the one-process bake over the scene bake's checks and outputs (capi_scene_bake.hpp),
 // and the shards and states as plain numbers and arrays (_get, _create) and back.
 #include "capi_internal.hpp"
+#include "capi_options.hpp"
 #include "capi_scene_bake.hpp"
 
 #include "hemilight/shards.hpp"
@@ -28,83 +29,6 @@ namespace {
 
 using hemilight::capi::guarded;
 using hemilight::capi::invalid;
-
-// ---- the info structs: growable like the options (capi_options.cpp) ----------------------------
-
-// Where a field lies in its struct.
-struct field_span {
-  std::size_t offset, size;
-};
-#define HEMILIGHT_SPAN(T, f) field_span { offsetof(T, f), sizeof(static_cast<T*>(nullptr)->f) }
-// Fields of each struct in order (reserved0 is padding: set to 0 by _init and _get, its value
-// never used). A later version appends fields that start at or after this version's sizeof (88
-// and 40 bytes on LP64).
-const field_span shard_info_fields[] = {
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, struct_size),    HEMILIGHT_SPAN(hemilight_bake_shard_info, key),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, pass),           HEMILIGHT_SPAN(hemilight_bake_shard_info, shard),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, shard_count),    HEMILIGHT_SPAN(hemilight_bake_shard_info, reserved0),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, sample_count),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, channel_count),  HEMILIGHT_SPAN(hemilight_bake_shard_info, hemicubes),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, records),        HEMILIGHT_SPAN(hemilight_bake_shard_info, invalid_samples),
-    HEMILIGHT_SPAN(hemilight_bake_shard_info, seconds),        HEMILIGHT_SPAN(hemilight_bake_shard_info, direct_seconds)};
-const field_span state_info_fields[] = {
-    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, struct_size), HEMILIGHT_SPAN(hemilight_bake_pass_state_info, key),
-    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, pass),        HEMILIGHT_SPAN(hemilight_bake_pass_state_info, shard_count),
-    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, width),       HEMILIGHT_SPAN(hemilight_bake_pass_state_info, height),
-    HEMILIGHT_SPAN(hemilight_bake_pass_state_info, pass_count)};
-#undef HEMILIGHT_SPAN
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_shard_info) == 88, "hemilight_bake_shard_info changed: append only");
-static_assert(sizeof(void*) != 8 || sizeof(hemilight_bake_pass_state_info) == 40, "hemilight_bake_pass_state_info changed: append only");
-
-template <std::size_t K>
-void copy_fields(const field_span (&fields)[K], const void* from, void* to, std::size_t size) {
-  for (const field_span& f : fields)
-    if (f.offset + f.size <= size)
-      std::memcpy(static_cast<char*>(to) + f.offset, static_cast<const char*>(from) + f.offset, f.size);
-}
-
-// "" or what is wrong with a caller's struct_size (the wording of capi_options.cpp's checks).
-std::string size_problem(const char* what, const char* init, std::size_t size, std::size_t known) {
-  if (size < sizeof(std::size_t))
-    return std::string(what) + "->struct_size is " + std::to_string(size) + ": fill the struct with " + init + " first";
-  if (size > known)
-    return std::string(what) + "->struct_size is " + std::to_string(size) + " but this library knows " + std::to_string(known) +
-           " bytes: the program was built against a newer hemilight.h than this libhemilight_c (link it with that version)";
-  return {};
-}
-
-template <class T>
-T zeroed() {
-  T t;
-  std::memset(&t, 0, sizeof t);
-  return t;
-}
-
-// The caller's fields within in->struct_size over zeros (checked first: "" or the problem).
-template <class T, std::size_t K>
-std::string read_info(const T* in, T& out, const field_span (&fields)[K], const char* init) {
-  out = zeroed<T>();
-  out.struct_size = sizeof(T);
-  if (std::string problem = size_problem("info", init, in->struct_size, sizeof(T)); !problem.empty()) return problem;
-  copy_fields(fields, in, &out, in->struct_size);
-  return {};
-}
-
-// Writes the fields of `from` within out->struct_size (checked before), keeping struct_size.
-template <class T, std::size_t K>
-void write_info(const T& from, T* out, const field_span (&fields)[K]) {
-  const std::size_t size = out->struct_size;
-  copy_fields(fields, &from, out, size);
-  out->struct_size = size;
-}
-
-template <class T, std::size_t K>
-void init_info(T* out, std::size_t size, const field_span (&fields)[K]) {
-  if (!out || size < sizeof(std::size_t)) return;
-  const T defaults = zeroed<T>();
-  copy_fields(fields, &defaults, out, std::min(size, sizeof defaults));
-  out->struct_size = size;
-}
 
 // ---- arguments ---------------------------------------------------------------------------------
 
@@ -253,24 +177,19 @@ hemilight_status hemilight_bake_scene_sharded(const hemilight_bake_scene_desc* s
 
 // ---- shards as plain data -----------------------------------------------------------------------
 
-void hemilight_bake_shard_info_init_sized(hemilight_bake_shard_info* info, size_t struct_size) {
-  init_info(info, struct_size, shard_info_fields);
-}
-
 hemilight_status hemilight_bake_shard_get(const hemilight_bake_shard* shard, hemilight_bake_shard_info* info, float* values,
                                           size_t values_capacity) {
   const char* fn = "hemilight_bake_shard_get";
   return guarded(fn, [&] {
     if (!shard) return invalid(fn, "shard is NULL");
     if (!info) return invalid(fn, "info is NULL (use hemilight_bake_shard_info_init)");
-    if (std::string p = size_problem("info", "hemilight_bake_shard_info_init", info->struct_size, sizeof *info); !p.empty())
-      return invalid(fn, p);
+    if (std::string p = hemilight::capi::check_sized(info); !p.empty()) return invalid(fn, p);
     const hemilight::bake_shard_result& r = shard->result;
     if (values && values_capacity < r.values.size())
       return invalid(fn, "values_capacity " + std::to_string(values_capacity) + " is below sample_count x channel_count = " +
                              std::to_string(r.sample_count) + " x " + std::to_string(r.channel_names.size()) + " = " +
                              std::to_string(r.values.size()) + " floats");
-    hemilight_bake_shard_info i = zeroed<hemilight_bake_shard_info>();
+    hemilight_bake_shard_info i{};
     i.struct_size = sizeof i;
     i.key = r.key;
     i.pass = r.pass;
@@ -284,7 +203,7 @@ hemilight_status hemilight_bake_shard_get(const hemilight_bake_shard* shard, hem
     i.seconds = r.seconds;
     i.direct_seconds = r.direct_seconds;
     if (values && !r.values.empty()) std::memcpy(values, r.values.data(), r.values.size() * sizeof(float));
-    write_info(i, info, shard_info_fields);
+    hemilight::capi::write_sized(i, info);
     return HEMILIGHT_OK;
   });
 }
@@ -301,7 +220,7 @@ hemilight_status hemilight_bake_shard_create(const hemilight_bake_shard_info* in
     if (!out) return invalid(fn, "out is NULL");
     if (!info) return invalid(fn, "info is NULL (use hemilight_bake_shard_info_init)");
     hemilight_bake_shard_info i;
-    if (std::string p = read_info(info, i, shard_info_fields, "hemilight_bake_shard_info_init"); !p.empty()) return invalid(fn, p);
+    if (std::string p = hemilight::capi::read_sized(info, i); !p.empty()) return invalid(fn, p);
     if (i.shard_count < 1 || i.shard_count > hemilight::max_bake_shards)
       return invalid(fn, "info->shard_count is " + std::to_string(i.shard_count) + "; it must be in " +
                              range_text(1, hemilight::max_bake_shards));
@@ -348,10 +267,6 @@ hemilight_status hemilight_bake_shard_create(const hemilight_bake_shard_info* in
 
 // ---- states as plain data -----------------------------------------------------------------------
 
-void hemilight_bake_pass_state_info_init_sized(hemilight_bake_pass_state_info* info, size_t struct_size) {
-  init_info(info, struct_size, state_info_fields);
-}
-
 hemilight_status hemilight_bake_pass_state_get(const hemilight_bake_pass_state* state, hemilight_bake_pass_state_info* info,
                                                float* radiance_rgba, size_t radiance_capacity, size_t* pass_hemicubes, size_t* pass_records,
                                                size_t* pass_invalid_samples, double* pass_seconds, size_t pass_capacity) {
@@ -359,8 +274,7 @@ hemilight_status hemilight_bake_pass_state_get(const hemilight_bake_pass_state* 
   return guarded(fn, [&] {
     if (!state) return invalid(fn, "state is NULL");
     if (!info) return invalid(fn, "info is NULL (use hemilight_bake_pass_state_info_init)");
-    if (std::string p = size_problem("info", "hemilight_bake_pass_state_info_init", info->struct_size, sizeof *info); !p.empty())
-      return invalid(fn, p);
+    if (std::string p = hemilight::capi::check_sized(info); !p.empty()) return invalid(fn, p);
     const hemilight::bake_pass_state& s = state->state;
     const std::size_t texels = std::size_t(s.radiance.width) * std::size_t(s.radiance.height);
     if (radiance_rgba && radiance_capacity < 4 * texels)
@@ -370,7 +284,7 @@ hemilight_status hemilight_bake_pass_state_get(const hemilight_bake_pass_state* 
     const std::size_t passes = s.passes.size();
     if ((pass_hemicubes || pass_records || pass_invalid_samples || pass_seconds) && pass_capacity < passes)
       return invalid(fn, "pass_capacity " + std::to_string(pass_capacity) + " is below pass_count = " + std::to_string(passes));
-    hemilight_bake_pass_state_info i = zeroed<hemilight_bake_pass_state_info>();
+    hemilight_bake_pass_state_info i{};
     i.struct_size = sizeof i;
     i.key = s.key;
     i.pass = s.pass;
@@ -389,7 +303,7 @@ hemilight_status hemilight_bake_pass_state_get(const hemilight_bake_pass_state* 
       if (pass_invalid_samples) pass_invalid_samples[p] = s.passes[p].invalid_samples;
       if (pass_seconds) pass_seconds[p] = s.passes[p].seconds;
     }
-    write_info(i, info, state_info_fields);
+    hemilight::capi::write_sized(i, info);
     return HEMILIGHT_OK;
   });
 }
@@ -403,7 +317,7 @@ hemilight_status hemilight_bake_pass_state_create(const hemilight_bake_pass_stat
     if (!out) return invalid(fn, "out is NULL");
     if (!info) return invalid(fn, "info is NULL (use hemilight_bake_pass_state_info_init)");
     hemilight_bake_pass_state_info i;
-    if (std::string p = read_info(info, i, state_info_fields, "hemilight_bake_pass_state_info_init"); !p.empty()) return invalid(fn, p);
+    if (std::string p = hemilight::capi::read_sized(info, i); !p.empty()) return invalid(fn, p);
     if (i.pass < 1 || i.pass > hemilight::max_bounces - 1)
       return invalid(fn, "info->pass is " + std::to_string(i.pass) + "; it must be in " + range_text(1, hemilight::max_bounces - 1) +
                              " (a state follows a pass before the last)");

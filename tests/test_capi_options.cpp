@@ -493,3 +493,48 @@ TEST_CASE("C ABI options: every opacity field reaches the C++ material, and only
   CHECK(m.opacity == surface_opacity::opaque);
   CHECK(m.transmittance == glm::vec3(0.0f));
 }
+
+TEST_CASE("C ABI options: the sharded bake's info structs read over zeros and write within struct_size", "[capi]") {
+  // A caller's shorter struct (up to hemicubes): read_sized takes its fields and zeros for the
+  // rest; write_sized leaves the bytes past its struct_size untouched.
+  hemilight_bake_shard_info in;
+  std::memset(&in, 0x5a, sizeof in);
+  in.struct_size = offsetof(hemilight_bake_shard_info, hemicubes);
+  in.key = 0x1234;
+  in.pass = 2;
+  in.sample_count = 17;
+  hemilight_bake_shard_info got;
+  REQUIRE(capi::read_sized(&in, got).empty());
+  CHECK(got.struct_size == in.struct_size);  // the caller's, as read_sized does for the options
+  CHECK(got.key == 0x1234);
+  CHECK(got.pass == 2);
+  CHECK(got.sample_count == 17);
+  CHECK(got.hemicubes == 0);
+  CHECK(got.seconds == 0.0);
+  hemilight_bake_shard_info from{};
+  from.struct_size = sizeof from;
+  from.key = 7;
+  from.hemicubes = 9;
+  hemilight_bake_shard_info to;
+  std::memset(&to, 0x5a, sizeof to);
+  to.struct_size = offsetof(hemilight_bake_shard_info, hemicubes);
+  capi::write_sized(from, &to);
+  CHECK(to.key == 7);
+  CHECK(to.struct_size == offsetof(hemilight_bake_shard_info, hemicubes));
+  hemilight_bake_shard_info untouched;
+  std::memset(&untouched, 0x5a, sizeof untouched);
+  CHECK(std::memcmp(&to.hemicubes, &untouched.hemicubes, sizeof to - offsetof(hemilight_bake_shard_info, hemicubes)) == 0);
+  in.struct_size = sizeof in + 8;
+  CHECK(capi::read_sized(&in, got).find("newer hemilight.h") != std::string::npos);
+  // The state's info: the same rules.
+  hemilight_bake_pass_state_info s;
+  std::memset(&s, 0x5a, sizeof s);
+  s.struct_size = offsetof(hemilight_bake_pass_state_info, pass_count);
+  s.width = 5;
+  hemilight_bake_pass_state_info sg;
+  REQUIRE(capi::read_sized(&s, sg).empty());
+  CHECK(sg.width == 5);
+  CHECK(sg.pass_count == 0);
+  s.struct_size = 0;
+  CHECK(capi::check_sized(&s).find("hemilight_bake_pass_state_info_init") != std::string::npos);
+}
