@@ -9,7 +9,7 @@ ratio to the one-worker Dask bake (paired: the machine's drift cancels). The out
 are checked byte for byte against the one-process bake's.
 
 Usage: dask_speedup.py --bake PATH --make-level PATH --out CSV [--rounds R] [--shards S]
-                       [--levels arena:20000:256,keep:20000:256]
+                       [--levels arena:20000:256,keep:20000:256,city_block:50000:512] [--append]
 """
 import argparse
 import filecmp
@@ -55,7 +55,8 @@ def main():
     p.add_argument("--out", required=True)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--shards", type=int, default=8)
-    p.add_argument("--levels", default="arena:20000:256,keep:20000:256")
+    p.add_argument("--levels", default="arena:20000:256,keep:20000:256,city_block:50000:512")
+    p.add_argument("--append", action="store_true", help="add rows to an existing CSV")
     a = p.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -91,8 +92,9 @@ def main():
             for k in keys:
                 rows.append([name, int(triangles), int(size), a.shards, k[0], k[1], round(statistics.median(times[k]), 3),
                              round(statistics.median(ratios[k]), 3), a.rounds])
-    with open(a.out, "w") as f:
-        f.write("model,triangles,size,shards,runner,workers,median_seconds,speedup,rounds\n")
+    with open(a.out, "a" if a.append else "w") as f:
+        if not a.append:
+            f.write("model,triangles,size,shards,runner,workers,median_seconds,speedup,rounds\n")
         for row in rows:
             f.write(",".join(str(x) for x in row) + "\n")
 
