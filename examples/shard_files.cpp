@@ -105,13 +105,16 @@ void write_planes(const std::string& path, int width, int height, const std::vec
 // The named FLOAT planes of an EXR of the given size; throws naming the file.
 std::vector<std::vector<float>> read_planes(const std::string& path, int width, int height, const std::vector<std::string>& names) {
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error("cannot read '" + path + "': no such file");
-  std::vector<std::vector<float>> planes(names.size(), std::vector<float>(std::size_t(width) * std::size_t(height)));
+  std::vector<std::vector<float>> planes;
   try {
+    // The header first: the manifest's size is believed only when the file agrees, before
+    // anything is allocated for the pixels.
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
     if (dw.min.x != 0 || dw.min.y != 0 || dw.max.x + 1 != width || dw.max.y + 1 != height)
       throw std::runtime_error("it is " + std::to_string(dw.max.x - dw.min.x + 1) + " x " + std::to_string(dw.max.y - dw.min.y + 1) +
                                ", its manifest says " + std::to_string(width) + " x " + std::to_string(height));
+    planes.assign(names.size(), std::vector<float>(std::size_t(width) * std::size_t(height)));
     Imf::FrameBuffer fb;
     for (std::size_t c = 0; c < names.size(); ++c) {
       const Imf::Channel* ch = in.header().channels().findChannel(names[c]);
@@ -168,7 +171,9 @@ bake_shard_result read_shard(const std::string& stem) {
   r.seconds = field<double>(j, "seconds", path);
   r.direct_seconds = field<double>(j, "direct_seconds", path);
   const int width = field<int>(j, "width", path), height = field<int>(j, "height", path);
-  if (width < 1 || height < 1 || std::size_t(width) * std::size_t(height) < r.sample_count || r.channel_names.empty())
+  if (width < 1 || height < 1 || std::size_t(width) * std::size_t(height) > hemilight::max_image_pixels ||
+      std::size_t(width) * std::size_t(height) < r.sample_count || r.channel_names.empty() ||
+      r.channel_names.size() * std::size_t(width) * std::size_t(height) > (std::size_t(1) << 30))  // 4 GiB of values at most
     throw std::runtime_error("'" + path + "': width, height, samples and channels do not fit together");
   const std::vector<std::vector<float>> planes = read_planes(stem + ".exr", width, height, r.channel_names);
   const std::size_t ch = r.channel_names.size();
