@@ -54,7 +54,7 @@ void require_same_bits(const scene_bake_result& a, const scene_bake_result& b) {
     REQUIRE(x.height == y.height);
     REQUIRE(x.channels == y.channels);
     REQUIRE(x.pixels.size() == y.pixels.size());
-    CHECK(std::memcmp(x.pixels.data(), y.pixels.data(), x.pixels.size() * sizeof(float)) == 0);
+    if (!x.pixels.empty()) CHECK(std::memcmp(x.pixels.data(), y.pixels.data(), x.pixels.size() * sizeof(float)) == 0);
   };
   for (std::size_t p = 0; p < a.pages.size(); ++p) {
     const bake_result &x = a.pages[p], &y = b.pages[p];
