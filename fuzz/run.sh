@@ -24,10 +24,10 @@ fi
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHEMILIGHT_BUILD_FUZZERS=ON \
   -DHEMILIGHT_BUILD_TESTS=OFF -DHEMILIGHT_BUILD_EXAMPLES=OFF > /dev/null
 cmake --build build-fuzz -j "$(nproc)" 2>&1 | grep -v "warning: loop not vectorized" | grep -E "error|Built target fuzz" || true
-for name in points cache bake cubemap exr; do
+for name in points cache bake cubemap exr shards; do
   [ -x "build-fuzz/fuzz/fuzz_$name" ] || { echo "build-fuzz/fuzz/fuzz_$name was not built" >&2; exit 1; }
 done
-for name in points cache bake cubemap exr; do
+for name in points cache bake cubemap exr shards; do
   corpus=build-fuzz/corpus/$name
   mkdir -p "$corpus"
   cp -n fuzz/corpus/$name/* "$corpus"/ 2>/dev/null || true
