@@ -27,16 +27,19 @@ struct shard_plan {
   bake_result r;  // coverage, sampled and the set-up's statistics (place_samples)
   std::uint64_t key = 0;
   int shard_count = 0;
-  std::vector<std::uint32_t> morton_order;  // sample indices in Morton order (ties: index)
+  // The samples shard by shard: shard i's are by_shard[begin[i], begin[i + 1]), in the bake's
+  // sample order (the i-th of shard_count equal runs of the Morton order, each sorted once).
+  std::vector<std::uint32_t> by_shard;
+  std::vector<std::size_t> begin;
   double setup_seconds = 0.0;
 
-  // Shard i's samples in the bake's sample order.
-  std::vector<std::uint32_t> samples(int i) const {
-    const std::size_t n = morton_order.size(), s = std::size_t(shard_count);
-    const std::size_t lo = n * std::size_t(i) / s, hi = n * (std::size_t(i) + 1) / s;
-    std::vector<std::uint32_t> out(morton_order.begin() + std::ptrdiff_t(lo), morton_order.begin() + std::ptrdiff_t(hi));
-    std::sort(out.begin(), out.end());
-    return out;
+  struct sample_range {
+    const std::uint32_t *first, *last;
+    std::size_t size() const { return std::size_t(last - first); }
+    std::uint32_t operator[](std::size_t k) const { return first[k]; }
+  };
+  sample_range samples(int i) const {
+    return {by_shard.data() + begin[std::size_t(i)], by_shard.data() + begin[std::size_t(i) + 1]};
   }
 };
 
@@ -97,7 +100,11 @@ shard_plan make_shard_plan(const char* who, const scene_bake_input& input, const
   p.su.samples = sparse_samples{};
   p.key = bake_key(input, o);
   p.shard_count = shard_count;
-  p.morton_order = morton_order(p.pts, *p.su.sc);
+  p.by_shard = morton_order(p.pts, *p.su.sc);
+  const std::size_t n = p.by_shard.size(), count = std::size_t(shard_count);
+  for (std::size_t i = 0; i <= count; ++i) p.begin.push_back(n * i / count);
+  for (std::size_t i = 0; i < count; ++i)
+    std::sort(p.by_shard.begin() + std::ptrdiff_t(p.begin[i]), p.by_shard.begin() + std::ptrdiff_t(p.begin[i + 1]));
   p.setup_seconds = seconds_since(t0);
   return p;
 }
@@ -169,11 +176,11 @@ void unpack_sample(const shard_channels& ch, const float* in, std::size_t at, pa
 }
 
 // The samples `idx` of pts as a sample_points of their own.
-sample_points subset(const sample_points& pts, const std::vector<std::uint32_t>& idx) {
+sample_points subset(const sample_points& pts, shard_plan::sample_range idx) {
   sample_points s;
   const auto take = [&idx](const auto& from, auto& to) {
     to.reserve(idx.size());
-    for (std::uint32_t i : idx) to.push_back(from[i]);
+    for (const std::uint32_t* i = idx.first; i != idx.last; ++i) to.push_back(from[*i]);
   };
   take(pts.texel_of, s.texel_of);
   take(pts.positions, s.positions);
@@ -230,7 +237,7 @@ void check_pass(const char* who, int pass, int hi, int bounces) {
 // `progress` (may be empty) sees the job's fraction; false cancels.
 bake_shard_result run_shard(const shard_plan& p, const bake_options& o, int shard, int pass, const bake_pass_state* previous,
                             const std::function<bool(float)>& progress, std::chrono::steady_clock::time_point t0) {
-  const std::vector<std::uint32_t> idx = p.samples(shard);
+  const shard_plan::sample_range idx = p.samples(shard);
   const sample_points pts = subset(p.pts, idx);
   const bake_layout& layout = p.su.atlas.layout;
   image emission_texture;
@@ -329,7 +336,7 @@ pass_values join_shards(const shard_plan& p, const bake_options& o, int pass, co
       for (auto& plane : d->mask) plane.resize(n);
   }
   for (int s = 0; s < p.shard_count; ++s) {
-    const std::vector<std::uint32_t> idx = p.samples(s);
+    const shard_plan::sample_range idx = p.samples(s);
     const bake_shard_result& r = *shards[std::size_t(s)];
     for (std::size_t i = 0; i < idx.size(); ++i) unpack_sample(ch, r.values.data() + i * ch.size(), idx[i], v, d);
   }
@@ -349,9 +356,11 @@ cache_stats pass_stats(const std::vector<const bake_shard_result*>& shards) {
 }
 
 // What a merge of pass `pass` joins: the pass's values with the lights added and invalid samples
-// filled, the lights (from pass 1's shards), and per sample valid in every pass so far.
+// filled, the lights (from pass 1's shards), and per sample valid in every pass so far; with
+// `finishing` (the last pass) also pass 1's AO (in v.ao) and, with indirect_only, pass 1's
+// values as the one-process bake kept them (first).
 struct joined_pass {
-  pass_values v;
+  pass_values v, first;
   direct_values direct;
   bool lit = false;
   std::vector<std::uint8_t> valid;
@@ -359,14 +368,20 @@ struct joined_pass {
 };
 
 joined_pass join_pass(const char* who, const shard_plan& p, const bake_options& o, int pass, const bake_shard_result* shards,
-                      std::size_t count, const bake_shard_result* first_pass, const bake_pass_state* previous) {
+                      std::size_t count, const bake_shard_result* first_pass, const bake_pass_state* previous, bool finishing) {
   check_previous(who, p, pass, previous);
   const std::vector<const bake_shard_result*> these = check_shards(who, "shards", p, o, pass, shards, count);
-  const std::vector<const bake_shard_result*> first = pass == 1 ? these : check_shards(who, "first_pass", p, o, 1, first_pass, count);
   joined_pass j;
   j.lit = !o.lights.empty();
-  if (j.lit) join_shards(p, o, 1, first, &j.direct);
-  j.v = join_shards(p, o, pass, these, nullptr);
+  // Pass 1's shards are read once: its values and the lights' (pass 1 itself: both at once).
+  pass_values first;
+  if (pass == 1) {
+    j.v = join_shards(p, o, 1, these, j.lit ? &j.direct : nullptr);
+  } else {
+    const std::vector<const bake_shard_result*> ones = check_shards(who, "first_pass", p, o, 1, first_pass, count);
+    if (j.lit || (finishing && (o.ao_distance > 0.0f || o.indirect_only))) first = join_shards(p, o, 1, ones, j.lit ? &j.direct : nullptr);
+    j.v = join_shards(p, o, pass, these, nullptr);
+  }
   const std::size_t n = p.pts.texel_of.size();
   j.valid.assign(n, 1);
   if (previous) {
@@ -374,18 +389,27 @@ joined_pass join_pass(const char* who, const shard_plan& p, const bake_options& 
     j.passes = previous->passes;
   }
   j.passes.push_back(pass_stats(these));
-  // The AO of pass 1 (from its shards) rides along to the end, before the lights are added.
-  std::vector<float> ao;
-  if (pass != 1 && o.ao_distance > 0.0f) ao = join_shards(p, o, 1, first, nullptr).ao;
   merge_pass(p.pts, j.lit ? &j.direct : nullptr, p.su.atlas.layout, j.v, j.valid);
-  if (!ao.empty()) j.v.ao = std::move(ao);
+  if (!finishing) return j;
+  if (pass == 1) {
+    if (o.indirect_only) j.first = j.v;
+    return j;
+  }
+  // The AO of pass 1 rides along to the end; with indirect_only, pass 1's values as the
+  // one-process bake kept them: lights added, its own invalid samples filled.
+  j.v.ao = std::move(first.ao);
+  if (o.indirect_only) {
+    std::vector<std::uint8_t> unused(n, 1);
+    merge_pass(p.pts, j.lit ? &j.direct : nullptr, p.su.atlas.layout, first, unused);
+    j.first = std::move(first);
+  }
   return j;
 }
 
 bake_pass_state merge_state(const char* who, const shard_plan& p, const bake_options& o, int pass, const bake_shard_result* shards,
                             std::size_t count, const bake_shard_result* first_pass, const bake_pass_state* previous) {
   check_pass(who, pass, o.bounces - 1, o.bounces);
-  joined_pass j = join_pass(who, p, o, pass, shards, count, first_pass, previous);
+  joined_pass j = join_pass(who, p, o, pass, shards, count, first_pass, previous, false);
   bake_pass_state st;
   st.key = p.key;
   st.pass = pass;
@@ -401,23 +425,12 @@ bake_pass_state merge_state(const char* who, const shard_plan& p, const bake_opt
 scene_bake_result finish(const char* who, const scene_bake_input& input, shard_plan& p, const bake_options& o,
                          const bake_shard_result* shards, std::size_t count, const bake_shard_result* first_pass,
                          const bake_pass_state* previous, std::chrono::steady_clock::time_point t0) {
-  joined_pass j = join_pass(who, p, o, o.bounces, shards, count, first_pass, previous);
-  pass_values first;
-  if (o.indirect_only) {
-    if (o.bounces == 1) {
-      first = j.v;
-    } else {
-      // Pass 1's values as the one-process bake kept them: lights added, its invalid samples filled.
-      first = join_shards(p, o, 1, check_shards(who, "first_pass", p, o, 1, first_pass, count), nullptr);
-      std::vector<std::uint8_t> unused(p.pts.texel_of.size(), 1);
-      merge_pass(p.pts, j.lit ? &j.direct : nullptr, p.su.atlas.layout, first, unused);
-    }
-  }
+  joined_pass j = join_pass(who, p, o, o.bounces, shards, count, first_pass, previous, true);
   const double seam_seconds = o.stitch_seams ? scene_seams(input, p.su.geometry, *p.su.sc, p.su.atlas) : 0.0;
   bake_result all = std::move(p.r);
   std::vector<float> ao = std::move(j.v.ao);
   std::vector<std::uint8_t> filled;
-  finish_samples(p.pts, j.v, o.indirect_only ? &first : nullptr, j.lit ? &j.direct : nullptr, ao, j.valid, o, p.su.atlas.layout, all,
+  finish_samples(p.pts, j.v, o.indirect_only ? &j.first : nullptr, j.lit ? &j.direct : nullptr, ao, j.valid, o, p.su.atlas.layout, all,
                  filled);
   for (const cache_stats& cs : j.passes) {
     all.stats.hemicubes += cs.hemicubes;
