@@ -531,59 +531,62 @@ std::optional<scene_bake_result> run_bake(const std::string& name, const std::st
   if (s.shards == 0) return bake_scene(in, o);
   if (s.shard < 0 && s.merge == 0) return bake_scene_sharded(in, o, s.shards);
   const auto t0 = std::chrono::steady_clock::now();
-  try {
-    if (s.shard >= 0) {
-      std::optional<bake_pass_state> previous;
-      if (s.pass > 1) previous = shard_files::read_state(shard_files::state_stem(base, s.pass - 1));
-      const bake_shard_result r = bake_scene_shard(in, o, s.shard, s.shards, s.pass, previous ? &*previous : nullptr);
-      const std::string stem = shard_files::shard_stem(base, s.pass, s.shard, s.shards);
-      shard_files::write_shard(stem, name, r);
-      if (bar_open) std::fprintf(stderr, "\n");
-      bar_open = false;
-      std::printf("%s: pass %d shard %d of %d: %zu samples, %zu hemicubes, %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.pass, s.shard,
-                  s.shards, r.sample_count, r.hemicubes, r.seconds, stem.c_str());
-      return std::nullopt;
-    }
-    // A merge: pass K's shards, pass 1's (their lights and AO), the state after pass K - 1.
-    const auto read_pass = [&](int pass) {
-      std::vector<bake_shard_result> shards;
-      for (int i = 0; i < s.shards; ++i) shards.push_back(shard_files::read_shard(shard_files::shard_stem(base, pass, i, s.shards)));
-      return shards;
-    };
-    const std::vector<bake_shard_result> these = read_pass(s.merge);
-    const std::vector<bake_shard_result> first = s.merge == 1 ? these : read_pass(1);
+  // Each file is checked against this bake as it is read, so that a refusal names the file (the
+  // library checks the same again, and the rest: sizes, channels).
+  const std::uint64_t key = bake_key(in, o);
+  const auto foreign = [&](const std::string& file, std::uint64_t k) {
+    fail(file + " was made by another bake (another scene or options: key " + shard_files::key_text(k) + ", this bake's " +
+         shard_files::key_text(key) + ")");
+  };
+  const auto read_shard = [&](int pass, int i) {
+    const std::string stem = shard_files::shard_stem(base, pass, i, s.shards);
+    bake_shard_result r = shard_files::read_shard(stem);
+    if (r.key != key) foreign(stem + ".json", r.key);
+    if (r.pass != pass || r.shard != i || r.shard_count != s.shards)
+      fail(stem + ".json holds shard " + std::to_string(r.shard) + " of " + std::to_string(r.shard_count) + " of pass " +
+           std::to_string(r.pass));
+    return r;
+  };
+  const auto read_state = [&](int pass) {
+    const std::string stem = shard_files::state_stem(base, pass);
+    bake_pass_state st = shard_files::read_state(stem);
+    if (st.key != key) foreign(stem + ".json", st.key);
+    if (st.pass != pass || st.shard_count != s.shards)
+      fail(stem + ".json is the state after pass " + std::to_string(st.pass) + " of " + std::to_string(st.shard_count) + " shards");
+    return st;
+  };
+  if (s.shard >= 0) {
     std::optional<bake_pass_state> previous;
-    if (s.merge > 1) previous = shard_files::read_state(shard_files::state_stem(base, s.merge - 1));
-    const bake_pass_state* prev = previous ? &*previous : nullptr;
-    if (s.merge == o.bounces) return finish_sharded_bake(in, o, these.data(), these.size(), first.data(), prev);
-    const bake_pass_state state = merge_bake_pass(in, o, s.merge, these.data(), these.size(), first.data(), prev);
-    const std::string stem = shard_files::state_stem(base, s.merge);
-    shard_files::write_state(stem, name, state);
-    std::size_t hemicubes = 0;
-    for (const bake_shard_result& r : these) hemicubes += r.hemicubes;
-    std::printf("%s: pass %d merged from %d shards (%zu hemicubes), %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.merge, s.shards,
-                hemicubes, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stem.c_str());
+    if (s.pass > 1) previous = read_state(s.pass - 1);
+    const bake_shard_result r = bake_scene_shard(in, o, s.shard, s.shards, s.pass, previous ? &*previous : nullptr);
+    const std::string stem = shard_files::shard_stem(base, s.pass, s.shard, s.shards);
+    shard_files::write_shard(stem, name, r);
+    if (bar_open) std::fprintf(stderr, "\n");
+    bar_open = false;
+    std::printf("%s: pass %d shard %d of %d: %zu samples, %zu hemicubes, %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.pass, s.shard,
+                s.shards, r.sample_count, r.hemicubes, r.seconds, stem.c_str());
     return std::nullopt;
-  } catch (const hemilight::error& e) {
-    if (e.code() != status::invalid_argument) throw;
-    // A mismatch the library found between this bake and the files: name the file. The merges
-    // name shards[i] (pass K's i-th file, read in order), first_pass[i] (pass 1's) or the
-    // previous state; a job only reads the state.
-    const std::string what = e.what();
-    std::string file = shard_files::state_stem(base, std::max(s.pass, s.merge) - 1);
-    for (const auto& [array, pass] : {std::pair<std::string, int>{"first_pass[", 1}, {"shards[", s.merge}}) {
-      const std::size_t at = what.find(array);
-      if (s.merge > 0 && at != std::string::npos && what.find("previous state") == std::string::npos) {
-        file = shard_files::shard_stem(base, pass, std::atoi(what.c_str() + at + array.size()), s.shards);
-        break;
-      }
-    }
-    fail(file + ".{exr,json} does not belong to this bake: " + what);
-  } catch (const cli_error&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    fail(e.what());  // a shard file missing or broken (shard_files names it)
   }
+  // A merge: pass K's shards, pass 1's (their lights and AO), the state after pass K - 1.
+  const auto read_pass = [&](int pass) {
+    std::vector<bake_shard_result> shards;
+    for (int i = 0; i < s.shards; ++i) shards.push_back(read_shard(pass, i));
+    return shards;
+  };
+  const std::vector<bake_shard_result> these = read_pass(s.merge);
+  const std::vector<bake_shard_result> first = s.merge == 1 ? these : read_pass(1);
+  std::optional<bake_pass_state> previous;
+  if (s.merge > 1) previous = read_state(s.merge - 1);
+  const bake_pass_state* prev = previous ? &*previous : nullptr;
+  if (s.merge == o.bounces) return finish_sharded_bake(in, o, these.data(), these.size(), first.data(), prev);
+  const bake_pass_state state = merge_bake_pass(in, o, s.merge, these.data(), these.size(), first.data(), prev);
+  const std::string stem = shard_files::state_stem(base, s.merge);
+  shard_files::write_state(stem, name, state);
+  std::size_t hemicubes = 0;
+  for (const bake_shard_result& r : these) hemicubes += r.hemicubes;
+  std::printf("%s: pass %d merged from %d shards (%zu hemicubes), %.2f s; wrote %s.{exr,json}\n", name.c_str(), s.merge, s.shards,
+              hemicubes, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stem.c_str());
+  return std::nullopt;
 }
 
 void bake_and_write(const std::string& name, const scene_bake_input& in, const settings& s, const std::vector<light>& scene_lights,

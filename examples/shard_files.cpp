@@ -24,11 +24,6 @@ using hemilight::bake_shard_result;
 
 constexpr int row_samples = 1024;  // samples per row of a shard's EXR
 
-std::string hex_key(std::uint64_t key) {
-  char text[24];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(key));
-  return text;
-}
 
 std::uint64_t parse_key(const std::string& text, const std::string& file) {
   if (text.size() != 16 || text.find_first_not_of("0123456789abcdef") != std::string::npos)
@@ -133,6 +128,12 @@ std::string file_name(const std::string& path) { return std::filesystem::path(pa
 
 }  // namespace
 
+std::string key_text(std::uint64_t key) {
+  char text[24];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(key));
+  return text;
+}
+
 std::string shard_stem(const std::string& prefix, int pass, int shard, int shards) {
   return prefix + "_pass" + std::to_string(pass) + "_shard" + std::to_string(shard) + "of" + std::to_string(shards);
 }
@@ -148,7 +149,7 @@ void write_shard(const std::string& stem, const std::string& name, const bake_sh
     for (std::size_t c = 0; c < ch; ++c) planes[c][i] = r.values[i * ch + c];
   write_planes(stem + ".exr", width, height, r.channel_names, planes);
   const json j = {{"format", "hemilight_shard"}, {"version", 1}, {"name", name}, {"pass", r.pass}, {"shard", r.shard},
-                  {"shards", r.shard_count}, {"key", hex_key(r.key)}, {"samples", n}, {"width", width}, {"height", height},
+                  {"shards", r.shard_count}, {"key", key_text(r.key)}, {"samples", n}, {"width", width}, {"height", height},
                   {"channels", r.channel_names}, {"hemicubes", r.hemicubes}, {"records", r.records},
                   {"invalid_samples", r.invalid_samples}, {"seconds", r.seconds}, {"direct_seconds", r.direct_seconds},
                   {"values", file_name(stem + ".exr")}};
@@ -195,7 +196,7 @@ void write_state(const std::string& stem, const std::string& name, const bake_pa
   for (const hemilight::cache_stats& p : s.passes)
     passes.push_back({{"hemicubes", p.hemicubes}, {"records", p.records}, {"invalid_samples", p.invalid_samples}, {"seconds", p.seconds}});
   const json j = {{"format", "hemilight_pass_state"}, {"version", 1}, {"name", name}, {"pass", s.pass}, {"shards", s.shard_count},
-                  {"key", hex_key(s.key)}, {"width", s.radiance.width}, {"height", s.radiance.height}, {"passes", passes},
+                  {"key", key_text(s.key)}, {"width", s.radiance.width}, {"height", s.radiance.height}, {"passes", passes},
                   {"values", file_name(stem + ".exr")}};
   write_json(stem + ".json", j);
 }

@@ -23,9 +23,13 @@
 
 #include "hemilight/shards.hpp"
 
+#include <cstdint>
 #include <string>
 
 namespace shard_files {
+
+/// A bake's key as the manifests write it: 16 hex digits.
+std::string key_text(std::uint64_t key);
 
 /// PREFIX_pass{K}_shard{I}of{S} (no extension).
 std::string shard_stem(const std::string& prefix, int pass, int shard, int shards);
