@@ -1,9 +1,11 @@
 // Steps 2-6 of the baker (internal, not installed): the per-sample state of a bake and its
-// stages (bake.hpp, "pipeline"), shared by bake_lightmap and bake_scene:
-//   place_samples -> [direct_pass] -> { pass_radiance_texture -> cached_pass | per_texel_pass
-//   -> add_direct -> fill_invalid_samples }* -> fill_direct_outputs -> write_outputs
-// bake_samples runs the chain (passes.cpp); direct.cpp holds the lights' stages, outputs.cpp
-// the images.
+// stages (bake.hpp, "pipeline"), shared by bake_lightmap, bake_scene and the sharded bake:
+//   place_samples -> [lights_at_samples] -> { pass_radiance_texture -> hemicube_pass (the cache or
+//   a hemicube per sample) -> merge_pass (add_direct, fill_invalid_samples) }* -> finish_samples
+//   (fill_invalid_ao, fill_direct_outputs, write_outputs)
+// bake_samples runs the chain in one process (bake_lightmap.cpp); shards.cpp runs hemicube_pass
+// per shard and the rest in its merges; direct.cpp holds the lights' stages, outputs.cpp the
+// images, bake_scene.cpp the scene set-up (make_scene_setup) and pages (scene_pages).
 #pragma once
 
 #include "coverage.hpp"
