@@ -1382,10 +1382,10 @@ TEST_CASE("raster: exact edge coverage blends textured triangles like emissive o
 namespace {
 
 // Renders at `points` with occlusion culling on and off (both otherwise the fastest paths, and the
-// scalar path with culling) and checks the buffers and the seen triangles bit for bit. Returns the
-// culled renders' statistics summed.
+// scalar path with culling) and checks the buffers and the seen triangles (ties settled in the
+// reference order's favour) bit for bit. Returns the culled renders' statistics summed.
 raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vector<std::pair<glm::vec3, frame>>& points, int n,
-                                           const radiance_texture* texture = nullptr, bool same_triangles = true) {
+                                           const radiance_texture* texture = nullptr) {
   const auto s = scene::create(m.desc());
   raster_options on, off, scalar;
   on.diagnostics.occlusion_min_triangles = 0;  // culling in scenes of every size
@@ -1405,9 +1405,9 @@ raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vecto
     CHECK(std::memcmp(c.distance.data(), b.distance.data(), c.distance.size() * sizeof(float)) == 0);
     CHECK(std::memcmp(c.radiance.data(), b.radiance.data(), c.radiance.size() * sizeof(float)) == 0);
     std::size_t same = 0;
-    for (std::size_t i = 0; i < a.texel_count(); ++i) same += culled.seen_triangle(i) == reference.seen_triangle(i) ? 1u : 0u;
-    // (Where two triangles of one shade meet at exactly the same depth, either may be named.)
-    if (same_triangles) CHECK(same == a.texel_count());
+    for (std::size_t i = 0; i < a.texel_count(); ++i)
+      same += culled.seen_triangle(i) == reference.seen_triangle(i) && culled_scalar.seen_triangle(i) == reference.seen_triangle(i);
+    CHECK(same == a.texel_count());
     CHECK(reference.statistics().nodes_occluded == 0);
     const raster_statistics& st = culled.statistics();
     sum.nodes_visited += st.nodes_visited;
@@ -1416,6 +1416,7 @@ raster_statistics check_occlusion_is_exact(const scene_mesh& m, const std::vecto
     sum.nodes_occluded += st.nodes_occluded;
     sum.triangles_occluded += st.triangles_occluded;
     sum.occlusion_redraws += st.occlusion_redraws;
+    sum.occlusion_ties_settled += st.occlusion_ties_settled;
   }
   return sum;
 }
@@ -1468,8 +1469,14 @@ TEST_CASE("raster: occlusion culling leaves the stand-in levels' buffers bitwise
     o.target_triangles = std::string(name) == "arena" || std::string(name) == "keep" ? 10000 : 50000;
     const scene_mesh m = make_level(name, o).mesh;
     INFO(name);
-    const raster_statistics st = check_occlusion_is_exact(m, surface_points(m, 16, rng), 64, nullptr, false);
+    const auto points = surface_points(m, 16, rng);
+    const raster_statistics st = check_occlusion_is_exact(m, points, 64);
     CHECK(st.triangles_occluded > 0);
+    // Textured (a bounce pass): tied fragments are compared by the texture values they read.
+    std::vector<float> pixels(3 * 256 * 256);
+    for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = float(i * 2654435761u % 1000u) / 1000.0f;
+    const radiance_texture texture(pixels.data(), 256, 256);
+    check_occlusion_is_exact(m, points, 64, &texture);
   }
 }
 
@@ -1499,7 +1506,8 @@ TEST_CASE("raster: occlusion culling keeps the reference order's choice between 
   // Two coplanar quads of different emission over the same area (z-fighting), the far one listed
   // first, and a third quad in front of part of them. The reference order draws the first-listed
   // quad first, which then keeps the texels where both have the same depth; front to back the
-  // other may come first. The culled render must detect the tie and give the reference's texels.
+  // other may come first. The culled render must settle the ties in place (no redraw) and give the
+  // reference's texels and seen triangles.
   scene_mesh m;
   const material red{glm::vec3(1, 0, 0), glm::vec3(0.5f), false}, blue{glm::vec3(0, 0, 1), glm::vec3(0.5f), false},
       green{glm::vec3(0, 1, 0), glm::vec3(0.5f), false};
@@ -1512,26 +1520,45 @@ TEST_CASE("raster: occlusion culling keeps the reference order's choice between 
     m.add_quad({x, -2, 1}, {x, 2, 1}, {x + 0.1f, 2, 1}, {x + 0.1f, -2, 1}, blue);
   }
   m.add_quad({-0.5f, -0.5f, 0.6f}, {-0.5f, 0.5f, 0.6f}, {0.5f, 0.5f, 0.6f}, {0.5f, -0.5f, 0.6f}, green);
-  const raster_statistics st = check_occlusion_is_exact(m, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64);
-  CHECK(st.occlusion_redraws == 1);
+  const std::vector<std::pair<glm::vec3, frame>> point = {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}};
+  const raster_statistics st = check_occlusion_is_exact(m, point, 64);
+  CHECK(st.occlusion_redraws == 0);
+  CHECK(st.occlusion_ties_settled > 0);
 
-  // The same with one material for both layers: whichever wins, the texel gets the same shade and
-  // the distance of the tied depth, so no redraw is needed (only seen_triangle may differ). With
-  // a radiance texture over lightmap UVs that differ between the layers, the winner matters again.
+  // The same with one material for both layers, and textured with lightmap UVs that differ between
+  // the layers (a texture that tells them apart, and one that gives both the same value).
   scene_mesh same = m;
   for (material& mat : same.materials)
     if (mat.emission.z == 1.0f) mat = red;
-  const raster_statistics st_same =
-      check_occlusion_is_exact(same, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64, nullptr, false);
-  CHECK(st_same.occlusion_redraws == 0);
+  CHECK(check_occlusion_is_exact(same, point, 64).occlusion_ties_settled > 0);
   same.lightmap_uvs.resize(same.positions.size());
   for (std::size_t v = 0; v < same.positions.size(); ++v)
     same.lightmap_uvs[v] = {v < same.positions.size() / 2 ? 0.1f : 0.9f, 0.5f};
   std::vector<float> pixels = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};  // 2 x 1: red left, blue right
   const radiance_texture texture(pixels.data(), 2, 1);
-  const raster_statistics st_textured =
-      check_occlusion_is_exact(same, {{{0.05f, 0.03f, 0.0f}, rolled_frame({0, 0, 1}, 0.0)}}, 64, &texture);
-  CHECK(st_textured.occlusion_redraws == 1);
+  const raster_statistics st_textured = check_occlusion_is_exact(same, point, 64, &texture);
+  CHECK(st_textured.occlusion_redraws == 0);
+  CHECK(st_textured.occlusion_ties_settled > 0);
+  std::vector<float> flat_pixels = {1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f};
+  const radiance_texture flat(flat_pixels.data(), 2, 1);
+  CHECK(check_occlusion_is_exact(same, point, 64, &flat).occlusion_redraws == 0);
+
+  // With level of detail the ties are not settled in place (proxies have no place in the order):
+  // the render is drawn again where the tied fragments differ (the quads are too near for proxies,
+  // so the buffers are still the unculled ones).
+  const auto s = scene::create(m.desc());
+  raster_options lod_on, lod_off;
+  lod_on.diagnostics.occlusion_min_triangles = 0;
+  lod_on.lod_texels = 1.0f;
+  lod_off.diagnostics.occlusion_culling = false;
+  lod_off.lod_texels = 1.0f;
+  hemicube_rasterizer culled(s, lod_on), reference(s, lod_off);
+  hemicube_buffer a, b;
+  culled.render(point[0].first, point[0].second, 64, a);
+  reference.render(point[0].first, point[0].second, 64, b);
+  CHECK(culled.statistics().occlusion_redraws == 1);
+  CHECK(culled.statistics().lod_nodes == 0);
+  CHECK(std::memcmp(a.radiance.data(), b.radiance.data(), a.radiance.size() * sizeof(float)) == 0);
 }
 
 TEST_CASE("raster: level of detail draws far nodes from proxies, deterministic and close to the exact render", "[raster]") {

@@ -152,7 +152,8 @@ struct raster_statistics {
   std::size_t nodes_occluded = 0;      ///< occlusion culling: nodes skipped as hidden on every face they touch
   std::size_t triangles_occluded = 0;  ///< occlusion culling: the triangles below those nodes
   std::size_t face_triangles_occluded = 0;  ///< occlusion culling: big (triangle, face) pairs found hidden before their spans
-  std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie; 0 or 1)
+  std::size_t occlusion_redraws = 0;   ///< renders drawn again in the reference order (a depth tie with level of detail, or too many ties; 0 or 1)
+  std::size_t occlusion_ties_settled = 0;  ///< occlusion culling: depth ties at a texel's final depth, given the reference order's winner in place
   std::size_t lod_nodes = 0;           ///< level of detail: nodes drawn from their proxies
   std::size_t see_through_tested = 0;     ///< see-through (alpha-tested, translucent) triangles tested
   std::size_t see_through_fragments = 0;  ///< texels tested for them (their rows' spans on each face)

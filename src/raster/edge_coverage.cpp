@@ -827,9 +827,9 @@ glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, st
     const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
     const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
     const std::vector<std::uint32_t>& indices = scene_->indices();
-    const std::size_t tri = 3 * static_cast<std::size_t>(rec.index);
-    const glm::vec2& uv0 = uvs[indices[tri]];
-    const glm::vec2 uv = uv0 + b1 * (uvs[indices[tri + 1]] - uv0) + b2 * (uvs[indices[tri + 2]] - uv0);
+    const std::uint32_t* v = rec.vertices ? rec.vertices : indices.data() + 3 * static_cast<std::size_t>(rec.index);
+    const glm::vec2& uv0 = uvs[v[0]];
+    const glm::vec2 uv = uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0);
     return texture->sample(uv);
   }
   const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];

@@ -270,6 +270,8 @@ class alignas(64) rasterizer_impl {
   void edge_make_density();
   void edge_group_fragments();
   void edge_blend(hemicube_buffer& out, const frame& basis, const radiance_texture* texture);
+  // What texel `texel` gets from fragment `id` at depth z: the texture at its UV (a textured
+  // draw: the resolve's formula, the same bits) or its shade's radiance.
   glm::vec3 fragment_radiance(std::uint32_t id, std::size_t texel, float z, const radiance_texture* texture) const;
   bool edge_ = false;
   edge_state edges_;
@@ -302,8 +304,13 @@ class alignas(64) rasterizer_impl {
   void draw_leaf(const bvh_node& node, unsigned mask, const glm::vec3& position, const frame& basis, const simd_frame& sf);
   void redraw_prepare();
   // A logged tie holds its texel's final depth between fragments the buffer can tell apart (other
-  // shades, or a textured render), or the log overflowed.
+  // shades, or other texture values in a textured render), or the log overflowed.
   bool ties_decide_order() const;
+  // Each logged tie that holds its texel's final depth: the texel goes to the tied fragment the
+  // reference order draws first (the lower position in scene::triangles()). Not with level of
+  // detail (proxies have no position) nor after an overflow.
+  void settle_ties();
+  std::vector<std::uint32_t> bvh_position_;  // per scene triangle: its position in scene::triangles() (bind)
   // See-through triangles (scene::see_through_triangles(); see_through.cpp): drawn after the
   // opaque ones, alpha-tested into depth_ and ids_, translucent as fragments composited over the
   // resolved buffer.
@@ -350,6 +357,7 @@ class alignas(64) rasterizer_impl {
   std::size_t tile_offset_[5] = {};            // each face's first tile
   int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
   std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)
+  std::vector<std::uint32_t> front_keys_;  // per scene triangle: (2 + emission index) << 1 | one-sided (bind)
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;
@@ -371,6 +379,7 @@ class alignas(64) rasterizer_impl {
   std::vector<std::uint32_t> draw_triangles_;  // per draw: the scene triangle (seen_triangle)
   std::vector<draw_record> draws_;             // per draw, textured renders only: the UV pass's data
   bool textured_ = false;                      // this render samples a texture (draws_ is kept)
+  const radiance_texture* texture_ = nullptr;  // that texture (textured_ renders; the tie check reads it)
   // [0] the sky, [1] a back face, [2 + e] the front of a triangle with scene emission e: built
   // once, so a draw needs no radiance of its own and equal radiances share one key.
   std::vector<shade> shades_;

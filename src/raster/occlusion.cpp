@@ -68,14 +68,36 @@ bool raster_detail::rasterizer_impl::ties_decide_order() const {
   // the texel the same bits: the same shade (radiance and flags) and, without a texture, the
   // distance comes from the texel's depth, which is the tied depth either way. (seen_triangle()
   // may then name either triangle.)
+  // In a textured render the texel's radiance is the texture at the winner's UV (the resolve's
+  // formula, fragment_radiance): the tie decides nothing when both fragments read the same bits.
   const auto key = [&](std::uint32_t id) { return key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]; };
   for (const tie_log::entry& e : ties_.at) {
     if (*e.depth != e.z) continue;
-    if (textured_) return true;
     const std::size_t texel = static_cast<std::size_t>(e.depth - depth_.data());
-    if (key(ids_[texel]) != key(e.id)) return true;
+    const std::uint32_t won = ids_[texel];
+    if (key(won) != key(e.id)) return true;
+    if (textured_) {
+      const glm::vec3 a = fragment_radiance(won, texel, e.z, texture_), b = fragment_radiance(e.id, texel, e.z, texture_);
+      if (std::memcmp(&a, &b, sizeof a) != 0) return true;
+    }
   }
   return false;
+}
+
+// The reference order (traverse) visits the leaves depth first, left child first, and the BVH
+// keeps each child's triangles in one run of scene::triangles(), the left child's first: it draws
+// the opaque triangles in that order, each face's lanes in leaf order. At equal depths the first
+// drawn keeps the texel, so among the fragments tied at a texel's final depth (the one that got
+// there first in this pass and the later ones the log holds) the reference keeps the lowest
+// position.
+void raster_detail::rasterizer_impl::settle_ties() {
+  const auto position = [&](std::uint32_t id) { return bvh_position_[draw_triangles_[key_bits_ ? id >> key_bits_ : id]]; };
+  for (const tie_log::entry& e : ties_.at) {
+    if (*e.depth != e.z) continue;
+    ++stats_.occlusion_ties_settled;
+    std::uint32_t& id = ids_[static_cast<std::size_t>(e.depth - depth_.data())];
+    if (position(e.id) < position(id)) id = e.id;
+  }
 }
 
 namespace {

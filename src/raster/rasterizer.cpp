@@ -285,6 +285,11 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
   if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
   validate_raster_options(options, "hemicube_rasterizer");
+  // front_keys_ packs 2 + an emission index and a flag in 32 bits (a scene with 2^30 distinct
+  // emissions would need over 100 GB).
+  if (s->emissions().size() >= (std::size_t(1) << 30))
+    throw_invalid_argument("hemicube_rasterizer: the scene has " + std::to_string(s->emissions().size()) +
+                           " distinct emissions; at most 2^30 - 1 are supported");
   // Step 2: the scene, the options, and the shades (the direction tables and scratch stay).
   scene_ = std::move(s);
   near_ = options.near_distance > 0.0f ? options.near_distance : default_near_distance(*scene_);
@@ -313,6 +318,16 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
   for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
+  // Per triangle (scene_desc numbering) its front key and whether its back is black, packed in
+  // one word: commit_record reads this compact table once per draw instead of the material and
+  // the emission index (two cache misses per drawn triangle on a large level; step 1 checked
+  // that the keys fit).
+  bvh_position_.assign(scene_->triangle_count(), no_triangle);
+  for (std::size_t i = 0; i < scene_->triangles().size(); ++i)
+    bvh_position_[scene_->triangles()[i].index] = static_cast<std::uint32_t>(i);
+  front_keys_.resize(scene_->triangle_count());
+  for (std::size_t i = 0; i < front_keys_.size(); ++i)
+    front_keys_[i] = (2u + scene_->emission_index(i)) << 1 | (scene_->triangle_material(i).two_sided ? 0u : 1u);
   // The back of a one-sided see-through triangle: black, but not a back face to the tests for
   // texels inside geometry (a card or a pane is no closed surface). Only when the scene has them.
   see_through_back_key_ = static_cast<std::uint32_t>(shades_.size());
@@ -473,8 +488,9 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
   if (M == mode::depth && occlusion_ && !edge_) {
     // Occlusion culling (occlusion.cpp): front to back, each node tested against the tiles of what
     // is drawn. A texel's winner is its nearest fragment in any order, unless two fragments tie,
-    // which the reference order decides (the first drawn wins): then the render is drawn again in
-    // that order, culled against the depths found (final: a node behind them neither wins nor
+    // which the reference order decides (the first drawn wins): the logged ties are settled in
+    // place (settle_ties), or with level of detail or an overflowed log the render is drawn again
+    // in that order, culled against the depths found (final: a node behind them neither wins nor
     // ties). Either way the buffer is the one the unculled reference order gives, bit for bit.
     occlusion_prepare();
     tiles_ready_ = true;
@@ -482,7 +498,9 @@ void raster_detail::rasterizer_impl::draw_all(const glm::vec3& position, const f
     culling_ = true;
     traverse_front_to_back(position, basis);
     tie_sink_ = nullptr;
-    if (ties_decide_order()) {
+    if (!ties_.overflow && !lod_) {
+      settle_ties();
+    } else if (ties_decide_order()) {
       ++stats_.occlusion_redraws;
       occlusion_freeze();
       redraw_prepare();
@@ -676,9 +694,10 @@ __attribute__((always_inline))
 // compared per draw.
 inline std::uint32_t raster_detail::rasterizer_impl::commit_record(float plane, const scene::triangle& tri,
                                                         const draw_record* rec, const frame& basis) {
-  const bool back = plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
+  const std::uint32_t front = front_keys_[tri.index];
+  const bool back = plane > 0.0f && (front & 1u);
   const auto draw = static_cast<std::uint32_t>(draw_keys_.size());
-  const std::uint32_t key = back ? 1u : 2u + scene_->emission_index(tri.index);
+  const std::uint32_t key = back ? 1u : front >> 1;
   draw_keys_.push_back(key);
   draw_triangles_.push_back(tri.index);
   if (textured_) {
@@ -1148,6 +1167,7 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
   if (texture) texture->validate(who);
   prepare(resolution);
   textured_ = texture && scene_->has_lightmap_uvs();
+  texture_ = textured_ ? texture : nullptr;
   if (edge_) edge_mark_hard(position, basis);
   draw_all<mode::depth>(position, basis);
   const bool see_through = !scene_->see_through_triangles().empty();
@@ -1229,6 +1249,7 @@ void raster_detail::rasterizer_impl::render_coverage(const glm::vec3& position, 
   counts.assign(hemicube_texel_count(resolution) + 8, 0u);
   counts_ = &counts;
   textured_ = false;
+  texture_ = nullptr;
   draw_all<mode::count>(position, basis);
   counts_ = nullptr;
   counts.resize(hemicube_texel_count(resolution));

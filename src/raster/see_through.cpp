@@ -172,7 +172,7 @@ void raster_detail::rasterizer_impl::draw_see_through_triangle(const scene::tria
   const glm::vec3 le1 = local[1] - local[0], le2 = local[2] - local[0];
   // Barycentrics of a local point q: b1 = grad_b1 . (q - v0), b2 = grad_b2 . (q - v0) (the UV pass's).
   const glm::vec3 grad_b1 = glm::cross(le2, rec.normal) / nn, grad_b2 = glm::cross(rec.normal, le1) / nn;
-  const bool back = rec.plane > 0.0f && !scene_->triangle_material(tri.index).two_sided;
+  const bool back = rec.plane > 0.0f && (front_keys_[tri.index] & 1u);
   const float far_limit = 1.0f / near_;  // 1/w of the near plane
   const edge_planes edges(local);
   // The triangle's orientation seen from the point (det(v0, v1, v2): the sign of every edge
