@@ -32,7 +32,10 @@ a later run unless --force; every bake runs alone, one after another):
    covered: hemilight samples the texel at its centre there); comparable (interior, its 8 neighbours
    interior too, so away from chart borders and from the geometry inside solids that invalid texels
    mark, and Cycles' mean sample position within a quarter texel of the centre in both seeds).
-   Against the Cycles reference also with its noise taken out (sqrt(e^2 - noise^2)).
+   Against the Cycles reference also with its noise taken out (sqrt(e^2 - noise^2)). Texels where a
+   reference is not finite are left out of every set and counted (Cycles writes NaN at a few
+   texels); a bake's own non-finite texels are left out of its error and counted
+   (nonfinite_valid_texels).
    Rows: both EXRs have the same row order for a glb (glTF's v = 0 is row 0 in hemilight and Blender's
    top scanline); every run checks it (the flipped comparison must be far worse).
 Writes --csv (default docs/bench/cycles_LEVEL_SIZE.csv), its chart (.png, same name: error against
@@ -338,11 +341,20 @@ def main():
     refs = [lum(load_exr(os.path.join(a.work, f"cy_ref_s{a.reference_samples}_seed{s + 1}.exr"), a.work))
             for s in range(a.reference_seeds)]
     C = sum(refs) / len(refs)
+    # Texels where a reference is not finite (Cycles writes NaN at a few texels) are left out of
+    # every set, and counted; a bake's own non-finite texels are left out of its error and counted.
+    finite_refs = np.isfinite(H) & np.isfinite(C)
+    nonfinite_refs = (f"texels left out (a reference not finite there): {int((valid & ~np.isfinite(H)).sum())} "
+                      f"valid texels of the hemilight reference, {int((valid & ~np.isfinite(C)).sum())} of the Cycles "
+                      f"reference")
+    print(nonfinite_refs)
 
     def rel_rms(x, ref, sel):
+        sel = sel & np.isfinite(x) & np.isfinite(ref)
         d = x[sel] - ref[sel]
         return float(math.sqrt((d * d).sum() / (ref[sel] ** 2).sum()))
 
+    valid, interior, comparable = valid & finite_refs, interior & finite_refs, comparable & finite_refs
     sets = {"valid": valid, "interior": interior, "comparable": comparable}
     # the Cycles reference's own noise: half the difference of two seeds, over sqrt(seeds / 2) more
     noise = {}
@@ -384,7 +396,8 @@ def main():
         if renderer == "cycles" and cy_first is None:
             cy_first = (label, Y)
         row = dict(renderer=renderer, label=label, n=n, a=at, samples=k, wall_seconds=float(t["wall_seconds"]),
-                   bake_seconds=float(t["bake_seconds"]), hemicubes=t["extra"] if renderer.startswith("hemilight") else "")
+                   bake_seconds=float(t["bake_seconds"]), hemicubes=t["extra"] if renderer.startswith("hemilight") else "",
+                   nonfinite_valid_texels=int((valid & ~np.isfinite(Y)).sum()))
         for nm, sel in sets.items():
             row[f"rms_{nm}"] = rel_rms(Y, H, sel)
         for nm, sel in sets.items():
@@ -407,7 +420,7 @@ def main():
         w.writeheader()
         w.writerows(rows)
     with open(a.csv[:-4] + "_check.txt", "w") as f:
-        f.write(r.level_line + "\n" + positions + "\n" + check + "\n")
+        f.write(r.level_line + "\n" + positions + "\n" + nonfinite_refs + "\n" + check + "\n")
     print(f"wrote {a.csv}")
 
     print(f"\n{r.level_line}\n{a.size}², {a.bounces} bounce(s), {a.threads} threads; relative RMS of luminance")
