@@ -3,7 +3,7 @@ and Cycles' time at the same error as hemilight's.
 
   /usr/bin/python3 benchmarks/cycles_compare.py [--quick] [--level arena] [--triangles T]
       [--lightmap-size S] [--size 1024] [--bounces 1] [--samples 16,64,256,1024]
-      [--hemilight 32:0.2,64:0.1,...] [--reference-n 256] [--reference-samples 4096]
+      [--hemilight 32:0.2,64:0.1,...] [--reference-n 128] [--reference-samples 2048]
       [--reference-seeds 2] [--threads 2] [--no-sun] [--work DIR] [--csv OUT.csv] [--plot-only] [--force]
 
 Steps (each bake's outputs are kept in --work, default build-bench/cycles/LEVEL_SIZE, and reused on
@@ -14,14 +14,14 @@ a later run unless --force; every bake runs alone, one after another):
    the sky alone; the files get the suffix _sky).
 2. hemilight: build-bench/examples/hemilight_bake LEVEL.glb --size SIZE --resolution N --error A
    --bounces B --threads 2 --sun ... --sky ... (A = "none": --no-cache), for every N:A of
-   --hemilight (default 32:0.2, 32:none, 64:0.1, 64:0.2, 64:0.4, 64:none); wall time of the command
+   --hemilight (default 32:0.2, 64:0.2, 64:0.1, 64:none); wall time of the command
    (import, bake, EXR and PNG writing) and the bake's own "total".
 3. Cycles: blender -b -P benchmarks/cycles_bake.py -- LEVEL.glb OUT.exr --size SIZE --samples K ...
    (DIFFUSE, direct + indirect, colour off, x pi: irradiance; see cycles_bake.py) for every K of
    --samples; wall time of the command (Blender's start, the glTF import, the bake, the EXR) and the
    bake operator's own time.
-4. References: hemilight --no-cache at N = --reference-n (default 256: a hemicube per texel), and
-   Cycles at --reference-samples (default 4096) with --reference-seeds independent seeds (default 2),
+4. References: hemilight --no-cache at N = --reference-n (default 128: a hemicube per texel), and
+   Cycles at --reference-samples (default 2048) with --reference-seeds independent seeds (default 2),
    averaged; their split-half difference estimates the Cycles reference's own noise. The two are
    checked against each other (median ratio, quartiles and RMS).
 5. Where Cycles evaluates the texels: cycles_bake.py --position (16 samples, two seeds) against the
@@ -45,7 +45,8 @@ samples), and prints Cycles' time at each hemilight bake's error and hemilight's
 bake's error in four views (log-log interpolation along each renderer's error-time front; "beyond"
 where a renderer never reached it).
 --quick: the arena at 10,000 triangles packed for 256², baked at 256², samples 16, 64, 256,
-hemilight 32:0.2, 64:0.2, 64:none, references N = 256 and 1024 samples x 2 (a few minutes).
+hemilight 32:0.2, 64:0.2, 64:none, references N = 128 and 1024 samples x 2 (a few minutes).
+The default run takes about 30 minutes on two cores (the references 25 of them).
 Needs Debian's blender (3.4.1; `apt-get install blender`, benchmarks/README.md), numpy and matplotlib
 for /usr/bin/python3, and build-bench with the examples (benchmarks/run.sh configures it so).
 """
@@ -106,7 +107,7 @@ def parse_args():
     p.add_argument("--bounces", type=int, default=1)
     p.add_argument("--samples", default="")
     p.add_argument("--hemilight", default="")
-    p.add_argument("--reference-n", type=int, default=256)
+    p.add_argument("--reference-n", type=int, default=128)
     p.add_argument("--reference-samples", type=int, default=0)
     p.add_argument("--reference-seeds", type=int, default=2)
     p.add_argument("--threads", type=int, default=2)
@@ -122,8 +123,8 @@ def parse_args():
         a.reference_samples = a.reference_samples or 1024
     a.size = a.size or 1024
     a.samples = a.samples or "16,64,256,1024"
-    a.hemilight = a.hemilight or "32:0.2,32:none,64:0.1,64:0.2,64:0.4,64:none"
-    a.reference_samples = a.reference_samples or 4096
+    a.hemilight = a.hemilight or "32:0.2,64:0.2,64:0.1,64:none"
+    a.reference_samples = a.reference_samples or 2048
     tag = (f"{a.level}{'_' + str(a.triangles) if a.triangles else ''}_{a.size}{'_b' + str(a.bounces) if a.bounces != 1 else ''}"
            f"{'_sky' if a.no_sun else ''}")
     a.work = a.work or os.path.join(BUILD, "cycles", tag)

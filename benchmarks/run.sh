@@ -22,7 +22,7 @@
 #                                     pavilion, the street and a 10k-triangle terrain (~4.5 min; not run by default)
 #   bash benchmarks/run.sh cycles             hemilight against Blender's Cycles on the arena at 1024²: error
 #                                     against time (benchmarks/cycles_compare.py; needs Debian's blender;
-#                                     ~1 h; CYCLES_FLAGS="--quick" for a few minutes; not run by default)
+#                                     ~30 min; CYCLES_FLAGS="--quick" for a few minutes; not run by default)
 #   bash benchmarks/run.sh raster_levels      a hemicube's cost on the stand-in levels (default size and 1M
 #                                     triangles) over the hexagon room's, culling on and off, paired rounds
 #                                     (docs/raster.md; ~4 min; RASTER_LEVELS_FLAGS="--quick" etc.; in the default run)
