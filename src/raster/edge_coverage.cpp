@@ -820,18 +820,7 @@ void raster_detail::rasterizer_impl::edge_group_fragments() {
 glm::vec3 raster_detail::rasterizer_impl::fragment_radiance(std::uint32_t id, std::size_t texel, float z,
                                                  const radiance_texture* texture) const {
   const std::uint32_t draw = id >> key_bits_;
-  if (textured_ && draws_[draw].textured) {
-    const draw_record& rec = draws_[draw];
-    const float distance = lengths_[texel] / z;
-    const glm::vec3 q = distance * directions_[texel] - rec.v0;
-    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-    const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
-    const std::vector<std::uint32_t>& indices = scene_->indices();
-    const std::uint32_t* v = rec.vertices ? rec.vertices : indices.data() + 3 * static_cast<std::size_t>(rec.index);
-    const glm::vec2& uv0 = uvs[v[0]];
-    const glm::vec2 uv = uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0);
-    return texture->sample(uv);
-  }
+  if (textured_ && draws_[draw].textured) return textured_texel(draws_[draw], texel, lengths_[texel] / z, *texture);
   const shade& sh = shades_[key_bits_ ? id & ((1u << key_bits_) - 1u) : draw_keys_[id]];
   return {sh.r, sh.g, sh.b};
 }

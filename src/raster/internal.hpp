@@ -179,6 +179,20 @@ class alignas(64) rasterizer_impl {
   // The public functions of hemicube_rasterizer (raster.hpp has their contracts).
   void bind(std::shared_ptr<const scene> s, const raster_options& options);
   void unbind() noexcept;
+  // What textured draw `rec` gives texel `texel` seen at distance t: the texture at the UV of the
+  // hit point t d on its triangle (perspective-correct). The one formula of every path.
+  glm::vec3 textured_texel(const draw_record& rec, std::size_t texel, float t, const radiance_texture& texture) const {
+    const glm::vec3 q = t * directions_[texel] - rec.v0;
+    const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
+    const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
+    const std::uint32_t* v = rec.vertices ? rec.vertices : scene_->indices().data() + 3 * static_cast<std::size_t>(rec.index);
+    const glm::vec2& uv0 = uvs[v[0]];
+    return texture.sample(uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0));
+  }
+  // A textured render's radiance: per texel won by a textured draw, the texture at the UV of the
+  // hit point t d on its triangle (perspective-correct); other texels keep their shade.
+  void resolve_textured(std::size_t count, const float* distance, const std::uint32_t* ids, const radiance_texture& texture,
+                        float* red, float* green, float* blue) const;
   void render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
               const radiance_texture* texture);
   void render_coverage(const glm::vec3& position, const frame& basis, int resolution,

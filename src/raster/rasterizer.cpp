@@ -1160,6 +1160,20 @@ void raster_detail::rasterizer_impl::draw_fixed(int face, const std::int64_t (&p
   walk_rows_of(nl, nr, left, right, y_first, y_last, box.x_begin, box.x_end, span);
 }
 
+void raster_detail::rasterizer_impl::resolve_textured(std::size_t count, const float* distance, const std::uint32_t* ids,
+                                                      const radiance_texture& texture, float* red, float* green,
+                                                      float* blue) const {
+  for (std::size_t i = 0; i < count; ++i) {
+    const draw_record& rec = draws_[ids[i] >> key_bits_];
+    if (!rec.textured) continue;
+    const glm::vec3 l = textured_texel(rec, i, distance[i], texture);
+    red[i] = l.x;
+    green[i] = l.y;
+    blue[i] = l.z;
+  }
+}
+
+
 void raster_detail::rasterizer_impl::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
                                  const radiance_texture* texture) {
   const char* who = "hemicube_rasterizer::render";
@@ -1213,24 +1227,7 @@ void raster_detail::rasterizer_impl::render(const glm::vec3& position, const fra
       blue[i] = l.z;
     }
   }
-  if (textured_) {
-    // Textured texels: perspective-correct UVs from the 3D hit point t d on the triangle.
-    const std::vector<glm::vec2>& uvs = scene_->lightmap_uvs();
-    const std::vector<std::uint32_t>& indices = scene_->indices();
-    for (std::size_t i = 0; i < count; ++i) {
-      const draw_record& rec = draws_[ids[i] >> key_bits_];
-      if (!rec.textured) continue;
-      const glm::vec3 q = distance[i] * directions_[i] - rec.v0;
-      const float b1 = glm::dot(rec.grad_b1, q), b2 = glm::dot(rec.grad_b2, q);
-      const std::uint32_t* v = rec.vertices ? rec.vertices : indices.data() + 3 * static_cast<std::size_t>(rec.index);
-      const glm::vec2& uv0 = uvs[v[0]];
-      const glm::vec2 uv = uv0 + b1 * (uvs[v[1]] - uv0) + b2 * (uvs[v[2]] - uv0);
-      const glm::vec3 l = texture->sample(uv);
-      red[i] = l.x;
-      green[i] = l.y;
-      blue[i] = l.z;
-    }
-  }
+  if (textured_) resolve_textured(count, distance, ids, *texture, red, green, blue);
   if (edge_) {
     // A texel an alpha-tested triangle wins keeps what its centre sees (no partial coverage).
     if (see_through) keep_cutouts(out);
