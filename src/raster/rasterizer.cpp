@@ -318,10 +318,10 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
   for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
-  // Per triangle (scene_desc numbering) its front key and whether its back is black, packed in
-  // one word: commit_record reads this compact table once per draw instead of the material and
-  // the emission index (two cache misses per drawn triangle on a large level; step 1 checked
-  // that the keys fit).
+  // Per triangle (scene_desc numbering) its position in the reference order (settle_ties), and
+  // its front key and whether its back is black, packed in one word: commit_record reads this
+  // compact table once per draw instead of the material and the emission index (two cache misses
+  // per drawn triangle on a large level; step 1 checked that the keys fit).
   bvh_position_.assign(scene_->triangle_count(), no_triangle);
   for (std::size_t i = 0; i < scene_->triangles().size(); ++i)
     bvh_position_[scene_->triangles()[i].index] = static_cast<std::uint32_t>(i);
@@ -1172,7 +1172,6 @@ void raster_detail::rasterizer_impl::resolve_textured(std::size_t count, const f
     blue[i] = l.z;
   }
 }
-
 
 void raster_detail::rasterizer_impl::render(const glm::vec3& position, const frame& basis, int resolution, hemicube_buffer& out,
                                  const radiance_texture* texture) {
