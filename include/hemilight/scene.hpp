@@ -287,7 +287,7 @@ class scene {
   std::vector<bvh_node> nodes_;
   // The ray queries' acceleration structure (rays.hpp): empty until the first query builds it.
   friend struct detail::derived_access;
-  std::shared_ptr<detail::lazy_slot> derived_[3];
+  std::shared_ptr<detail::lazy_slot> derived_[4];
 };
 
 }  // namespace hemilight

@@ -138,6 +138,19 @@ struct edge_table {
 // The edge table of `s`, built on the first call (thread-safe; O(T log T)).
 const edge_table& edge_table_of(const scene& s);
 
+// Per scene triangle (scene_desc numbering), what a draw needs of it: front_key = (2 + its
+// emission index) << 1 | 1 if it is one-sided (a draw reads this one compact word instead of the
+// material and the emission index: two cache misses per drawn triangle on a large level), and
+// position = its place in scene::triangles(), the reference order (settle_ties; no_triangle for
+// triangles not drawn there).
+struct triangle_keys {
+  std::vector<std::uint32_t> front_key, position;
+};
+
+// The triangle keys of `s`, built on the first call (thread-safe; O(T); 8 bytes per triangle,
+// shared by every rasterizer of the scene). Precondition: fewer than 2^30 distinct emissions.
+const triangle_keys& triangle_keys_of(const scene& s);
+
 // The texels where a fragment's depth equalled the depth already there (a tie, which the drawing
 // order decides), with that depth: occlusion culling's front-to-back pass checks after drawing
 // whether a tie still holds a texel's final depth. Ties are rare (coplanar overlapping triangles);
@@ -324,7 +337,6 @@ class alignas(64) rasterizer_impl {
   // reference order draws first (the lower position in scene::triangles()). Not with level of
   // detail (proxies have no position) nor after an overflow.
   void settle_ties();
-  std::vector<std::uint32_t> bvh_position_;  // per scene triangle: its position in scene::triangles() (bind)
   // See-through triangles (scene::see_through_triangles(); see_through.cpp): drawn after the
   // opaque ones, alpha-tested into depth_ and ids_, translucent as fragments composited over the
   // resolved buffer.
@@ -371,7 +383,8 @@ class alignas(64) rasterizer_impl {
   std::size_t tile_offset_[5] = {};            // each face's first tile
   int tiles_x_ = 0, tiles_y_[5] = {};          // tiles per row, rows of tiles per face
   std::vector<std::uint32_t> subtree_triangles_;  // per BVH node: the triangles below it (statistics)
-  std::vector<std::uint32_t> front_keys_;  // per scene triangle: (2 + emission index) << 1 | one-sided (bind)
+  const std::uint32_t* front_keys_ = nullptr;   // triangle_keys_of(*scene_): front_key (bind)
+  const std::uint32_t* bvh_position_ = nullptr;  // and position
 
   std::shared_ptr<const scene> scene_;
   float near_ = 0.0f;

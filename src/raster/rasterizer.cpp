@@ -5,6 +5,7 @@
 #include "hemilight/raster.hpp"
 #include "internal.hpp"
 #include "lod.hpp"
+#include "../scene/scene_access.hpp"
 
 #include "hemilight/cubemap.hpp"
 
@@ -185,6 +186,22 @@ glm::vec3 radiance_texture::sample(const glm::vec2& uv) const noexcept {
   return (1.0f - fy) * top + fy * bottom;
 }
 
+const raster_detail::triangle_keys& raster_detail::triangle_keys_of(const scene& s) {
+  detail::lazy_slot* slot = detail::derived_access::of(s, detail::derived_kind::raster_keys);
+  if (!slot->done.load(std::memory_order_acquire))
+    std::call_once(slot->once, [&] {
+      auto keys = std::make_shared<triangle_keys>();
+      keys->front_key.resize(s.triangle_count());
+      for (std::size_t i = 0; i < s.triangle_count(); ++i)
+        keys->front_key[i] = (2u + s.emission_index(i)) << 1 | (s.triangle_material(i).two_sided ? 0u : 1u);
+      keys->position.assign(s.triangle_count(), hemicube_rasterizer::no_triangle);
+      for (std::size_t i = 0; i < s.triangles().size(); ++i) keys->position[s.triangles()[i].index] = static_cast<std::uint32_t>(i);
+      slot->value = std::move(keys);
+      slot->done.store(true, std::memory_order_release);
+    });
+  return *static_cast<const triangle_keys*>(slot->value.get());
+}
+
 float default_near_distance(const scene& s) noexcept {
   const float d = 1e-4f * s.size();
   return d > 0.0f ? d : 1e-4f;
@@ -279,13 +296,14 @@ void validate_raster_options(const raster_options& options, const std::string& w
 void raster_detail::rasterizer_impl::unbind() noexcept {
   scene_.reset();
   sky_.reset();
+  front_keys_ = bvh_position_ = nullptr;  // the scene's (triangle_keys_of)
 }
 
 void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const raster_options& options) {
   // Step 1: every check before any member changes (a failed bind leaves the rasterizer as it was).
   if (!s) throw_invalid_argument("hemicube_rasterizer: scene is null");
   validate_raster_options(options, "hemicube_rasterizer");
-  // front_keys_ packs 2 + an emission index and a flag in 32 bits (a scene with 2^30 distinct
+  // triangle_keys packs 2 + an emission index and a flag in 32 bits (a scene with 2^30 distinct
   // emissions would need over 100 GB).
   if (s->emissions().size() >= (std::size_t(1) << 30))
     throw_invalid_argument("hemicube_rasterizer: the scene has " + std::to_string(s->emissions().size()) +
@@ -318,16 +336,9 @@ void raster_detail::rasterizer_impl::bind(std::shared_ptr<const scene> s, const 
   shades_.push_back({sky.x, sky.y, sky.z, texel_miss});
   shades_.push_back({0.0f, 0.0f, 0.0f, texel_back_face});
   for (const glm::vec3& e : scene_->emissions()) shades_.push_back({e.x, e.y, e.z, texel_hit_front});
-  // Per triangle (scene_desc numbering) its position in the reference order (settle_ties), and
-  // its front key and whether its back is black, packed in one word: commit_record reads this
-  // compact table once per draw instead of the material and the emission index (two cache misses
-  // per drawn triangle on a large level; step 1 checked that the keys fit).
-  bvh_position_.assign(scene_->triangle_count(), no_triangle);
-  for (std::size_t i = 0; i < scene_->triangles().size(); ++i)
-    bvh_position_[scene_->triangles()[i].index] = static_cast<std::uint32_t>(i);
-  front_keys_.resize(scene_->triangle_count());
-  for (std::size_t i = 0; i < front_keys_.size(); ++i)
-    front_keys_[i] = (2u + scene_->emission_index(i)) << 1 | (scene_->triangle_material(i).two_sided ? 0u : 1u);
+  const triangle_keys& keys = triangle_keys_of(*scene_);  // step 1 checked that the keys fit
+  front_keys_ = keys.front_key.data();
+  bvh_position_ = keys.position.data();
   // The back of a one-sided see-through triangle: black, but not a back face to the tests for
   // texels inside geometry (a card or a pane is no closed surface). Only when the scene has them.
   see_through_back_key_ = static_cast<std::uint32_t>(shades_.size());

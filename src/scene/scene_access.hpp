@@ -25,10 +25,11 @@ struct lazy_slot {
 };
 
 /// The scene's lazy slots, one per kind of data a module derives from it: the ray queries' Embree
-/// scene (rays.cpp), the rasterizer's level-of-detail proxies (src/raster/lod.cpp) and the edges
-/// exact edge coverage may find hard (src/raster/edge_coverage.cpp). Null only for a scene not
-/// made by scene::create.
-enum class derived_kind : int { rays = 0, raster_lod = 1, raster_edges = 2 };
+/// scene (rays.cpp), the rasterizer's level-of-detail proxies (src/raster/lod.cpp), the edges
+/// exact edge coverage may find hard (src/raster/edge_coverage.cpp) and the rasterizer's
+/// per-triangle keys and draw order (src/raster/rasterizer.cpp). Null only for a scene not made
+/// by scene::create.
+enum class derived_kind : int { rays = 0, raster_lod = 1, raster_edges = 2, raster_keys = 3 };
 struct derived_access {
   static lazy_slot* of(const scene& s, derived_kind kind) noexcept { return s.derived_[static_cast<int>(kind)].get(); }
 };
